@@ -1,0 +1,2 @@
+// ridge: the command-line tool (being written).
+int main() { return 0; }

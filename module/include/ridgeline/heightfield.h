@@ -1,0 +1,132 @@
+// Heightfield: the stored samples of a terrain, validated, placed in the world (SPEC.md, Coordinates).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "ridgeline/result.h"
+
+namespace ridgeline {
+
+/// What to do with samples that are non-finite or equal to the no-data value.
+enum class FillPolicy {
+  kRefuse,    ///< creation fails, naming the first bad sample (the default)
+  kNearest,   ///< replaced by the nearest valid sample (4-neighbour distance, ties by scan order)
+  kConstant,  ///< replaced by `fill_constant` (a raw value, scaled like any other)
+};
+
+/// Everything needed to turn raw sample values into a placed heightfield. Defaults are sane.
+struct HeightfieldDesc {
+  std::uint32_t width = 0;   ///< samples along x (image columns), >= 2
+  std::uint32_t height = 0;  ///< samples along z (image rows), >= 2
+  double spacing_x = 1.0;    ///< metres between samples along x; finite, > 0
+  double spacing_z = 1.0;    ///< metres between samples along z; finite, > 0
+  double origin_x = 0.0;     ///< world x of sample (0, 0), metres; finite
+  double origin_z = 0.0;     ///< world z of sample (0, 0), metres; finite
+  double height_scale = 1.0;   ///< height = height_offset + height_scale * value; finite, > 0
+  double height_offset = 0.0;  ///< metres; finite
+  std::optional<double> nodata;  ///< raw value that marks a missing sample
+  FillPolicy fill = FillPolicy::kRefuse;
+  double fill_constant = 0.0;  ///< raw value used by FillPolicy::kConstant; finite
+  /// Refuse sizes above this many samples (checked before allocating). Default 2^28 (1 GiB of
+  /// float heights).
+  std::uint64_t max_samples = std::uint64_t{1} << 28;
+  /// Name used in error messages (a file name, "default terrain", ...).
+  std::string name = "heightfield";
+};
+
+/// Checks a descriptor's size, spacing, scale and placement without touching sample data.
+/// Loaders call it before allocating. Error messages name `desc.name` and the bad value.
+Status validate_heightfield_desc(const HeightfieldDesc& desc);
+
+/// A validated grid of heights. Immutable after creation; move-only; all const methods are safe
+/// from any number of threads. Heights are stored as float metres relative to `height_offset()`
+/// (so a terrain whose heights sit at 1e6 m keeps float precision); world heights are doubles.
+/// Row-major: index = i + j * width.
+class Heightfield {
+ public:
+  /// Validates `desc` and `values` (width * height raw values, row-major) and builds the field.
+  /// `materials`, if not empty, holds one material id per cell ((width-1) * (height-1) values) or
+  /// per sample (width * height values; cell (i, j) takes sample (i, j)'s id). Fails with a precise
+  /// message on any bad input; nothing is built then.
+  static Result<Heightfield> create(const HeightfieldDesc& desc, std::span<const float> values,
+                                    std::span<const std::uint8_t> materials = {});
+
+  Heightfield(Heightfield&&) noexcept = default;
+  Heightfield& operator=(Heightfield&&) noexcept = default;
+  Heightfield(const Heightfield&) = delete;
+  Heightfield& operator=(const Heightfield&) = delete;
+
+  std::uint32_t width() const noexcept { return width_; }
+  std::uint32_t height() const noexcept { return height_; }
+  double spacing_x() const noexcept { return spacing_x_; }
+  double spacing_z() const noexcept { return spacing_z_; }
+  double origin_x() const noexcept { return origin_x_; }
+  double origin_z() const noexcept { return origin_z_; }
+  double height_offset() const noexcept { return height_offset_; }
+  double height_scale() const noexcept { return height_scale_; }
+  /// World extent along x and z in metres: (width - 1) * spacing_x, (height - 1) * spacing_z.
+  double extent_x() const noexcept { return (width_ - 1) * spacing_x_; }
+  double extent_z() const noexcept { return (height_ - 1) * spacing_z_; }
+
+  /// Height of sample (i, j) relative to height_offset(), metres. No bounds check beyond an
+  /// assert: i < width(), j < height().
+  float local(std::uint32_t i, std::uint32_t j) const noexcept {
+    return heights_[i + static_cast<std::size_t>(j) * width_];
+  }
+  /// Like local() but clamps (i, j) into the grid: the edge-repeating padding of SPEC.md.
+  float local_clamped(std::int64_t i, std::int64_t j) const noexcept;
+  /// World height of sample (i, j), metres.
+  double world(std::uint32_t i, std::uint32_t j) const noexcept {
+    return height_offset_ + local(i, j);
+  }
+  /// All heights relative to height_offset(), row-major.
+  std::span<const float> local_heights() const noexcept { return heights_; }
+
+  float min_local() const noexcept { return min_local_; }
+  float max_local() const noexcept { return max_local_; }
+
+  bool has_materials() const noexcept { return !materials_.empty(); }
+  /// Material id of cell (i, j), 0 when the field has no material layer. i < width-1, j < height-1.
+  std::uint8_t material(std::uint32_t i, std::uint32_t j) const noexcept {
+    return materials_.empty() ? 0 : materials_[i + static_cast<std::size_t>(j) * (width_ - 1)];
+  }
+
+  /// Number of samples replaced by the fill policy at creation.
+  std::uint64_t filled_samples() const noexcept { return filled_samples_; }
+  /// Bytes held by this object (heights and materials).
+  std::size_t memory_bytes() const noexcept {
+    return heights_.capacity() * sizeof(float) + materials_.capacity();
+  }
+  /// A 64-bit FNV-1a hash of size, placement and height bits: identifies the base data (save files
+  /// refuse to load onto another terrain).
+  std::uint64_t content_hash() const noexcept;
+
+ private:
+  Heightfield() = default;
+
+  std::vector<float> heights_;
+  std::vector<std::uint8_t> materials_;
+  std::uint32_t width_ = 0, height_ = 0;
+  double spacing_x_ = 1, spacing_z_ = 1, origin_x_ = 0, origin_z_ = 0;
+  double height_offset_ = 0, height_scale_ = 1;
+  float min_local_ = 0, max_local_ = 0;
+  std::uint64_t filled_samples_ = 0;
+};
+
+/// The built-in default terrain: 1025 x 1025 samples, 2 m spacing (a 2048 m square) at origin
+/// (0, 0), seed 1337, fBm value noise with ridges, heights about 0 .. 260 m, with a material layer
+/// (0 grass, 1 rock on steep cells, 2 sand near the lowest heights, 3 snow near the top).
+/// Deterministic: the same bytes on every machine. Benchmark figures quoted with
+/// `--default-terrain` depend on exactly these parameters.
+struct DefaultTerrainParams {
+  std::uint32_t size = 1025;
+  double spacing = 2.0;
+  std::uint32_t seed = 1337;
+};
+Result<Heightfield> make_default_heightfield(const DefaultTerrainParams& params = {});
+
+}  // namespace ridgeline

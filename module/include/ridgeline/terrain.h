@@ -1,0 +1,116 @@
+// Terrain: shared, read-mostly terrain data (heightfield, ray hierarchy) and the physics queries on
+// the surface of surface.h.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+#include "ridgeline/heightfield.h"
+#include "ridgeline/result.h"
+
+namespace ridgeline {
+
+class RayHierarchy;
+
+/// Height, both normals and the material at a point of the surface.
+struct SurfaceSample {
+  double height = 0;             ///< world height, metres
+  glm::vec3 face_normal{0, 1, 0};    ///< unit normal of the triangle under the point (physics)
+  glm::vec3 smooth_normal{0, 1, 0};  ///< unit normal interpolated from vertex normals (shading)
+  std::uint8_t material = 0;     ///< material id of the cell under the point
+};
+
+/// The first intersection of a ray with the surface.
+struct RayHit {
+  double distance = 0;        ///< metres along the (normalised) direction from the origin
+  glm::dvec3 point{0};        ///< world position of the hit
+  glm::vec3 normal{0, 1, 0};  ///< face normal of the triangle hit (unit, points up)
+  std::uint8_t material = 0;
+  bool started_below = false;  ///< the origin was below the surface: distance 0, point = origin
+};
+
+/// A full-detail surface triangle in world coordinates, counter-clockwise seen from above.
+struct SurfaceTriangle {
+  glm::dvec3 v[3];
+  std::uint8_t material = 0;
+};
+
+/// Axis-aligned box in world coordinates (metres). min <= max per axis.
+struct Box {
+  glm::dvec3 min{0};
+  glm::dvec3 max{0};
+};
+
+/// The terrain shared by every view and every physics query. Created once from a Heightfield;
+/// immutable afterwards in this version (deformation arrives with the edit layer).
+///
+/// Threading: every const method may run concurrently from any number of threads.
+///
+/// Queries take world coordinates in double precision. Points outside the sampled area (including
+/// the padding that patches add), and NaN or infinite input, give an empty optional or no hit;
+/// they never have undefined behaviour. A point exactly on the far edge (x = origin_x + extent_x)
+/// is on the terrain.
+class Terrain {
+ public:
+  /// Builds the query acceleration structures (a max-height pyramid for rays). Never fails for a
+  /// valid Heightfield.
+  static std::shared_ptr<const Terrain> create(Heightfield heightfield);
+
+  ~Terrain();
+  Terrain(const Terrain&) = delete;
+  Terrain& operator=(const Terrain&) = delete;
+
+  const Heightfield& heightfield() const noexcept { return heightfield_; }
+
+  /// World height of the surface at (x, z), metres; empty off-terrain or for non-finite input.
+  std::optional<double> height(double x, double z) const noexcept;
+  /// Face normal (unit, y > 0) of the triangle under (x, z). Points on an edge shared by two
+  /// triangles take the triangle that locate_in_cell() picks.
+  std::optional<glm::vec3> face_normal(double x, double z) const noexcept;
+  /// Smooth normal (unit, y > 0): barycentric blend of the vertex normals of the triangle under
+  /// (x, z); a vertex normal is the area-weighted mean of the face normals of the triangles
+  /// around the vertex.
+  std::optional<glm::vec3> smooth_normal(double x, double z) const noexcept;
+  /// Height, both normals and the material in one call.
+  std::optional<SurfaceSample> sample(double x, double z) const noexcept;
+
+  /// Batched heights: out[k] = height(xz[k]) or NaN off-terrain. out.size() must be >= xz.size().
+  void heights(std::span<const glm::dvec2> xz, std::span<double> out) const noexcept;
+  /// Batched samples: valid[k] says whether out[k] is meaningful. Sizes as for heights().
+  void samples(std::span<const glm::dvec2> xz, std::span<SurfaceSample> out,
+               std::span<std::uint8_t> valid) const noexcept;
+
+  /// First intersection of the ray origin + t * normalize(direction), 0 <= t <= max_distance,
+  /// with the surface. Empty when it misses, leaves the terrain first, direction is zero, or any
+  /// input is non-finite. A ray starting below the surface (inside the solid under it) reports a
+  /// hit at distance 0 with started_below = true. A ray that only touches the surface (grazes it
+  /// at a point or runs along it) counts as a hit at the first touching point.
+  std::optional<RayHit> raycast(const glm::dvec3& origin, const glm::dvec3& direction,
+                                double max_distance) const noexcept;
+
+  /// Appends to `out` every full-detail triangle whose xz footprint overlaps the box's xz range and
+  /// whose height range overlaps [box.min.y, box.max.y]: what a physics mid-phase asks for.
+  /// Returns the number appended. `max_triangles` caps the work (0 = no cap); when the cap is
+  /// hit the result is truncated and the return value equals the cap.
+  std::size_t triangles_in_box(const Box& box, std::vector<SurfaceTriangle>& out,
+                               std::size_t max_triangles = 0) const;
+
+  /// Bytes held: heights, materials, ray hierarchy.
+  std::size_t memory_bytes() const noexcept;
+
+ private:
+  explicit Terrain(Heightfield heightfield);
+
+  Heightfield heightfield_;
+  std::unique_ptr<RayHierarchy> rays_;
+  // Cached for the query fast path.
+  double inv_spacing_x_ = 1, inv_spacing_z_ = 1;
+};
+
+}  // namespace ridgeline

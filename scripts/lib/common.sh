@@ -1,0 +1,45 @@
+# Shared by scripts/demo.sh and scripts/test.sh: package installation and the build.
+# shellcheck shell=bash
+
+RIDGELINE_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
+
+# Debian packages the build, the tests and the demo need (--no-install-recommends).
+RIDGELINE_PACKAGES=(
+  g++ cmake ninja-build pkg-config git ca-certificates
+  libglm-dev libopenimageio-dev libtinygltf-dev nlohmann-json3-dev libcli11-dev
+  libgtest-dev libbenchmark-dev
+)
+
+# Installs the given Debian packages that are missing, through sudo when not root.
+ensure_packages() {
+  local missing=() p
+  for p in "$@"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  echo "installing: ${missing[*]}"
+  local sudo=()
+  [ "$(id -u)" -eq 0 ] || sudo=(sudo)
+  export DEBIAN_FRONTEND=noninteractive
+  "${sudo[@]}" apt-get update -qq
+  "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" > /dev/null
+}
+
+# configure_and_build BUILD_DIR [cmake args...]
+configure_and_build() {
+  local dir=$1; shift
+  cmake -S "$RIDGELINE_ROOT" -B "$dir" -G Ninja "$@" > "$dir.configure.log" 2>&1 || {
+    cat "$dir.configure.log"; return 1; }
+  cmake --build "$dir" -j "$(nproc)"
+}
+
+# stage NAME COMMAND...: runs a stage and prints its wall time.
+stage() {
+  local name=$1; shift
+  local t0=$SECONDS
+  echo "=== stage: $name"
+  "$@"
+  local rc=$?
+  echo "=== stage: $name took $((SECONDS - t0)) s (exit $rc)"
+  return $rc
+}

@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Builds and runs every test: the normal build and its tests, then an AddressSanitizer +
+# UndefinedBehaviorSanitizer build of the tests. Installs missing Debian packages first.
+# Usage: scripts/test.sh            (all stages)
+#        STAGES="release" scripts/test.sh   (a subset: release asan)
+set -uo pipefail
+source "$(dirname "$0")/lib/common.sh"
+cd "$RIDGELINE_ROOT"
+
+STAGES=${STAGES:-"release asan"}
+JOBS=$(nproc)
+total0=$SECONDS
+
+stage "packages" ensure_packages "${RIDGELINE_PACKAGES[@]}" clang-14 || exit 1
+
+release() {
+  configure_and_build build/release -DCMAKE_BUILD_TYPE=Release || return 1
+  (cd build/release && ctest --output-on-failure -j "$JOBS")
+}
+
+asan() {
+  # clang for the sanitizer build (the same build will carry the fuzzers).
+  configure_and_build build/asan -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DCMAKE_CXX_COMPILER=clang++-14 -DRIDGELINE_SANITIZE=address,undefined \
+    -DRIDGELINE_BUILD_BENCHMARKS=OFF || return 1
+  (cd build/asan && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
+     UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 ctest --output-on-failure -j "$JOBS")
+}
+
+rc=0
+for s in $STAGES; do
+  stage "$s" "$s" || rc=1
+done
+echo "=== all stages took $((SECONDS - total0)) s"
+exit $rc
