@@ -1,2 +1,235 @@
-// (being written)
-#include "ridgeline/io.h"
+// Heightmaps and material layers read through OpenImageIO.
+//
+// Headers are checked (size against the cap, channel count, pixel type) before any pixel buffer
+// is allocated, and integer pixels are read in their native type so that a 16-bit PNG gives
+// 0..65535 rather than OIIO's normalised 0..1.
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <memory>
+
+#include "format.h"
+#include "io/loader_common.h"
+#include "ridgeline/log.h"
+
+namespace ridgeline::io {
+
+namespace detail {
+
+std::string heightmap_name(const std::string& path) {
+  return "heightmap '" + path + "'";
+}
+
+Status check_regular_file(const std::string& path, const std::string& name) {
+  std::error_code ec;
+  const auto st = std::filesystem::status(path, ec);
+  if (st.type() == std::filesystem::file_type::not_found) return Error{name + ": no such file"};
+  if (ec) return Error{name + ": cannot access: " + ec.message()};
+  if (st.type() == std::filesystem::file_type::directory) return Error{name + ": is a directory"};
+  if (st.type() != std::filesystem::file_type::regular) return Error{name + ": not a regular file"};
+  return {};
+}
+
+}  // namespace detail
+
+namespace {
+
+using OIIO::ImageInput;
+using OIIO::ImageSpec;
+using OIIO::TypeDesc;
+
+// OIIO messages may span lines and end in a newline; keep them on one line.
+std::string one_line(std::string s) {
+  std::replace(s.begin(), s.end(), '\n', ' ');
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\r')) s.pop_back();
+  return s.empty() ? std::string("unknown error") : s;
+}
+
+std::string channel_list(const ImageSpec& spec) {
+  std::string out;
+  for (int c = 0; c < spec.nchannels; ++c) {
+    if (c) out += ", ";
+    out +=
+        c < static_cast<int>(spec.channelnames.size()) ? spec.channelnames[c] : std::to_string(c);
+  }
+  return out;
+}
+
+/// An open image whose header passed the checks common to heightmaps and material layers.
+struct OpenImage {
+  std::unique_ptr<ImageInput> input;
+  std::uint32_t width = 0, height = 0;
+  int nchannels = 0;
+};
+
+Result<OpenImage> open_image(const std::string& path, const std::string& name) {
+  if (auto s = detail::check_regular_file(path, name); !s) return Error{s.message()};
+  // Keep colour values as stored: OIIO would otherwise premultiply grey by alpha.
+  ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  auto in = ImageInput::open(path, &config);
+  if (!in) return Error{name + ": not a readable image: " + one_line(OIIO::geterror())};
+  const ImageSpec& spec = in->spec();
+  if (spec.deep) return Error{name + ": deep images are not supported"};
+  if (spec.depth > 1)
+    return Error{fmt("%s: a volume image (%d slices); need a 2D image", name.c_str(), spec.depth)};
+  if (spec.width < 0 || spec.height < 0 || spec.nchannels < 1)
+    return Error{fmt("%s: invalid header (%d x %d pixels, %d channels)", name.c_str(), spec.width,
+                     spec.height, spec.nchannels)};
+  OpenImage out;
+  out.width = static_cast<std::uint32_t>(spec.width);
+  out.height = static_cast<std::uint32_t>(spec.height);
+  out.nchannels = spec.nchannels;
+  out.input = std::move(in);
+  return out;
+}
+
+/// Reads channel `c` of the whole image as T (no normalisation: T is the native type or float
+/// for float-like pixel types) into a buffer of width * height values.
+template <class T>
+Status read_channel(ImageInput& in, int c, TypeDesc type, std::vector<T>& out,
+                    const std::string& name) {
+  const ImageSpec& spec = in.spec();
+  out.resize(static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height));
+  const bool ok = in.read_image(0, 0, c, c + 1, type, out.data());
+  // Some readers report a problem (a short strip, a bad CRC) and still return true.
+  if (!ok || in.has_error()) {
+    out.clear();
+    out.shrink_to_fit();
+    return Error{
+        name + ": cannot read the pixels (truncated or corrupt file?): " + one_line(in.geterror())};
+  }
+  return {};
+}
+
+template <class T>
+Status read_as_float(ImageInput& in, int c, TypeDesc type, std::vector<float>& values,
+                     const std::string& name) {
+  std::vector<T> native;
+  if (auto s = read_channel(in, c, type, native, name); !s) return s;
+  values.resize(native.size());
+  std::transform(native.begin(), native.end(), values.begin(),
+                 [](T v) { return static_cast<float>(v); });
+  return {};
+}
+
+/// Reads channel `c` as raw values: integers as the integer, floats as the float.
+Status read_values(ImageInput& in, int c, std::vector<float>& values, const std::string& name) {
+  const TypeDesc t = in.spec().channelformat(c);
+  switch (t.basetype) {
+    case TypeDesc::UINT8:
+      return read_as_float<std::uint8_t>(in, c, TypeDesc::UINT8, values, name);
+    case TypeDesc::INT8:
+      return read_as_float<std::int8_t>(in, c, TypeDesc::INT8, values, name);
+    case TypeDesc::UINT16:
+      return read_as_float<std::uint16_t>(in, c, TypeDesc::UINT16, values, name);
+    case TypeDesc::INT16:
+      return read_as_float<std::int16_t>(in, c, TypeDesc::INT16, values, name);
+    case TypeDesc::UINT32:
+    case TypeDesc::INT32:
+      // Up to 2^24 these are exact in float; larger ones are rounded (documented in io.h).
+      if (t.basetype == TypeDesc::UINT32)
+        return read_as_float<std::uint32_t>(in, c, TypeDesc::UINT32, values, name);
+      return read_as_float<std::int32_t>(in, c, TypeDesc::INT32, values, name);
+    case TypeDesc::HALF:
+    case TypeDesc::FLOAT:
+      return read_channel(in, c, TypeDesc::FLOAT, values, name);
+    case TypeDesc::DOUBLE:
+      // Values beyond float range become infinite and are refused by Heightfield::create.
+      return read_as_float<double>(in, c, TypeDesc::DOUBLE, values, name);
+    default:
+      return Error{name + ": pixel type '" + std::string(t.c_str()) + "' is not supported"};
+  }
+}
+
+}  // namespace
+
+namespace detail {
+
+Result<std::vector<std::uint8_t>> load_material_ids(const LoadOptions& options, std::uint32_t width,
+                                                    std::uint32_t height) {
+  std::vector<std::uint8_t> ids;
+  if (options.materials_path.empty()) return ids;
+  const std::string name = "material image '" + options.materials_path + "'";
+  auto img = open_image(options.materials_path, name);
+  if (!img) return img.error();
+  const ImageSpec& spec = img->input->spec();
+  if (img->width != width || img->height != height)
+    return Error{fmt("%s: %u x %u pixels; the heightmap has %u x %u samples", name.c_str(),
+                     img->width, img->height, width, height)};
+  if (img->nchannels != 1)
+    return Error{fmt("%s: %d channels (%s); need one 8-bit channel of material ids", name.c_str(),
+                     img->nchannels, channel_list(spec).c_str())};
+  if (spec.channelformat(0).basetype != TypeDesc::UINT8)
+    return Error{name + ": pixel type '" + std::string(spec.channelformat(0).c_str()) +
+                 "'; need 8-bit unsigned material ids"};
+  if (auto s = read_channel(*img->input, 0, TypeDesc::UINT8, ids, name); !s)
+    return Error{s.message()};
+  return ids;
+}
+
+Result<Heightfield> finish_heightfield(const HeightfieldDesc& desc, std::span<const float> values,
+                                       const LoadOptions& options) {
+  auto ids = load_material_ids(options, desc.width, desc.height);
+  if (!ids) return ids.error();
+  return Heightfield::create(desc, values, *ids);
+}
+
+}  // namespace detail
+
+Result<Heightfield> load_image(const std::string& path, const LoadOptions& options) {
+  const std::string name = detail::heightmap_name(path);
+  auto img = open_image(path, name);
+  if (!img) return img.error();
+  const ImageSpec& spec = img->input->spec();
+
+  HeightfieldDesc desc = options.placement;
+  desc.width = img->width;
+  desc.height = img->height;
+  desc.name = name;
+  // Size (and the cap), spacing, scale: all before a single pixel is allocated.
+  if (auto s = validate_heightfield_desc(desc); !s) return Error{s.message()};
+
+  int channel = 0;
+  if (options.channel >= 0) {
+    if (options.channel >= img->nchannels)
+      return Error{fmt("%s: channel %d requested but the image has %d channel%s (%s)", name.c_str(),
+                       options.channel, img->nchannels, img->nchannels == 1 ? "" : "s",
+                       channel_list(spec).c_str())};
+    channel = options.channel;
+    if (img->nchannels > 1)
+      log_message(LogLevel::kInfo, fmt("%s: using channel %d (%s) of %d", name.c_str(), channel,
+                                       spec.channelnames[channel].c_str(), img->nchannels));
+  } else if (img->nchannels == 2 && spec.alpha_channel == 1) {
+    log_message(LogLevel::kInfo,
+                fmt("%s: greyscale + alpha image; using the grey channel (0), ignoring alpha",
+                    name.c_str()));
+  } else if (img->nchannels > 1) {
+    return Error{
+        fmt("%s: %d channels (%s); a heightmap needs one channel (choose one with the "
+            "channel option, e.g. --channel 0)",
+            name.c_str(), img->nchannels, channel_list(spec).c_str())};
+  }
+
+  std::vector<float> values;
+  if (auto s = read_values(*img->input, channel, values, name); !s) return Error{s.message()};
+  img->input->close();
+  return detail::finish_heightfield(desc, values, options);
+}
+
+Result<Heightfield> load_heightmap(const std::string& path, const LoadOptions& options,
+                                   const RawFormat* raw) {
+  if (raw && raw->width != 0 && raw->height != 0) return load_raw(path, *raw, options);
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  if (ext == ".raw" || ext == ".r16" || ext == ".r32")
+    return Error{detail::heightmap_name(path) +
+                 ": a headerless raw file needs its size and sample type (--raw-size W,H "
+                 "--raw-type u16|f32)"};
+  return load_image(path, options);
+}
+
+}  // namespace ridgeline::io
