@@ -1,1 +1,222 @@
-echo "cli tests: being written"
+#!/usr/bin/env bash
+# End-to-end checks of the `ridge` tool: every subcommand, its output format, bad flags, bad
+# files, bad CSV lines and exit codes (0 ok, 1 runtime error, 2 usage error).
+# Environment: RIDGE (the binary), TEST_DATA (tests/data), TMPDIR (a scratch directory).
+set -u
+: "${RIDGE:?set RIDGE to the ridge binary}" "${TEST_DATA:?set TEST_DATA}" "${TMPDIR:=/tmp}"
+T=$(mktemp -d "$TMPDIR/cli_ridge.XXXXXX")
+trap 'rm -rf "$T"' EXIT
+passed=0
+failed=0
+
+ok() { passed=$((passed + 1)); }
+bad() { failed=$((failed + 1)); echo "FAIL: $1"; [ -n "${2:-}" ] && printf '  %s\n' "$2"; }
+
+# run ARGS...: runs ridge, keeping stdout in $out, stderr in $err and the exit code in $rc.
+run() {
+  "$RIDGE" "$@" > "$T/stdout" 2> "$T/stderr"
+  rc=$?
+  out=$(cat "$T/stdout")
+  err=$(cat "$T/stderr")
+}
+
+# expect NAME RC [STDERR_SUBSTRING]: checks the last run's exit code (and stderr text).
+expect() {
+  local name=$1 want=$2 text=${3:-}
+  if [ "$rc" != "$want" ]; then
+    bad "$name: exit $rc, want $want" "stderr: $err"
+  elif [ -n "$text" ] && [[ "$err" != *"$text"* ]]; then
+    bad "$name: stderr lacks '$text'" "stderr: $err"
+  elif [ "$want" != 0 ] && [ -n "$out" ] && [ -z "${ALLOW_OUT:-}" ]; then
+    bad "$name: failed but wrote to stdout" "stdout: $out"
+  else
+    ok
+  fi
+}
+
+# contains NAME TEXT: the last run's stdout contains TEXT.
+contains() {
+  if [[ "$out" == *"$2"* ]]; then ok; else bad "$1: stdout lacks '$2'" "stdout: ${out:0:400}"; fi
+}
+
+# near NAME A B TOL: |A - B| <= TOL (floating point, through awk).
+near() {
+  if awk -v a="$2" -v b="$3" -v t="$4" 'BEGIN { d = a - b; if (d < 0) d = -d; exit !(d <= t) }'
+  then ok; else bad "$1: $2 vs $3 (tolerance $4)"; fi
+}
+
+# json_num KEY: the number after "KEY": in $out (first occurrence).
+json_num() { sed -n "s/.*\"$1\": *\([-0-9.eE+]*\).*/\1/p" <<< "$out" | head -1; }
+
+# A 3 x 2 raw u16 heightmap: 10 20 30 / 40 0 60 (the 0 is used as no-data below).
+printf '\x0a\x00\x14\x00\x1e\x00\x28\x00\x00\x00\x3c\x00' > "$T/h.r16"
+PNG=$TEST_DATA/ramp16.png   # 5 x 4, 16-bit, value(i, j) = 1000 + 100 i + 10 j
+RGB=$TEST_DATA/rgb8.png     # 4 x 3, 8-bit RGB: R = i, G = 10 + j, B = 200
+
+# ---- help and usage ------------------------------------------------------------------------------
+run --help; expect "ridge --help" 0
+for s in info query profile bench; do contains "ridge --help lists $s" "$s"; done
+for s in info query profile bench "bench queries"; do
+  # shellcheck disable=SC2086
+  run $s --help; expect "ridge $s --help" 0
+done
+run info --help; contains "info --help shows the terrain flags" "--raw-size"
+run; expect "no subcommand" 2
+run frobnicate; expect "unknown subcommand" 2
+run info --default-terrain --no-such-flag; expect "unknown flag" 2
+run bench --default-terrain; expect "bench without a benchmark" 2
+run info --default-terrain --heightmap "$PNG"; expect "--heightmap with --default-terrain" 2
+run info; expect "no terrain" 1 "no terrain given"
+
+# ---- info ----------------------------------------------------------------------------------------
+run info --default-terrain; expect "info default" 0
+contains "info default width" '"width": 1025'
+contains "info default height" '"height": 1025'
+contains "info default spacing" '"spacing": ['
+contains "info default materials" '"has_materials": true'
+hash1=$(sed -n 's/.*"content_hash": "\([0-9a-f]*\)".*/\1/p' <<< "$out")
+bps=$(json_num bytes_per_sample)
+near "info default bytes per sample in (4, 16)" "$bps" 10 6
+[ "${#hash1}" = 16 ] && ok || bad "content hash is 16 hex digits: '$hash1'"
+run info --default-terrain --json "$T/info.json"; expect "info --json" 0
+[ -z "$out" ] && ok || bad "info --json FILE writes nothing to stdout" "$out"
+grep -q "\"content_hash\": \"$hash1\"" "$T/info.json" && ok || bad "info --json file has the same hash"
+
+run info --heightmap "$PNG" --spacing 10,2 --height-scale 0.5 --height-offset -100 --origin 1e6,-5
+expect "info png" 0
+contains "png width" '"width": 5'
+contains "png height" '"height": 4'
+near "png height_min = -100 + 0.5 * 1000" "$(json_num height_min)" 400 0
+near "png height_max = -100 + 0.5 * 1430" "$(json_num height_max)" 615 0
+contains "png extent" "\"extent\": ["
+out_compact=$(tr -d ' \n' <<< "$out")
+[[ "$out_compact" == *'"extent":[40.0,6.0]'* ]] && ok || bad "png extent is 40 x 6" "$out_compact"
+[[ "$out_compact" == *'"origin":[1000000.0,-5.0]'* ]] && ok || bad "png origin" "$out_compact"
+
+run info --heightmap "$T/h.r16" --raw-size 3,2 --raw-type u16
+expect "info raw" 0
+near "raw height_max" "$(json_num height_max)" 60 0
+near "raw height_min" "$(json_num height_min)" 0 0
+run info --heightmap "$T/h.r16" --raw-size 3,2; expect "raw type from .r16" 0
+cp "$T/h.r16" "$T/h.raw"
+run info --heightmap "$T/h.raw" --raw-size 3,2; expect "raw without type" 1 "--raw-type"
+run info --heightmap "$T/h.raw"; expect "raw without size" 1 "--raw-size"
+run info --heightmap "$T/h.r16" --raw-size 4,2 --raw-type u16
+expect "raw size mismatch" 1 "file is 12 bytes but 4 x 2 u16 samples need 16 bytes"
+run info --heightmap "$T/h.r16" --raw-size 3,2 --raw-type f32
+expect "raw type mismatch" 1 "need 24 bytes"
+run info --heightmap "$T/h.r16" --raw-size 3,2 --raw-type u8; expect "bad raw type" 1 "'u8'"
+run info --heightmap "$T/h.r16" --raw-size 3.5,2; expect "fractional raw size" 1 "--raw-size"
+run info --heightmap "$T/h.r16" --raw-size 1,12; expect "1 sample wide" 1 "1 x 12 samples; need at least 2 x 2"
+
+# no-data and fill
+run info --heightmap "$T/h.r16" --raw-size 3,2 --nodata 0
+expect "no-data refused" 1 "sample (1, 1) is 0 (the no-data value)"
+run info --heightmap "$T/h.r16" --raw-size 3,2 --nodata 0 --fill constant:5
+expect "no-data constant fill" 0
+near "filled_samples" "$(json_num filled_samples)" 1 0
+near "fill constant is the new minimum" "$(json_num height_min)" 5 0
+run info --heightmap "$T/h.r16" --raw-size 3,2 --nodata 0 --fill nearest; expect "nearest fill" 0
+near "nearest fill minimum" "$(json_num height_min)" 10 0
+
+# bad files
+run info --heightmap "$T/missing.png"; expect "missing file" 1 "heightmap '$T/missing.png': no such file"
+run info --heightmap "$T"; expect "directory" 1 "is a directory"
+head -c 60 "$PNG" > "$T/truncated.png"
+run info --heightmap "$T/truncated.png"; expect "truncated png" 1 "heightmap '$T/truncated.png'"
+printf 'this is not a png at all, not even close.........' > "$T/garbage.png"
+run info --heightmap "$T/garbage.png"; expect "garbage png" 1 "not a readable image"
+run info --heightmap "$RGB"; expect "rgb refused" 1 "3 channels (R, G, B)"
+run info --heightmap "$RGB" --channel 1; expect "rgb channel 1" 0
+near "rgb green max = 12" "$(json_num height_max)" 12 0
+run info --heightmap "$RGB" --channel 3; expect "rgb channel 3" 1 "channel 3 requested"
+run info --heightmap "$PNG" --max-samples 19; expect "size cap" 1 "exceeds the limit of 19 samples"
+run info --heightmap "$PNG" --max-samples 20; expect "size cap exact" 0
+run info --default-terrain --max-samples 1000; expect "default terrain cap" 1 "exceeds the limit"
+run info --heightmap "$PNG" --materials "$RGB"; expect "material size" 1 "material image"
+
+# non-finite and malformed numbers in flags
+for args in "--spacing nan" "--spacing inf" "--spacing -1" "--spacing 0" "--spacing 1,2,3" \
+            "--spacing 1,nan" "--spacing abc" "--height-scale 0" "--height-scale -inf" \
+            "--height-offset nan" "--origin 1" "--origin 1,2,3" "--origin nan,0" "--nodata nan" \
+            "--fill sideways" "--fill constant:" "--fill constant:nan" "--max-samples 1.5" \
+            "--max-samples -3" "--height-offset 1e999"; do
+  # shellcheck disable=SC2086
+  run info --default-terrain $args
+  flag=${args%% *}
+  expect "info $args" 1 "${flag%%=*}"
+done
+run info --default-terrain --spacing=; expect "empty --spacing=" 2
+run info --default-terrain --spacing ""; expect "empty --spacing" 1 "--spacing"
+run info --default-terrain --spacing 4 --origin 100,200 --height-offset 1000
+expect "default terrain placed" 0
+[[ "$(tr -d ' \n' <<< "$out")" == *'"extent":[4096.0,4096.0]'* ]] && ok || bad "placed extent"
+
+# ---- query ---------------------------------------------------------------------------------------
+# On the ramp with spacing 10, scale 0.1, offset -50: height = -50 + 100 + x + z / 10 where the
+# terrain is; a plane, so every face normal is (-1, 1, -0.1) / sqrt(2.01).
+printf '15,5\n0.1,0\n\n40,30\n-1,0\n41,0\n 20 , 10 \r\n' > "$T/points.csv"
+run query --heightmap "$PNG" --spacing 10 --height-scale 0.1 --height-offset -50 --points "$T/points.csv"
+expect "query" 0
+lines=$(wc -l < "$T/stdout")
+[ "$lines" = 6 ] && ok || bad "query writes one line per point (6), got $lines" "$out"
+IFS=, read -r x z h nx ny nz <<< "$(sed -n 1p "$T/stdout")"
+near "query x" "$x" 15 0
+near "query height" "$h" 65.5 1e-9
+s=$(awk 'BEGIN { printf "%.17g", 1 / sqrt(2.01) }')
+near "query nx" "$nx" "-$s" 1e-6
+near "query ny" "$ny" "$s" 1e-6
+near "query nz" "$nz" "$(awk -v s="$s" 'BEGIN { printf "%.17g", -0.1 * s }')" 1e-6
+[ "$(sed -n 2p "$T/stdout" | cut -d, -f1)" = "0.10000000000000001" ] && ok ||
+  bad "query writes 17 significant digits" "$(sed -n 2p "$T/stdout")"
+near "query far corner is on the terrain" "$(sed -n 3p "$T/stdout" | cut -d, -f3)" 93 1e-9
+[ "$(sed -n 4p "$T/stdout")" = "-1,0,,,," ] && ok || bad "off terrain: empty fields" "$(sed -n 4p "$T/stdout")"
+[ "$(sed -n 5p "$T/stdout")" = "41,0,,,," ] && ok || bad "off terrain past the edge" "$(sed -n 5p "$T/stdout")"
+[ "$(sed -n 6p "$T/stdout" | cut -d, -f1-3)" = "20,10,71" ] && ok ||
+  bad "spaces and CRLF accepted" "$(sed -n 6p "$T/stdout")"
+fields=$(sed -n 1p "$T/stdout" | awk -F, '{ print NF }')
+[ "$fields" = 6 ] && ok || bad "query lines have 6 fields"
+run query --default-terrain --points - < "$T/points.csv"; expect "query from stdin" 0
+
+for line in "1;2" "1,2,3" "nan,1" "1,inf" "1," ",1" "x,y" "1e999,0"; do
+  printf '0,0\n1,1\n%s\n' "$line" > "$T/bad.csv"
+  run query --default-terrain --points "$T/bad.csv"
+  expect "query bad line '$line'" 1 "line 3"
+done
+run query --default-terrain; expect "query without --points" 2
+run query --default-terrain --points "$T/none.csv"; expect "query missing points file" 1 "none.csv"
+run query --heightmap "$T/missing.png" --points "$T/points.csv"; expect "query missing heightmap" 1 "no such file"
+
+# ---- profile -------------------------------------------------------------------------------------
+run profile --default-terrain --from 0,0 --to 2048,2048 --steps 48
+expect "profile" 0
+contains "profile title" "Profile of default terrain"
+contains "profile summary" "Heights: min"
+contains "profile sparkline" "sparkline"
+rows=$(grep -cE '^ +[0-9]+ +[0-9.]+ +[0-9.]+ +[0-9.]+ +-?[0-9.]+$' <<< "$out")
+[ "$rows" = 49 ] && ok || bad "profile table has 49 rows, got $rows"
+# The plot's highest row is labelled with the maximum, and the max is at the top of a column.
+grep -qE '^ +[0-9.]+ m \|.*#' <<< "$out" && ok || bad "profile plot has labelled rows"
+run profile --heightmap "$PNG" --spacing 10 --from -10,0 --to 50,0 --steps 6 --json "$T/profile.json"
+expect "profile partly off terrain" 0
+contains "profile marks off-terrain points" "off"
+grep -q '"height": null' "$T/profile.json" && ok || bad "profile JSON has null heights off terrain"
+grep -q '"height": 1200.0' "$T/profile.json" && ok || bad "profile JSON has the height at x=20" "$(cat "$T/profile.json")"
+run profile --default-terrain --from 0,0 --to 1,1 --steps 0; expect "profile steps 0" 1 "--steps"
+run profile --default-terrain --from nan,0 --to 1,1; expect "profile nan" 1 "--from"
+run profile --default-terrain --from 0,0; expect "profile without --to" 2
+run profile --default-terrain --from 0,0 --to 1; expect "profile bad --to" 1 "--to"
+
+# ---- bench queries -------------------------------------------------------------------------------
+run bench queries --heightmap "$PNG" --points 2000 --repetitions 1 --seed 3
+expect "bench queries" 0
+contains "bench JSON names the terrain" '"terrain"'
+run bench queries --heightmap "$PNG" --points 2000 --repetitions 1 --json "$T/bench.json"
+expect "bench queries --json" 0
+grep -q '"terrain"' "$T/bench.json" && ok || bad "bench --json file"
+run bench queries --default-terrain --points 0; expect "bench points 0" 1 "--points"
+run bench queries --default-terrain --repetitions x; expect "bench bad repetitions" 1 "--repetitions"
+run bench queries --default-terrain --spacing nan; expect "bench bad terrain flag" 1 "--spacing"
+
+echo "$passed passed, $failed failed"
+[ "$failed" = 0 ]

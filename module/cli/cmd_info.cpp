@@ -1,0 +1,61 @@
+// `ridge info`: what a terrain is, as JSON.
+#include <cstdio>
+#include <memory>
+
+#include "cli_util.h"
+#include "commands.h"
+#include "terrain_args.h"
+
+namespace ridgeline::cli {
+
+namespace {
+
+struct InfoOptions {
+  TerrainArgs terrain;
+  std::string json_path;
+};
+
+int run_info(const InfoOptions& o) {
+  auto terrain = o.terrain.load_terrain();
+  if (!terrain) return report_error(terrain.error().message);
+  const Heightfield& hf = (*terrain)->heightfield();
+  const std::uint64_t samples = std::uint64_t{hf.width()} * hf.height();
+  char hash[24];
+  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(hf.content_hash()));
+  const std::size_t bytes = (*terrain)->memory_bytes();
+  const nlohmann::ordered_json j = {
+      {"source", o.terrain.source()},
+      {"width", hf.width()},
+      {"height", hf.height()},
+      {"samples", samples},
+      {"spacing", {hf.spacing_x(), hf.spacing_z()}},
+      {"origin", {hf.origin_x(), hf.origin_z()}},
+      {"extent", {hf.extent_x(), hf.extent_z()}},
+      {"height_offset", hf.height_offset()},
+      {"height_scale", hf.height_scale()},
+      {"height_min", hf.height_offset() + double(hf.min_local())},
+      {"height_max", hf.height_offset() + double(hf.max_local())},
+      {"has_materials", hf.has_materials()},
+      {"filled_samples", hf.filled_samples()},
+      {"heightfield_bytes", hf.memory_bytes()},
+      {"memory_bytes", bytes},
+      {"bytes_per_sample", double(bytes) / double(samples)},
+      {"content_hash", hash},
+  };
+  if (auto s = write_json(j, o.json_path); !s) return report_error(s.message());
+  return 0;
+}
+
+}  // namespace
+
+Command add_info_command(CLI::App& parent) {
+  auto* app = parent.add_subcommand(
+      "info", "Size, extent, height range, memory used and content hash of a terrain (JSON)");
+  auto o = std::make_shared<InfoOptions>();
+  o->terrain.add_to(*app);
+  app->add_option("--json", o->json_path, "Write the JSON to FILE instead of standard output")
+      ->type_name("FILE");
+  return {app, [o] { return run_info(*o); }};
+}
+
+}  // namespace ridgeline::cli

@@ -1,0 +1,24 @@
+// The `ridge` subcommands. Each add_*_command() registers a subcommand (its flags and help) on
+// `parent` and returns the function main() runs when that subcommand was given.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <functional>
+
+namespace ridgeline::cli {
+
+struct Command {
+  CLI::App* app = nullptr;   ///< the subcommand; run() is called when it was parsed
+  std::function<int()> run;  ///< returns the process exit code
+};
+
+/// `ridge info`: size, extent, height range, memory, filled samples, content hash (JSON).
+Command add_info_command(CLI::App& parent);
+/// `ridge query --points IN.csv`: height and face normal per point (CSV).
+Command add_query_command(CLI::App& parent);
+/// `ridge profile --from X,Z --to X,Z --steps N`: a text profile with an ASCII plot.
+Command add_profile_command(CLI::App& parent);
+/// `ridge bench queries`: query speed (JSON), measured by bench_queries.h.
+Command add_bench_queries_command(CLI::App& bench);
+
+}  // namespace ridgeline::cli

@@ -1,0 +1,204 @@
+#include "terrain_args.h"
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+
+#include "cli_util.h"
+#include "ridgeline/io.h"
+
+namespace ridgeline::cli {
+
+void TerrainArgs::add_to(CLI::App& app) {
+  app_ = &app;
+  const std::string g = "Terrain";
+  auto* hm = app.add_option("--heightmap", heightmap_,
+                            "Heightmap file: 8/16-bit greyscale PNG, 16-bit or float TIFF, float "
+                            "EXR, or headerless raw (with --raw-size, --raw-type)")
+                 ->type_name("FILE")
+                 ->group(g);
+  auto* dt = app.add_flag("--default-terrain", default_terrain_,
+                          "Use the built-in default terrain (1025 x 1025 samples, 2 m spacing, "
+                          "seed 1337)")
+                 ->group(g);
+  hm->excludes(dt);
+  dt->excludes(hm);
+  app.add_option("--raw-size", raw_size_, "Size of a raw heightmap in samples")
+      ->type_name("W,H")
+      ->group(g);
+  app.add_option("--raw-type", raw_type_,
+                 "Sample type of a raw heightmap, little-endian (default from the extension: "
+                 ".r16 u16, .r32 f32)")
+      ->type_name("u16|f32")
+      ->group(g);
+  app.add_option("--spacing", spacing_,
+                 "Metres between samples: one value for both axes or SX,SZ (default 1)")
+      ->type_name("S|SX,SZ")
+      ->group(g);
+  app.add_option(
+         "--height-scale", height_scale_,
+         "Height = offset + scale * value, value being the raw integer or float (default 1)")
+      ->type_name("K")
+      ->group(g);
+  app.add_option("--height-offset", height_offset_, "Height offset in metres (default 0)")
+      ->type_name("O")
+      ->group(g);
+  app.add_option("--origin", origin_, "World position of sample (0, 0) in metres (default 0,0)")
+      ->type_name("X,Z")
+      ->group(g);
+  app.add_option("--nodata", nodata_,
+                 "Raw value that marks a missing sample (refused unless --fill is given)")
+      ->type_name("V")
+      ->group(g);
+  app.add_option("--fill", fill_,
+                 "Replace missing (no-data or non-finite) samples: by the nearest valid sample, or "
+                 "by the raw value V")
+      ->type_name("nearest|constant:V")
+      ->group(g);
+  app.add_option("--max-samples", max_samples_,
+                 "Refuse heightmaps of more samples than N, checked before allocating (default "
+                 "268435456 = 2^28)")
+      ->type_name("N")
+      ->group(g);
+  app.add_option("--channel", channel_,
+                 "Channel of a multi-channel image to use (0-based); without it colour images are "
+                 "refused")
+      ->type_name("C")
+      ->group(g);
+  app.add_option("--materials", materials_,
+                 "8-bit single-channel image of the heightmap's size holding a material id per "
+                 "sample")
+      ->type_name("FILE")
+      ->group(g);
+}
+
+bool TerrainArgs::given(const char* flag) const {
+  return app_ && app_->count(flag) > 0;
+}
+
+std::string TerrainArgs::source() const {
+  return default_terrain_ ? std::string("default terrain") : heightmap_;
+}
+
+Result<HeightfieldDesc> TerrainArgs::placement() const {
+  HeightfieldDesc d;
+  if (given("--spacing")) {
+    auto v = parse_finite_list(spacing_, "--spacing", 1, 2);
+    if (!v) return v.error();
+    d.spacing_x = (*v)[0];
+    d.spacing_z = v->size() == 2 ? (*v)[1] : (*v)[0];
+    if (d.spacing_x <= 0 || d.spacing_z <= 0)
+      return Error{"--spacing '" + spacing_ + "': spacing must be > 0"};
+  }
+  if (given("--height-scale")) {
+    auto v = parse_finite(height_scale_, "--height-scale");
+    if (!v) return v.error();
+    if (*v <= 0) return Error{"--height-scale '" + height_scale_ + "': must be > 0"};
+    d.height_scale = *v;
+  }
+  if (given("--height-offset")) {
+    auto v = parse_finite(height_offset_, "--height-offset");
+    if (!v) return v.error();
+    d.height_offset = *v;
+  }
+  if (given("--origin")) {
+    auto v = parse_finite_list(origin_, "--origin", 2, 2);
+    if (!v) return v.error();
+    d.origin_x = (*v)[0];
+    d.origin_z = (*v)[1];
+  }
+  if (given("--nodata")) {
+    auto v = parse_finite(nodata_, "--nodata");
+    if (!v) return v.error();
+    d.nodata = *v;
+  }
+  if (given("--fill")) {
+    if (fill_ == "nearest") {
+      d.fill = FillPolicy::kNearest;
+    } else if (fill_.rfind("constant:", 0) == 0) {
+      auto v = parse_finite(std::string_view(fill_).substr(9), "--fill constant");
+      if (!v) return v.error();
+      d.fill = FillPolicy::kConstant;
+      d.fill_constant = *v;
+    } else {
+      return Error{"--fill '" + fill_ + "': expected 'nearest' or 'constant:V'"};
+    }
+  }
+  if (given("--max-samples")) {
+    auto v =
+        parse_count(max_samples_, "--max-samples", 4, std::numeric_limits<std::uint64_t>::max());
+    if (!v) return v.error();
+    d.max_samples = *v;
+  }
+  return d;
+}
+
+Result<Heightfield> TerrainArgs::load_heightfield() const {
+  if (!given("--heightmap") && !default_terrain_)
+    return Error{"no terrain given: pass --heightmap FILE or --default-terrain"};
+  auto desc = placement();
+  if (!desc) return desc.error();
+
+  if (default_terrain_) {
+    for (const char* flag : {"--raw-size", "--raw-type", "--channel", "--materials"})
+      if (given(flag))
+        return Error{std::string(flag) + " applies to --heightmap, not to --default-terrain"};
+    const DefaultTerrainParams params;
+    HeightfieldDesc d = *desc;
+    d.width = d.height = params.size;
+    d.name = "default terrain";
+    // The cap and the placement are checked before the terrain is generated.
+    if (auto s = validate_heightfield_desc(d); !s) return Error{s.message()};
+    auto base = make_default_heightfield(params);
+    if (!base) return base.error();
+    const bool placed = given("--spacing") || given("--height-scale") || given("--height-offset") ||
+                        given("--origin") || given("--nodata") || given("--fill");
+    if (!placed) return base;
+    // The generated heights act as raw values for the placement flags.
+    std::vector<std::uint8_t> mats;
+    mats.reserve(std::size_t{base->width() - 1} * (base->height() - 1));
+    for (std::uint32_t j = 0; j + 1 < base->height(); ++j)
+      for (std::uint32_t i = 0; i + 1 < base->width(); ++i) mats.push_back(base->material(i, j));
+    return Heightfield::create(d, base->local_heights(), mats);
+  }
+
+  io::LoadOptions options;
+  options.placement = *desc;
+  options.materials_path = materials_;
+  if (given("--channel")) {
+    auto c = parse_count(channel_, "--channel", 0, 1023);
+    if (!c) return c.error();
+    options.channel = static_cast<int>(*c);
+  }
+  if (!given("--raw-size") && given("--raw-type")) return Error{"--raw-type needs --raw-size W,H"};
+  if (given("--raw-size")) {
+    io::RawFormat raw;
+    auto size = parse_finite_list(raw_size_, "--raw-size", 2, 2);
+    if (!size) return size.error();
+    for (double v : *size)
+      if (v != std::floor(v) || v < 0 || v > std::numeric_limits<std::uint32_t>::max())
+        return Error{"--raw-size '" + raw_size_ + "': expected two whole numbers W,H"};
+    raw.width = static_cast<std::uint32_t>((*size)[0]);
+    raw.height = static_cast<std::uint32_t>((*size)[1]);
+    std::string type = raw_type_;
+    if (!given("--raw-type")) {
+      const std::string ext = std::filesystem::path(heightmap_).extension().string();
+      if (ext == ".r16") type = "u16";
+      if (ext == ".r32") type = "f32";
+    }
+    if (type.empty()) return Error{"--raw-size needs --raw-type u16|f32"};
+    auto t = io::parse_raw_type(type);
+    if (!t) return Error{"--raw-type: " + t.error().message};
+    raw.type = *t;
+    return io::load_raw(heightmap_, raw, options);
+  }
+  return io::load_heightmap(heightmap_, options);
+}
+
+Result<std::shared_ptr<const Terrain>> TerrainArgs::load_terrain() const {
+  auto hf = load_heightfield();
+  if (!hf) return hf.error();
+  return Terrain::create(std::move(*hf));
+}
+
+}  // namespace ridgeline::cli
