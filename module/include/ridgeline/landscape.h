@@ -1,0 +1,102 @@
+// Landscape: the terrain cut into patches of bintree roots, with nested error bounds per node.
+// Shared, read-only data that every RoamView (one per camera) reads.
+#pragma once
+
+#include <cstdint>
+#include <glm/vec3.hpp>
+#include <memory>
+#include <vector>
+
+#include "ridgeline/result.h"
+#include "ridgeline/terrain.h"
+
+namespace ridgeline {
+
+struct LandscapeDesc {
+  /// Patches hold 2^patch_exponent cells per side (2^k + 1 samples). 2..10; default 6 (65 x 65
+  /// samples). Larger patches: fewer roots, bigger per-patch buffers, longer edits per patch.
+  std::uint32_t patch_exponent = 6;
+};
+
+/// A bintree triangle in global lattice coordinates: apex and the two ends of its hypotenuse,
+/// counter-clockwise seen from above (apex, left, right).
+struct LatticeTriangle {
+  std::int64_t ax, az, lx, lz, rx, rz;
+};
+
+/// Patches and error bounds over a Terrain.
+///
+/// Layout: the sampled area is covered by patches_x() x patches_z() patches; the last row and
+/// column of patches may extend past the samples: that padding repeats the edge samples
+/// (SPEC.md) and is not terrain (queries there are off-terrain; mesh output flags the triangles
+/// whose centre lies in it). Each patch has two roots split along its main diagonal; root ids
+/// are patch * 2 + r, patch = px + pz * patches_x(). Node ids inside a root are heap indices:
+/// the root is 1, the children of h are 2h and 2h + 1 (child 0 holds the root's left corner).
+///
+/// Error bounds (SPEC.md): for every node, the largest |surface - triangle plane| over every
+/// lattice vertex under the node's triangle (the exact error), then made nested by taking the
+/// maximum with the children's bounds. Finest-level nodes (half cells) have bound 0.
+///
+/// Threading: immutable after create(); every method may run concurrently.
+class Landscape {
+ public:
+  static Result<std::shared_ptr<const Landscape>> create(std::shared_ptr<const Terrain> terrain,
+                                                         const LandscapeDesc& desc = {});
+
+  const Terrain& terrain() const noexcept { return *terrain_; }
+  const std::shared_ptr<const Terrain>& terrain_ptr() const noexcept { return terrain_; }
+
+  std::uint32_t patch_exponent() const noexcept { return exponent_; }
+  std::int64_t patch_cells() const noexcept { return std::int64_t{1} << exponent_; }
+  std::uint32_t patches_x() const noexcept { return patches_x_; }
+  std::uint32_t patches_z() const noexcept { return patches_z_; }
+  std::uint32_t patch_count() const noexcept { return patches_x_ * patches_z_; }
+  std::uint32_t root_count() const noexcept { return 2 * patch_count(); }
+  /// Deepest bintree level: 2 * patch_exponent (half-cell triangles).
+  std::uint32_t max_level() const noexcept { return 2 * exponent_; }
+
+  /// Geometry of node `heap` of root `root`.
+  LatticeTriangle triangle(std::uint32_t root, std::uint64_t heap) const noexcept;
+  /// Geometry of a child given its parent's (child 0 or 1).
+  static LatticeTriangle child_triangle(const LatticeTriangle& parent, int child) noexcept;
+
+  /// Nested error bound of a node, metres.
+  float bound(std::uint32_t root, std::uint64_t heap) const noexcept {
+    return heap < nodes_per_root_plus_one_
+               ? bounds_[root * (nodes_per_root_plus_one_ - 1) + heap - 1]
+               : 0.0f;
+  }
+  /// Exact (not nested) error of a node, metres: used by tests and the minimal-triangulation
+  /// reference. Recomputed on each call (O(area)).
+  float exact_error(std::uint32_t root, std::uint64_t heap) const noexcept;
+
+  /// Height of lattice vertex (i, j) relative to the heightfield's offset, with the padding rule.
+  float lattice_height(std::int64_t i, std::int64_t j) const noexcept {
+    return terrain_->heightfield().local_clamped(i, j);
+  }
+  /// World x / z of a lattice index.
+  double world_x(std::int64_t i) const noexcept { return origin_x_ + double(i) * spacing_x_; }
+  double world_z(std::int64_t j) const noexcept { return origin_z_ + double(j) * spacing_z_; }
+  /// True when lattice vertex (i, j) is inside the sampled area (not padding).
+  bool is_sampled(std::int64_t i, std::int64_t j) const noexcept {
+    return i >= 0 && j >= 0 && i < std::int64_t(terrain_->heightfield().width()) &&
+           j < std::int64_t(terrain_->heightfield().height());
+  }
+
+  /// Bytes of the bound arrays, and how long building them took.
+  std::size_t bound_bytes() const noexcept { return bounds_.size() * sizeof(float); }
+  double build_ms() const noexcept { return build_ms_; }
+
+ private:
+  Landscape() = default;
+  float compute_exact(const LatticeTriangle& t) const noexcept;
+
+  std::shared_ptr<const Terrain> terrain_;
+  std::uint32_t exponent_ = 6, patches_x_ = 0, patches_z_ = 0;
+  std::uint64_t nodes_per_root_plus_one_ = 0;  // 2^(2k): heaps 1 .. 2^(2k) - 1 are stored
+  std::vector<float> bounds_;
+  double origin_x_ = 0, origin_z_ = 0, spacing_x_ = 1, spacing_z_ = 1;
+  double build_ms_ = 0;
+};
+
+}  // namespace ridgeline

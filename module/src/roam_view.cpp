@@ -1,0 +1,858 @@
+// Frame-coherent ROAM after Duchaineau et al. 1997 ("ROAMing Terrain"): bintree forest with
+// diamonds and forced splits (section 4), split and merge queues (section 5), deferred priority
+// recomputation (section 6). The split-only rebuild mode is Turner 2000.
+//
+// Lazy priorities. A queued node's key is the LARGEST priority it can take while the eye stays
+// within r = slack * d of the point where it was computed (d: distance to the node's bounding
+// box): bound * K / (d - r). Both queues are keyed by this upper bound and decisions compare it
+// with the threshold, so split and merge use one function (no oscillation) and every triangle
+// left unsplit truly meets the threshold for any eye position in its window. The key is
+// recomputed when the eye has travelled r (an odometer, so it is conservative for any path).
+// A node classified outside the frustum gets priority 0 (it is merged back towards its root),
+// which stays valid while translation and rotation cannot bring it inside: it carries a second,
+// angular expiry. Nodes near the frustum border count as inside (conservative). A change of
+// field of view, viewport or far plane recomputes every key.
+#include "ridgeline/roam_view.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <glm/geometric.hpp>
+#include <limits>
+#include <queue>
+#include <unordered_map>
+
+#include "format.h"
+#include "ridgeline/log.h"
+#include "surface_eval.h"
+
+namespace ridgeline {
+
+namespace {
+
+constexpr std::uint32_t kNone = 0xffffffffu;
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+struct Node {
+  std::uint32_t parent = kNone;
+  std::uint32_t child = kNone;  // first of the pair (child, child + 1); kNone for a leaf
+  std::uint32_t base = kNone, left = kNone, right = kNone;
+  std::uint32_t qslot = kNone;  // position in the split heap (leaf) or merge heap (internal)
+  std::uint32_t root = 0;
+  std::uint32_t heap = 1;
+  std::uint32_t stamp = 0;  // generation of the node's newest expiry records
+};
+
+struct HeapEntry {
+  float key;
+  std::uint32_t node;
+};
+
+// Binary heap of nodes with positions written back into Node::qslot, so keys can change and
+// entries can leave from the middle in O(log n). Max-heap when kMax.
+template <bool kMax>
+class IndexedHeap {
+ public:
+  explicit IndexedHeap(std::vector<Node>& nodes) : nodes_(&nodes) {}
+  bool empty() const { return a_.empty(); }
+  std::size_t size() const { return a_.size(); }
+  const HeapEntry& top() const { return a_.front(); }
+  void clear() {
+    for (auto& e : a_) (*nodes_)[e.node].qslot = kNone;
+    a_.clear();
+  }
+  void push(std::uint32_t node, float key) {
+    a_.push_back({key, node});
+    (*nodes_)[node].qslot = static_cast<std::uint32_t>(a_.size() - 1);
+    up(a_.size() - 1);
+  }
+  void remove(std::uint32_t node) {
+    const std::uint32_t i = (*nodes_)[node].qslot;
+    if (i == kNone) return;
+    (*nodes_)[node].qslot = kNone;
+    const std::size_t last = a_.size() - 1;
+    if (i != last) {
+      a_[i] = a_[last];
+      (*nodes_)[a_[i].node].qslot = i;
+      a_.pop_back();
+      if (!up(i)) down(i);
+    } else {
+      a_.pop_back();
+    }
+  }
+  void update(std::uint32_t node, float key) {
+    const std::uint32_t i = (*nodes_)[node].qslot;
+    a_[i].key = key;
+    if (!up(i)) down(i);
+  }
+  const std::vector<HeapEntry>& entries() const { return a_; }
+  std::size_t memory_bytes() const { return a_.capacity() * sizeof(HeapEntry); }
+
+ private:
+  static bool before(float a, float b) { return kMax ? a > b : a < b; }
+  bool up(std::size_t i) {
+    bool moved = false;
+    while (i > 0) {
+      const std::size_t p = (i - 1) / 2;
+      if (!before(a_[i].key, a_[p].key)) break;
+      swap(i, p);
+      i = p;
+      moved = true;
+    }
+    return moved;
+  }
+  void down(std::size_t i) {
+    const std::size_t n = a_.size();
+    for (;;) {
+      std::size_t best = i;
+      const std::size_t l = 2 * i + 1, r = l + 1;
+      if (l < n && before(a_[l].key, a_[best].key)) best = l;
+      if (r < n && before(a_[r].key, a_[best].key)) best = r;
+      if (best == i) return;
+      swap(i, best);
+      i = best;
+    }
+  }
+  void swap(std::size_t i, std::size_t j) {
+    std::swap(a_[i], a_[j]);
+    (*nodes_)[a_[i].node].qslot = static_cast<std::uint32_t>(i);
+    (*nodes_)[a_[j].node].qslot = static_cast<std::uint32_t>(j);
+  }
+  std::vector<Node>* nodes_;
+  std::vector<HeapEntry> a_;
+};
+
+struct Expiry {
+  double key;
+  std::uint32_t node;
+  std::uint32_t stamp;
+  bool operator>(const Expiry& o) const { return key > o.key; }
+};
+using ExpiryQueue = std::priority_queue<Expiry, std::vector<Expiry>, std::greater<Expiry>>;
+
+struct Validity {
+  double distance = std::numeric_limits<double>::infinity();  // eye travel allowed, metres
+  double angle = std::numeric_limits<double>::infinity();     // view rotation allowed, radians
+};
+
+// Orthonormal camera frame.
+struct Frame {
+  glm::dvec3 f, r, u;
+};
+
+Frame frame_of(const Camera& c) {
+  Frame fr;
+  fr.f = glm::normalize(c.target - c.eye);
+  fr.r = glm::normalize(glm::cross(fr.f, c.up));
+  fr.u = glm::cross(fr.r, fr.f);
+  return fr;
+}
+
+// Rotation angle between two orthonormal frames.
+double frame_angle(const Frame& a, const Frame& b) {
+  const double tr = glm::dot(a.f, b.f) + glm::dot(a.r, b.r) + glm::dot(a.u, b.u);
+  return std::acos(std::clamp((tr - 1.0) / 2.0, -1.0, 1.0));
+}
+
+}  // namespace
+
+struct RoamView::Impl {
+  explicit Impl(const Landscape& l) : land(l), split(nodes), merge(nodes) {}
+
+  const Landscape& land;
+  std::vector<Node> nodes;
+  std::vector<std::uint32_t> free_pairs;
+  IndexedHeap<true> split;
+  IndexedHeap<false> merge;
+  ExpiryQueue by_distance, by_angle;
+
+  // Camera state.
+  bool have_camera = false;
+  Camera cam;
+  Frame frame{};
+  double K = 1;
+  glm::dvec3 planes[4];  // inward normals of the side planes, through the eye
+  double odometer = 0, angometer = 0;
+
+  // Settings snapshot used by priorities.
+  ErrorMetric metric = ErrorMetric::kScreenPixels;
+  double slack = 0.05;
+  bool reset_pending = true;
+
+  // Output.
+  std::vector<std::uint64_t> patch_version;
+  std::vector<std::uint8_t> patch_dirty;  // listed in dirty_list since last take
+  std::vector<std::uint32_t> dirty_list;
+  std::vector<PatchMesh> meshes;
+  std::vector<std::uint64_t> mesh_built_version;
+  std::vector<std::uint32_t> scratch_index;
+
+  // Per-update counters.
+  RoamStats st;
+  std::uint32_t triangles = 0;
+
+  // ---- structure ---------------------------------------------------------------------------
+
+  bool is_leaf(std::uint32_t n) const { return nodes[n].child == kNone; }
+  std::uint32_t level(std::uint32_t n) const { return 31 - __builtin_clz(nodes[n].heap); }
+  bool splittable(std::uint32_t n) const { return level(n) < land.max_level(); }
+
+  void mark_dirty(std::uint32_t n) {
+    const std::uint32_t p = nodes[n].root / 2;
+    ++patch_version[p];
+    if (!patch_dirty[p]) {
+      patch_dirty[p] = 1;
+      dirty_list.push_back(p);
+    }
+  }
+
+  std::uint32_t alloc_pair() {
+    if (!free_pairs.empty()) {
+      const std::uint32_t c = free_pairs.back();
+      free_pairs.pop_back();
+      return c;
+    }
+    const auto c = static_cast<std::uint32_t>(nodes.size());
+    nodes.resize(nodes.size() + 2);
+    return c;
+  }
+
+  void replace_link(std::uint32_t n, std::uint32_t from, std::uint32_t to) {
+    if (n == kNone) return;
+    Node& x = nodes[n];
+    if (x.base == from)
+      x.base = to;
+    else if (x.left == from)
+      x.left = to;
+    else if (x.right == from)
+      x.right = to;
+    else
+      RIDGELINE_ASSERT(false && "neighbour link not found");
+  }
+
+  void reset_to_roots() {
+    split.clear();
+    merge.clear();
+    by_distance = {};
+    by_angle = {};
+    free_pairs.clear();
+    const std::uint32_t px = land.patches_x(), pz = land.patches_z();
+    nodes.assign(land.root_count(), Node{});
+    for (std::uint32_t z = 0; z < pz; ++z) {
+      for (std::uint32_t x = 0; x < px; ++x) {
+        const std::uint32_t p = x + z * px;
+        Node& r0 = nodes[2 * p];
+        Node& r1 = nodes[2 * p + 1];
+        r0.root = 2 * p;
+        r1.root = 2 * p + 1;
+        r0.base = 2 * p + 1;
+        r1.base = 2 * p;
+        // root 0: apex (P, 0), left edge z = 0 (towards -z), right edge x = P (towards +x)
+        r0.left = z > 0 ? 2 * (p - px) + 1 : kNone;
+        r0.right = x + 1 < px ? 2 * (p + 1) + 1 : kNone;
+        // root 1: apex (0, P), left edge z = P (towards +z), right edge x = 0 (towards -x)
+        r1.left = z + 1 < pz ? 2 * (p + px) : kNone;
+        r1.right = x > 0 ? 2 * (p - 1) : kNone;
+      }
+    }
+    triangles = land.root_count();
+    for (std::uint32_t n = 0; n < land.root_count(); ++n) push_split(n);
+    for (std::uint32_t p = 0; p < land.patch_count(); ++p) mark_dirty(2 * p);
+    st.rebuilt = true;
+  }
+
+  // ---- priorities ---------------------------------------------------------------------------
+
+  float priority(std::uint32_t n, Validity& v) {
+    ++st.priority_updates;
+    const Node& nd = nodes[n];
+    const float b = land.bound(nd.root, nd.heap);
+    v = Validity{};
+    if (metric == ErrorMetric::kWorldMetres || b == 0.0f) return b;
+    const LatticeTriangle t = land.triangle(nd.root, nd.heap);
+    const std::int64_t i0 = std::min({t.ax, t.lx, t.rx}), i1 = std::max({t.ax, t.lx, t.rx});
+    const std::int64_t j0 = std::min({t.az, t.lz, t.rz}), j1 = std::max({t.az, t.lz, t.rz});
+    const float ha = land.lattice_height(t.ax, t.az), hl = land.lattice_height(t.lx, t.lz),
+                hr = land.lattice_height(t.rx, t.rz);
+    const double off = land.terrain().heightfield().height_offset();
+    const glm::dvec3 lo(land.world_x(i0), off + double(std::min({ha, hl, hr})) - b,
+                        land.world_z(j0));
+    const glm::dvec3 hi(land.world_x(i1), off + double(std::max({ha, hl, hr})) + b,
+                        land.world_z(j1));
+    const glm::dvec3 e = cam.eye;
+    const glm::dvec3 nearest = glm::clamp(e, lo, hi);
+    const double d = glm::length(nearest - e);
+    const double r = slack * d;
+    // Far plane, as a sphere: outside while the eye cannot get within far of the box.
+    if (d - r > cam.far_m) {
+      v.distance = d - cam.far_m;
+      return 0.0f;
+    }
+    // Side planes. The box is outside a plane by margin m (metres) when its most inward corner
+    // is m behind it; the classification holds while translation + rotation * reach < m.
+    const glm::dvec3 c = 0.5 * (lo + hi) - e, he = 0.5 * (hi - lo);
+    double margin = 0.0;
+    for (const glm::dvec3& pn : planes) {
+      const double s_max =
+          glm::dot(pn, c) + std::abs(pn.x) * he.x + std::abs(pn.y) * he.y + std::abs(pn.z) * he.z;
+      margin = std::max(margin, -s_max);
+    }
+    if (margin > r && margin > 0.0) {
+      const double reach = glm::length(c) + glm::length(he);
+      v.distance = 0.5 * margin;
+      v.angle = 0.5 * margin / std::max(reach, 1e-9);
+      return 0.0f;
+    }
+    v.distance = r;
+    const double dd = d - r;
+    if (dd <= 0.0) return kInf;
+    return static_cast<float>(double(b) * K / dd);
+  }
+
+  void push_records(std::uint32_t n, const Validity& v) {
+    Node& nd = nodes[n];
+    ++nd.stamp;
+    if (std::isfinite(v.distance)) by_distance.push({odometer + v.distance, n, nd.stamp});
+    if (std::isfinite(v.angle)) by_angle.push({angometer + v.angle, n, nd.stamp});
+  }
+
+  void push_split(std::uint32_t n) {
+    if (!splittable(n)) return;
+    Validity v;
+    const float p = priority(n, v);
+    split.push(n, p);
+    push_records(n, v);
+  }
+
+  // Representative node of the diamond of internal node n.
+  std::uint32_t rep_of(std::uint32_t n) const {
+    const std::uint32_t b = nodes[n].base;
+    return (b == kNone || n < b) ? n : b;
+  }
+
+  bool children_are_leaves(std::uint32_t n) const {
+    const std::uint32_t c = nodes[n].child;
+    return c != kNone && is_leaf(c) && is_leaf(c + 1);
+  }
+
+  bool mergeable(std::uint32_t n) const {
+    if (!children_are_leaves(n)) return false;
+    const std::uint32_t b = nodes[n].base;
+    return b == kNone || (nodes[b].base == n && children_are_leaves(b));
+  }
+
+  float diamond_priority(std::uint32_t rep, Validity& v) {
+    float p = priority(rep, v);
+    const std::uint32_t b = nodes[rep].base;
+    if (b != kNone) {
+      Validity vb;
+      p = std::max(p, priority(b, vb));
+      v.distance = std::min(v.distance, vb.distance);
+      v.angle = std::min(v.angle, vb.angle);
+    }
+    return p;
+  }
+
+  // Puts the diamond of internal node n in the merge queue if it is mergeable, takes it out if
+  // it is not.
+  void refresh_merge(std::uint32_t n) {
+    if (n == kNone || is_leaf(n)) return;
+    const std::uint32_t rep = rep_of(n);
+    const bool in = nodes[rep].qslot != kNone;
+    if (mergeable(n)) {
+      if (!in) {
+        Validity v;
+        const float p = diamond_priority(rep, v);
+        merge.push(rep, p);
+        push_records(rep, v);
+      }
+    } else if (in) {
+      merge.remove(rep);
+    }
+  }
+
+  // Recomputes the key of a queued node (split leaf or merge representative).
+  void requeue(std::uint32_t n) {
+    Validity v;
+    if (is_leaf(n)) {
+      const float p = priority(n, v);
+      split.update(n, p);
+    } else {
+      const float p = diamond_priority(n, v);
+      merge.update(n, p);
+    }
+    push_records(n, v);
+  }
+
+  // ---- split and merge ---------------------------------------------------------------------
+
+  // Triangles a split of leaf n adds, counting the forced splits it needs.
+  std::uint32_t split_cost(std::uint32_t n) const {
+    std::uint32_t cost = 0;
+    std::uint32_t x = n;
+    for (;;) {
+      const std::uint32_t b = nodes[x].base;
+      if (b == kNone) return cost + 1;
+      if (nodes[b].base == x) return cost + 2;
+      cost += 2;
+      x = b;
+    }
+  }
+
+  void make_children(std::uint32_t n) {
+    const std::uint32_t c = alloc_pair();
+    Node& p = nodes[n];
+    Node& c0 = nodes[c];
+    Node& c1 = nodes[c + 1];
+    c0 = Node{};
+    c1 = Node{};
+    c0.parent = c1.parent = n;
+    c0.root = c1.root = p.root;
+    c0.heap = 2 * p.heap;
+    c1.heap = 2 * p.heap + 1;
+    p.child = c;
+  }
+
+  void split_leaf(std::uint32_t t, bool forced) {
+    // Make the base neighbour a diamond partner first (forced splits), then split both.
+    while (nodes[t].base != kNone && nodes[nodes[t].base].base != t)
+      split_leaf(nodes[t].base, true);
+    if (forced)
+      ++st.forced_splits;
+    else
+      ++st.splits;
+    const std::uint32_t b = nodes[t].base;
+    split.remove(t);
+    make_children(t);
+    const std::uint32_t t0 = nodes[t].child, t1 = t0 + 1;
+    std::uint32_t b0 = kNone, b1 = kNone;
+    if (b != kNone) {
+      split.remove(b);
+      make_children(b);
+      b0 = nodes[b].child;
+      b1 = b0 + 1;
+    }
+    {
+      const Node& T = nodes[t];
+      nodes[t0].base = T.left;
+      nodes[t0].left = t1;
+      nodes[t0].right = b1;
+      nodes[t1].base = T.right;
+      nodes[t1].left = b0;
+      nodes[t1].right = t0;
+      replace_link(T.left, t, t0);
+      replace_link(T.right, t, t1);
+    }
+    if (b != kNone) {
+      const Node& B = nodes[b];
+      nodes[b0].base = B.left;
+      nodes[b0].left = b1;
+      nodes[b0].right = t1;
+      nodes[b1].base = B.right;
+      nodes[b1].left = t0;
+      nodes[b1].right = b0;
+      replace_link(B.left, b, b0);
+      replace_link(B.right, b, b1);
+    }
+    triangles += b != kNone ? 2 : 1;
+    mark_dirty(t);
+    if (b != kNone) mark_dirty(b);
+    // Queues: new leaves, the new diamond, and the parents' diamonds that stopped being mergeable.
+    push_split(t0);
+    push_split(t1);
+    if (b != kNone) {
+      push_split(b0);
+      push_split(b1);
+    }
+    refresh_merge(t);
+    if (nodes[t].parent != kNone) refresh_merge(nodes[t].parent);
+    if (b != kNone && nodes[b].parent != kNone) refresh_merge(nodes[b].parent);
+  }
+
+  void merge_diamond(std::uint32_t rep) {
+    ++st.merges;
+    merge.remove(rep);
+    const std::uint32_t t = rep, b = nodes[rep].base;
+    auto collapse = [&](std::uint32_t n) {
+      const std::uint32_t c0 = nodes[n].child, c1 = c0 + 1;
+      nodes[n].left = nodes[c0].base;
+      nodes[n].right = nodes[c1].base;
+      replace_link(nodes[c0].base, c0, n);
+      replace_link(nodes[c1].base, c1, n);
+      split.remove(c0);
+      split.remove(c1);
+      nodes[c0].stamp++;  // invalidate any expiry records of the freed nodes
+      nodes[c1].stamp++;
+      nodes[n].child = kNone;
+      free_pairs.push_back(c0);
+      mark_dirty(n);
+    };
+    collapse(t);
+    if (b != kNone) collapse(b);
+    triangles -= b != kNone ? 2 : 1;
+    push_split(t);
+    if (b != kNone) push_split(b);
+    if (nodes[t].parent != kNone) refresh_merge(nodes[t].parent);
+    if (b != kNone && nodes[b].parent != kNone) refresh_merge(nodes[b].parent);
+  }
+
+  // ---- camera -------------------------------------------------------------------------------
+
+  // Returns true when every key must be recomputed (projection or far plane changed).
+  bool set_camera(const Camera& c) {
+    const Frame fr = frame_of(c);
+    bool all = !have_camera;
+    if (have_camera) {
+      odometer += glm::length(c.eye - cam.eye);
+      angometer += frame_angle(frame, fr);
+      all = c.fov_y_deg != cam.fov_y_deg || c.viewport != cam.viewport || c.far_m != cam.far_m;
+    }
+    cam = c;
+    frame = fr;
+    have_camera = true;
+    K = projection_scale(c);
+    const double tv = std::tan(c.fov_y_deg * 3.14159265358979323846 / 360.0);
+    const double th = tv * double(c.viewport.x) / double(c.viewport.y);
+    planes[0] = glm::normalize(th * fr.f + fr.r);  // left
+    planes[1] = glm::normalize(th * fr.f - fr.r);  // right
+    planes[2] = glm::normalize(tv * fr.f + fr.u);  // bottom
+    planes[3] = glm::normalize(tv * fr.f - fr.u);  // top
+    return all;
+  }
+
+  void recompute_all() {
+    by_distance = {};
+    by_angle = {};
+    std::vector<std::uint32_t> queued;
+    queued.reserve(split.size() + merge.size());
+    for (const auto& e : split.entries()) queued.push_back(e.node);
+    for (const auto& e : merge.entries()) queued.push_back(e.node);
+    for (std::uint32_t n : queued) requeue(n);
+  }
+
+  // Recomputes expired keys. Returns false when so many expired that rebuilding is cheaper.
+  bool refresh_expired(std::size_t rebuild_above) {
+    std::size_t done = 0;
+    auto drain = [&](ExpiryQueue& q, double now) {
+      while (!q.empty() && q.top().key <= now) {
+        const Expiry e = q.top();
+        q.pop();
+        const Node& nd = nodes[e.node];
+        if (nd.stamp != e.stamp || nd.qslot == kNone) continue;  // stale record
+        requeue(e.node);
+        if (++done > rebuild_above) return false;
+      }
+      return true;
+    };
+    return drain(by_angle, angometer) && drain(by_distance, odometer);
+  }
+};
+
+// -------------------------------------------------------------------------------------------
+
+float morph_factor(float morph_bound, double distance_m, double k, double threshold_px) {
+  if (morph_bound <= 0.0f) return 1.0f;
+  if (!(threshold_px > 0.0)) return 1.0f;
+  const double p = distance_m > 0.0 ? double(morph_bound) * k / distance_m : 1e30;
+  return static_cast<float>(std::clamp(p / threshold_px - 1.0, 0.0, 1.0));
+}
+
+Result<std::unique_ptr<RoamView>> RoamView::create(std::shared_ptr<const Landscape> landscape,
+                                                   const RoamSettings& settings) {
+  if (!landscape) return Error{"roam view: no landscape given"};
+  std::unique_ptr<RoamView> v(new RoamView());
+  v->landscape_ = std::move(landscape);
+  v->impl_ = std::make_unique<Impl>(*v->landscape_);
+  if (auto s = v->set_settings(settings); !s) return Error{s.message()};
+  Impl& m = *v->impl_;
+  const std::uint32_t np = v->landscape_->patch_count();
+  m.patch_version.assign(np, 0);
+  m.patch_dirty.assign(np, 0);
+  m.meshes.resize(np);
+  m.mesh_built_version.assign(np, ~std::uint64_t{0});
+  m.reset_to_roots();
+  v->triangles_ = m.triangles;
+  return v;
+}
+
+RoamView::~RoamView() = default;
+
+Status RoamView::set_settings(const RoamSettings& s) {
+  if (!std::isfinite(s.threshold) || s.threshold < 0.0)
+    return Error{
+        fmt("roam view: threshold %s; need a finite value >= 0", num(s.threshold).c_str())};
+  if (!std::isfinite(s.budget_ms) || s.budget_ms < 0.0)
+    return Error{
+        fmt("roam view: time budget %s ms; need a finite value >= 0", num(s.budget_ms).c_str())};
+  if (!(s.slack >= 0.005 && s.slack <= 0.5))
+    return Error{fmt("roam view: slack %s; need 0.005 .. 0.5", num(s.slack).c_str())};
+  if (s.max_triangles != 0 && s.max_triangles < landscape_->root_count())
+    return Error{fmt("roam view: triangle budget %u is below the %u root triangles",
+                     s.max_triangles, landscape_->root_count())};
+  if (impl_ &&
+      (s.mode != settings_.mode || s.metric != settings_.metric || s.slack != settings_.slack))
+    impl_->reset_pending = true;
+  settings_ = s;
+  return {};
+}
+
+Result<RoamStats> RoamView::converge(const Camera& camera) {
+  RoamSettings saved = settings_;
+  RoamSettings s = settings_;
+  s.budget_ms = 0;
+  (void)set_settings(s);
+  auto r = update(camera);
+  (void)set_settings(saved);
+  return r;
+}
+
+Result<RoamStats> RoamView::update(const Camera& camera) {
+  if (settings_.metric == ErrorMetric::kScreenPixels)
+    if (auto s = validate_camera(camera); !s) return Error{s.message()};
+  const auto t0 = std::chrono::steady_clock::now();
+  Impl& m = *impl_;
+  m.st = RoamStats{};
+  m.metric = settings_.metric;
+  m.slack = settings_.slack;
+  const double threshold = settings_.threshold;
+  const std::uint32_t cap = settings_.max_triangles;
+  const double budget = settings_.budget_ms;
+  auto elapsed_ms = [&] {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  };
+
+  bool all = false;
+  if (settings_.metric == ErrorMetric::kScreenPixels) all = m.set_camera(camera);
+  if (m.reset_pending || settings_.mode == RoamMode::kRebuild) {
+    m.reset_pending = false;
+    m.reset_to_roots();
+  } else if (all) {
+    m.recompute_all();
+  } else if (settings_.metric == ErrorMetric::kScreenPixels) {
+    // Coherence loses when most keys expire at once (a teleport, a snap turn): rebuilding
+    // top-down then costs less than requeueing everything and merging most of the mesh away.
+    const std::size_t queued = m.split.size() + m.merge.size();
+    if (!m.refresh_expired(std::max<std::size_t>(2048, queued / 2))) m.reset_to_roots();
+  }
+
+  // Greedy split/merge (D97 section 5): split the worst leaf while it exceeds the threshold,
+  // merge the best diamond while it is within it; under a triangle cap, trade merges of
+  // low-priority diamonds for splits of higher-priority leaves.
+  std::uint64_t ops = 0;
+  for (;;) {
+    // A safety net against a trade cycle under a triangle cap; never reached in practice.
+    if (++ops > 16ull * (m.triangles + 4096)) break;
+    if (budget > 0.0 && (ops & 15) == 0 && elapsed_ms() >= budget) {
+      m.st.stop = StopReason::kTimeBudget;
+      break;
+    }
+    const float s = m.split.empty() ? -1.0f : m.split.top().key;
+    const float g = m.merge.empty() ? kInf : m.merge.top().key;
+    if (cap != 0 && m.triangles > cap) {
+      if (m.merge.empty()) break;
+      m.merge_diamond(m.merge.top().node);
+      continue;
+    }
+    if (s > threshold) {
+      const std::uint32_t n = m.split.top().node;
+      if (cap != 0 && m.triangles + m.split_cost(n) > cap) {
+        // Trade only a diamond that is not the leaf's own parent pair.
+        if (g < s && m.nodes[n].parent != m.merge.top().node &&
+            m.nodes[n].parent != m.nodes[m.merge.top().node].base) {
+          m.merge_diamond(m.merge.top().node);
+          continue;
+        }
+        m.st.stop = StopReason::kTriangleBudget;
+        break;
+      }
+      m.split_leaf(n, false);
+      continue;
+    }
+    if (g <= threshold) {
+      m.merge_diamond(m.merge.top().node);
+      continue;
+    }
+    break;
+  }
+
+  triangles_ = m.triangles;
+  m.st.triangles = m.triangles;
+  m.st.max_remaining_error = m.split.empty() ? 0.0 : std::max(0.0f, m.split.top().key);
+  m.st.dirty_patches = static_cast<std::uint32_t>(m.dirty_list.size());
+  m.st.memory_bytes = m.nodes.capacity() * sizeof(Node) + m.split.memory_bytes() +
+                      m.merge.memory_bytes() +
+                      (m.by_distance.size() + m.by_angle.size()) * sizeof(Expiry) +
+                      m.free_pairs.capacity() * sizeof(std::uint32_t);
+  for (const PatchMesh& pm : m.meshes)
+    m.st.memory_bytes += pm.vertices.capacity() * sizeof(MeshVertex) +
+                         pm.indices.capacity() * sizeof(std::uint32_t) + pm.padding.capacity();
+  m.st.update_ms = elapsed_ms();
+  return m.st;
+}
+
+std::vector<std::uint32_t> RoamView::take_dirty_patches() {
+  Impl& m = *impl_;
+  std::vector<std::uint32_t> out;
+  out.swap(m.dirty_list);
+  for (std::uint32_t p : out) m.patch_dirty[p] = 0;
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+void RoamView::for_each_leaf(
+    const std::function<void(std::uint32_t, std::uint64_t, const LatticeTriangle&)>& fn) const {
+  const Impl& m = *impl_;
+  struct Item {
+    std::uint32_t n;
+    LatticeTriangle t;
+  };
+  std::vector<Item> stack;
+  for (std::uint32_t r = 0; r < landscape_->root_count(); ++r) {
+    stack.push_back({r, landscape_->triangle(r, 1)});
+    while (!stack.empty()) {
+      const Item it = stack.back();
+      stack.pop_back();
+      const Node& nd = m.nodes[it.n];
+      if (nd.child == kNone) {
+        fn(nd.root, nd.heap, it.t);
+        continue;
+      }
+      stack.push_back({nd.child + 1, Landscape::child_triangle(it.t, 1)});
+      stack.push_back({nd.child, Landscape::child_triangle(it.t, 0)});
+    }
+  }
+}
+
+std::uint64_t RoamView::mesh_hash() const {
+  std::uint64_t h = 1469598103934665603ull;
+  for_each_leaf([&](std::uint32_t root, std::uint64_t heap, const LatticeTriangle&) {
+    for (std::uint64_t v : {std::uint64_t(root), heap}) {
+      h ^= v;
+      h *= 1099511628211ull;
+    }
+  });
+  return h;
+}
+
+std::string RoamView::check_invariants() const {
+  const Impl& m = *impl_;
+  std::string err;
+  std::uint32_t leaves = 0;
+  // Pointer symmetry: every leaf's neighbours are leaves that point back.
+  std::vector<std::uint32_t> stack;
+  for (std::uint32_t r = 0; r < landscape_->root_count() && err.empty(); ++r) {
+    stack.push_back(r);
+    while (!stack.empty() && err.empty()) {
+      const std::uint32_t n = stack.back();
+      stack.pop_back();
+      const Node& nd = m.nodes[n];
+      if (nd.child != kNone) {
+        stack.push_back(nd.child);
+        stack.push_back(nd.child + 1);
+        continue;
+      }
+      ++leaves;
+      for (std::uint32_t nb : {nd.base, nd.left, nd.right}) {
+        if (nb == kNone) continue;
+        const Node& o = m.nodes[nb];
+        if (o.child != kNone)
+          err = fmt("leaf %u (root %u heap %u) links to internal node %u", n, nd.root, nd.heap, nb);
+        else if (o.base != n && o.left != n && o.right != n)
+          err = fmt("leaf %u links to %u which does not link back", n, nb);
+      }
+      if (nd.base != kNone) {
+        const Node& o = m.nodes[nd.base];
+        const std::uint32_t lo = 31 - __builtin_clz(o.heap), ln = 31 - __builtin_clz(nd.heap);
+        if (o.base == n ? lo != ln : lo + 1 != ln)
+          err = fmt("leaf %u and its base neighbour %u differ by more than one level", n, nd.base);
+      }
+    }
+  }
+  if (err.empty() && leaves != m.triangles)
+    err = fmt("leaf count %u differs from the triangle counter %u", leaves, m.triangles);
+  return err;
+}
+
+const PatchMesh& RoamView::patch_mesh(std::uint32_t patch) {
+  Impl& m = *impl_;
+  RIDGELINE_ASSERT(patch < landscape_->patch_count());
+  PatchMesh& pm = m.meshes[patch];
+  if (m.mesh_built_version[patch] == m.patch_version[patch]) return pm;
+  const Landscape& l = *landscape_;
+  const Heightfield& hf = l.terrain().heightfield();
+  const std::int64_t P = l.patch_cells();
+  const std::int64_t i0 = std::int64_t(patch % l.patches_x()) * P;
+  const std::int64_t j0 = std::int64_t(patch / l.patches_x()) * P;
+  pm.origin_x = l.world_x(i0);
+  pm.origin_z = l.world_z(j0);
+  pm.origin_y = hf.height_offset();
+  pm.vertices.clear();
+  pm.indices.clear();
+  pm.padding.clear();
+  pm.version = m.patch_version[patch];
+  m.scratch_index.assign(std::size_t(P + 1) * std::size_t(P + 1), kNone);
+  const std::int64_t wmax = hf.width() - 1, hmax = hf.height() - 1;
+
+  // Depth-first over the patch's two roots; a vertex's geomorph data comes from the diamond
+  // whose split introduced it (the first time the traversal meets it as a midpoint).
+  struct Item {
+    std::uint32_t n;
+    LatticeTriangle t;
+  };
+  std::vector<Item> stack;
+  std::vector<std::pair<float, float>> morph(m.scratch_index.size(), {0.0f, 0.0f});
+  auto vertex = [&](std::int64_t i, std::int64_t j) -> std::uint32_t {
+    const std::size_t key = std::size_t(i - i0) + std::size_t(j - j0) * std::size_t(P + 1);
+    std::uint32_t& slot = m.scratch_index[key];
+    if (slot != kNone) return slot;
+    slot = static_cast<std::uint32_t>(pm.vertices.size());
+    const auto ci = static_cast<std::uint32_t>(std::clamp<std::int64_t>(i, 0, wmax));
+    const auto cj = static_cast<std::uint32_t>(std::clamp<std::int64_t>(j, 0, hmax));
+    const glm::vec3 n = detail::vertex_normal(hf, ci, cj);
+    MeshVertex v;
+    v.x = static_cast<float>(double(i - i0) * hf.spacing_x());
+    v.z = static_cast<float>(double(j - j0) * hf.spacing_z());
+    v.y = l.lattice_height(i, j);
+    v.nx = n.x;
+    v.ny = n.y;
+    v.nz = n.z;
+    v.morph_dy = morph[key].first;
+    v.morph_bound = morph[key].second;
+    pm.vertices.push_back(v);
+    return slot;
+  };
+  for (std::uint32_t r = 2 * patch; r < 2 * patch + 2; ++r) {
+    stack.push_back({r, l.triangle(r, 1)});
+    while (!stack.empty()) {
+      const Item it = stack.back();
+      stack.pop_back();
+      const Node& nd = m.nodes[it.n];
+      if (nd.child == kNone) {
+        const LatticeTriangle& t = it.t;
+        pm.indices.push_back(vertex(t.ax, t.az));
+        pm.indices.push_back(vertex(t.lx, t.lz));
+        pm.indices.push_back(vertex(t.rx, t.rz));
+        const double cx = double(t.ax + t.lx + t.rx) / 3.0, cz = double(t.az + t.lz + t.rz) / 3.0;
+        pm.padding.push_back(cx > double(wmax) || cz > double(hmax));
+        continue;
+      }
+      // The midpoint this split introduced: record its geomorph data before any leaf uses it.
+      const LatticeTriangle& t = it.t;
+      const std::int64_t mx = (t.lx + t.rx) / 2, mz = (t.lz + t.rz) / 2;
+      const std::size_t key = std::size_t(mx - i0) + std::size_t(mz - j0) * std::size_t(P + 1);
+      if (m.scratch_index[key] == kNone && morph[key].second == 0.0f) {
+        float b = l.bound(nd.root, nd.heap);
+        if (nd.base != kNone)
+          b = std::max(b, l.bound(m.nodes[nd.base].root, m.nodes[nd.base].heap));
+        const float interp = 0.5f * (l.lattice_height(t.lx, t.lz) + l.lattice_height(t.rx, t.rz));
+        morph[key] = {interp - l.lattice_height(mx, mz), std::max(b, 1e-30f)};
+      }
+      stack.push_back({nd.child + 1, Landscape::child_triangle(it.t, 1)});
+      stack.push_back({nd.child, Landscape::child_triangle(it.t, 0)});
+    }
+  }
+  m.mesh_built_version[patch] = m.patch_version[patch];
+  return pm;
+}
+
+}  // namespace ridgeline
