@@ -118,7 +118,7 @@ class Heightfield {
 };
 
 /// The built-in default terrain: 1025 x 1025 samples, 2 m spacing (a 2048 m square) at origin
-/// (0, 0), seed 1337, fBm value noise with ridges, heights about 0 .. 260 m, with a material layer
+/// (0, 0), seed 1337, fBm value noise with ridges, heights 16.3 .. 218.1 m, with a material layer
 /// (0 grass, 1 rock on steep cells, 2 sand near the lowest heights, 3 snow near the top).
 /// Deterministic: the same bytes on every machine. Benchmark figures quoted with
 /// `--default-terrain` depend on exactly these parameters.
