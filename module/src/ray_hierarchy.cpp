@@ -1,13 +1,381 @@
-// Raycasts against the surface (placeholder: being written).
+// Raycasts and box queries against the surface of surface.h.
+//
+// Raycasts descend a min/max pyramid front to back, after the octree ray traversal of Revelles,
+// Urena and Lastra (2000) and the maximum mipmaps of Tevs, Ihrke and Seidel (2008): a node is
+// skipped when the ray stays above the node's highest sample over the node's footprint. A leaf
+// block is walked cell by cell with a 2D DDA (Amanatides and Woo 1987); in each cell the ray's
+// height above the surface is linear in t over each of the two triangles, so the first touching
+// point follows from the values at the ends of the ray's piece over each triangle.
+//
+// Everything runs in double precision in lattice-local coordinates (grid units from sample (0, 0)
+// along x and z, metres above the height offset along y), so terrains far from the world origin
+// lose nothing.
 #include "ray_hierarchy.h"
+
+#include <algorithm>
+#include <cmath>
+#include <glm/geometric.hpp>
+#include <limits>
+
+#include "surface_eval.h"
 
 namespace ridgeline {
 
-RayHierarchy::RayHierarchy(const Heightfield&) {}
-std::size_t RayHierarchy::memory_bytes() const noexcept { return 0; }
-std::optional<RayHit> RayHierarchy::raycast(const Heightfield&, const glm::dvec3&,
-                                            const glm::dvec3&, double) const noexcept {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// Footprints of nodes are widened by this many grid units so that rounding in u0 + du * t never
+// drops a node the ray touches; the exact cell tests decide.
+constexpr double kPad = 1e-7;
+// Direction components below this (after normalisation) are zero: over any representable ray
+// length they move the ray by far less than a nanometre, and they would overflow 1 / d.
+constexpr double kTinyDirection = 1e-150;
+
+// A ray "touches" the surface where its height above it is at most this (metres): a few units of
+// double rounding of heights of that size, far below anything physical.
+inline double touch_tolerance(double h) noexcept {
+  return 1e-9 * (1.0 + std::abs(h));
+}
+
+// Narrows [t0, t1] to the part where o + d * t lies in [a, b]. False when empty.
+inline bool clip_axis(double o, double d, double inv, double a, double b, double& t0,
+                      double& t1) noexcept {
+  if (d == 0.0) return o >= a && o <= b;
+  double ta = (a - o) * inv, tb = (b - o) * inv;
+  if (ta > tb) std::swap(ta, tb);
+  t0 = std::max(t0, ta);
+  t1 = std::min(t1, tb);
+  return t0 <= t1;
+}
+
+}  // namespace
+
+struct RayHierarchy::Ray {
+  double u0, v0, y0;       // origin: grid units along x and z, metres above the height offset
+  double du, dv, dy;       // change per metre along the ray
+  double inv_du, inv_dv;   // 1 / du, 1 / dv (unused when zero)
+  double t_enter, t_exit;  // the part of [0, max_distance] above the footprint
+  glm::dvec3 origin, dir;  // world origin and unit direction
+};
+
+RayHierarchy::RayHierarchy(const Heightfield& hf) {
+  const std::uint32_t cells_x = hf.width() - 1, cells_z = hf.height() - 1;
+  Level leaf;
+  leaf.nx = (cells_x + kLeafCells - 1) >> kLeafShift;
+  leaf.nz = (cells_z + kLeafCells - 1) >> kLeafShift;
+  leaf.nodes.resize(std::size_t{leaf.nx} * leaf.nz);
+  for (std::uint32_t bz = 0; bz < leaf.nz; ++bz) {
+    const std::uint32_t j0 = bz << kLeafShift, j1 = std::min(j0 + kLeafCells, cells_z);
+    for (std::uint32_t bx = 0; bx < leaf.nx; ++bx) {
+      const std::uint32_t i0 = bx << kLeafShift, i1 = std::min(i0 + kLeafCells, cells_x);
+      float lo = hf.local(i0, j0), hi = lo;
+      for (std::uint32_t j = j0; j <= j1; ++j) {
+        for (std::uint32_t i = i0; i <= i1; ++i) {
+          const float h = hf.local(i, j);
+          lo = std::min(lo, h);
+          hi = std::max(hi, h);
+        }
+      }
+      leaf.nodes[bx + std::size_t{bz} * leaf.nx] = {lo, hi};
+    }
+  }
+  levels_.push_back(std::move(leaf));
+  while (levels_.back().nx > 1 || levels_.back().nz > 1) {
+    const Level& below = levels_.back();
+    Level up;
+    up.nx = (below.nx + 1) / 2;
+    up.nz = (below.nz + 1) / 2;
+    up.nodes.resize(std::size_t{up.nx} * up.nz);
+    for (std::uint32_t z = 0; z < up.nz; ++z) {
+      for (std::uint32_t x = 0; x < up.nx; ++x) {
+        Range r = below.nodes[2 * x + std::size_t{2 * z} * below.nx];
+        for (std::uint32_t c = 1; c < 4; ++c) {
+          const std::uint32_t cx = 2 * x + (c & 1), cz = 2 * z + (c >> 1);
+          if (cx >= below.nx || cz >= below.nz) continue;
+          const Range& k = below.nodes[cx + std::size_t{cz} * below.nx];
+          r.min = std::min(r.min, k.min);
+          r.max = std::max(r.max, k.max);
+        }
+        up.nodes[x + std::size_t{z} * up.nx] = r;
+      }
+    }
+    levels_.push_back(std::move(up));
+  }
+}
+
+std::size_t RayHierarchy::memory_bytes() const noexcept {
+  std::size_t bytes = levels_.capacity() * sizeof(Level);
+  for (const Level& l : levels_) bytes += l.nodes.capacity() * sizeof(Range);
+  return bytes;
+}
+
+namespace {
+
+// Fills a hit on triangle `tri` of cell (i, j) at distance t.
+void fill_hit(const Heightfield& hf, const glm::dvec3& origin, const glm::dvec3& dir,
+              std::uint32_t i, std::uint32_t j, const CellTriangle& tri, double t,
+              bool started_below, RayHit& hit) noexcept {
+  hit.distance = t;
+  hit.point = t == 0.0 ? origin : origin + dir * t;
+  hit.normal = detail::face_normal(hf, i, j, tri);
+  hit.material = hf.material(i, j);
+  hit.started_below = started_below;
+}
+
+}  // namespace
+
+// Tests the cells of leaf block (bx, bz) that the ray crosses during [ta, tb], in ray order.
+bool RayHierarchy::leaf_hit(const Heightfield& hf, const Ray& r, std::uint32_t bx, std::uint32_t bz,
+                            double ta, double tb, RayHit& hit) const noexcept {
+  const std::int64_t ci0 = std::int64_t{bx} << kLeafShift;
+  const std::int64_t cj0 = std::int64_t{bz} << kLeafShift;
+  const std::int64_t ci1 = std::min<std::int64_t>(ci0 + kLeafCells, hf.width() - 1) - 1;
+  const std::int64_t cj1 = std::min<std::int64_t>(cj0 + kLeafCells, hf.height() - 1) - 1;
+  std::int64_t ci =
+      std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor(r.u0 + r.du * ta)), ci0, ci1);
+  std::int64_t cj =
+      std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor(r.v0 + r.dv * ta)), cj0, cj1);
+  const int step_u = r.du > 0 ? 1 : -1, step_v = r.dv > 0 ? 1 : -1;
+  double t = ta;
+  for (;;) {
+    // Leave this cell where the ray crosses its far u or v boundary. With both at once (through a
+    // vertex) the DDA steps one axis first: the side cell gets an empty interval and is tested at
+    // the vertex alone, which is harmless.
+    const double tnu = r.du > 0   ? (double(ci + 1) - r.u0) * r.inv_du
+                       : r.du < 0 ? (double(ci) - r.u0) * r.inv_du
+                                  : kInf;
+    const double tnv = r.dv > 0   ? (double(cj + 1) - r.v0) * r.inv_dv
+                       : r.dv < 0 ? (double(cj) - r.v0) * r.inv_dv
+                                  : kInf;
+    const double tc = std::max(t, std::min({tnu, tnv, tb}));
+
+    // The cell: skip it when the ray stays above its highest corner.
+    const auto i = static_cast<std::uint32_t>(ci), j = static_cast<std::uint32_t>(cj);
+    const float h00 = hf.local(i, j), h10 = hf.local(i + 1, j);
+    const float h01 = hf.local(i, j + 1), h11 = hf.local(i + 1, j + 1);
+    const double cmax = std::max(std::max(h00, h10), std::max(h01, h11));
+    const double ylow = r.y0 + r.dy * (r.dy < 0 ? tc : t);
+    if (ylow <= cmax + touch_tolerance(cmax)) {
+      // Split [t, tc] where the ray crosses the cell's diagonal (surface.h decides which one).
+      const double ou = r.u0 - double(ci), ov = r.v0 - double(cj);
+      const bool main = cell_has_main_diagonal(ci, cj);
+      auto side = [&](double s) {
+        const double fu = ou + r.du * s, fv = ov + r.dv * s;
+        return main ? fu - fv : fu + fv - 1.0;
+      };
+      const double sa = side(t), sb = side(tc);
+      double piece[3] = {t, tc, tc};
+      int pieces = 1;
+      if ((sa < 0 && sb > 0) || (sa > 0 && sb < 0)) {
+        piece[1] = std::clamp(t + (tc - t) * (sa / (sa - sb)), t, tc);
+        pieces = 2;
+      }
+      for (int k = 0; k < pieces; ++k) {
+        const double pa = piece[k], pb = piece[k + 1];
+        const double pm = 0.5 * (pa + pb);
+        const CellTriangle tri =
+            locate_in_cell(ci, cj, static_cast<float>(std::clamp(ou + r.du * pm, 0.0, 1.0)),
+                           static_cast<float>(std::clamp(ov + r.dv * pm, 0.0, 1.0)));
+        const detail::CellPlane plane = detail::cell_plane(hf, i, j, tri);
+        const double ha = plane.at(ou + r.du * pa, ov + r.dv * pa);
+        const double fa = (r.y0 + r.dy * pa) - ha;
+        double th;
+        if (fa <= touch_tolerance(ha)) {
+          th = pa;
+        } else {
+          const double hb = plane.at(ou + r.du * pb, ov + r.dv * pb);
+          const double fb = (r.y0 + r.dy * pb) - hb;
+          if (fb > touch_tolerance(hb)) continue;
+          th = fb <= 0 ? std::clamp(pa + (pb - pa) * (fa / (fa - fb)), pa, pb) : pb;
+        }
+        fill_hit(hf, r.origin, r.dir, i, j, tri, th, false, hit);
+        return true;
+      }
+    }
+
+    if (tc >= tb) return false;
+    if (tnu <= tnv) {
+      ci += step_u;
+      if (ci < ci0 || ci > ci1) return false;
+    } else {
+      cj += step_v;
+      if (cj < cj0 || cj > cj1) return false;
+    }
+    t = tc;
+  }
+}
+
+std::optional<RayHit> RayHierarchy::raycast(const Heightfield& hf, const glm::dvec3& origin,
+                                            const glm::dvec3& direction,
+                                            double max_distance) const noexcept {
+  if (!(max_distance > 0.0)) return std::nullopt;  // also NaN
+  for (int a = 0; a < 3; ++a)
+    if (!std::isfinite(origin[a]) || !std::isfinite(direction[a])) return std::nullopt;
+  // Normalise without overflow: scale by the largest component first.
+  const double m = std::max({std::abs(direction.x), std::abs(direction.y), std::abs(direction.z)});
+  if (!(m > 0.0)) return std::nullopt;  // zero direction
+  glm::dvec3 d = direction / m;
+  d /= std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+  if (std::abs(d.x) < kTinyDirection) d.x = 0.0;
+  if (std::abs(d.z) < kTinyDirection) d.z = 0.0;
+
+  Ray r;
+  r.origin = origin;
+  r.dir = d;
+  r.u0 = (origin.x - hf.origin_x()) / hf.spacing_x();
+  r.v0 = (origin.z - hf.origin_z()) / hf.spacing_z();
+  r.y0 = origin.y - hf.height_offset();
+  r.du = d.x / hf.spacing_x();
+  r.dv = d.z / hf.spacing_z();
+  r.dy = d.y;
+  r.inv_du = r.du != 0.0 ? 1.0 / r.du : 0.0;
+  r.inv_dv = r.dv != 0.0 ? 1.0 / r.dv : 0.0;
+
+  // The part of the ray above the footprint (exact bounds: the footprint is the terrain).
+  const double umax = hf.width() - 1.0, vmax = hf.height() - 1.0;
+  r.t_enter = 0.0;
+  r.t_exit = max_distance;
+  if (!clip_axis(r.u0, r.du, r.inv_du, 0.0, umax, r.t_enter, r.t_exit)) return std::nullopt;
+  if (!clip_axis(r.v0, r.dv, r.inv_dv, 0.0, vmax, r.t_enter, r.t_exit)) return std::nullopt;
+
+  // Where the ray starts over the terrain: at or below the surface there, it hits there.
+  RayHit hit;
+  {
+    const double t = r.t_enter;
+    const double u = std::clamp(r.u0 + r.du * t, 0.0, umax);
+    const double v = std::clamp(r.v0 + r.dv * t, 0.0, vmax);
+    const auto i = std::min(static_cast<std::uint32_t>(u), hf.width() - 2);
+    const auto j = std::min(static_cast<std::uint32_t>(v), hf.height() - 2);
+    const double fu = u - i, fv = v - j;
+    const CellTriangle tri = locate_in_cell(i, j, static_cast<float>(fu), static_cast<float>(fv));
+    const double h = detail::cell_plane(hf, i, j, tri).at(fu, fv);
+    const double f = (r.y0 + r.dy * t) - h;
+    if (f <= touch_tolerance(h)) {
+      fill_hit(hf, origin, d, i, j, tri, t, t == 0.0 && f < 0.0, hit);
+      return hit;
+    }
+    if (r.du == 0.0 && r.dv == 0.0) {
+      // Vertical: the surface under the origin is the only candidate.
+      if (r.dy >= 0.0) return std::nullopt;
+      const double th = f / -r.dy;
+      if (th > r.t_exit) return std::nullopt;
+      fill_hit(hf, origin, d, i, j, tri, th, false, hit);
+      return hit;
+    }
+  }
+
+  // Front-to-back descent. Children are visited near first, far last; of the two others, the
+  // one across the axis the ray does not move along comes first (a ray exactly on a node
+  // boundary touches both halves along that axis during the same t).
+  struct Entry {
+    std::uint32_t level, x, z;
+  };
+  Entry stack[4 * 40];
+  int sp = 0;
+  stack[sp++] = {static_cast<std::uint32_t>(levels_.size() - 1), 0, 0};
+  const std::uint32_t nu = r.du < 0 ? 1 : 0, nv = r.dv < 0 ? 1 : 0;
+  const bool u_first = r.du == 0.0 || r.dv != 0.0;
+  const std::uint32_t order_x[4] = {nu, u_first ? 1 - nu : nu, u_first ? nu : 1 - nu, 1 - nu};
+  const std::uint32_t order_z[4] = {nv, u_first ? nv : 1 - nv, u_first ? 1 - nv : nv, 1 - nv};
+
+  while (sp > 0) {
+    const Entry e = stack[--sp];
+    const Level& level = levels_[e.level];
+    const Range range = level.nodes[e.x + std::size_t{e.z} * level.nx];
+    const std::uint32_t shift = e.level + kLeafShift;
+    const double ua = double(std::uint64_t{e.x} << shift);
+    const double ub = std::min(double(std::uint64_t{e.x + 1} << shift), umax);
+    const double va = double(std::uint64_t{e.z} << shift);
+    const double vb = std::min(double(std::uint64_t{e.z + 1} << shift), vmax);
+    double ta = r.t_enter, tb = r.t_exit;
+    if (!clip_axis(r.u0, r.du, r.inv_du, ua - kPad, ub + kPad, ta, tb)) continue;
+    if (!clip_axis(r.v0, r.dv, r.inv_dv, va - kPad, vb + kPad, ta, tb)) continue;
+    const double ylow = r.y0 + r.dy * (r.dy < 0 ? tb : ta);
+    if (ylow > double(range.max) + touch_tolerance(range.max)) continue;
+    if (e.level == 0) {
+      if (leaf_hit(hf, r, e.x, e.z, ta, tb, hit)) return hit;
+      continue;
+    }
+    const Level& below = levels_[e.level - 1];
+    for (int k = 3; k >= 0; --k) {
+      const std::uint32_t cx = 2 * e.x + order_x[k], cz = 2 * e.z + order_z[k];
+      if (cx < below.nx && cz < below.nz) stack[sp++] = {e.level - 1, cx, cz};
+    }
+  }
   return std::nullopt;
+}
+
+std::size_t RayHierarchy::triangles_in_box(const Heightfield& hf, const Box& box,
+                                           std::vector<SurfaceTriangle>& out,
+                                           std::size_t max_triangles) const {
+  for (int a = 0; a < 3; ++a)
+    if (!std::isfinite(box.min[a]) || !std::isfinite(box.max[a]) || !(box.min[a] <= box.max[a]))
+      return 0;
+  const double sx = hf.spacing_x(), sz = hf.spacing_z();
+  const double ua = (box.min.x - hf.origin_x()) / sx, ub = (box.max.x - hf.origin_x()) / sx;
+  const double va = (box.min.z - hf.origin_z()) / sz, vb = (box.max.z - hf.origin_z()) / sz;
+  const double ylo = box.min.y - hf.height_offset(), yhi = box.max.y - hf.height_offset();
+  const double umax = hf.width() - 1.0, vmax = hf.height() - 1.0;
+  if (ub < 0.0 || vb < 0.0 || ua > umax || va > vmax) return 0;
+  // Closed cell ranges: a box touching a cell's edge overlaps that cell.
+  const auto cell_lo = [](double a, double cells) {
+    return static_cast<std::int64_t>(std::clamp(std::ceil(a) - 1.0, 0.0, cells - 1.0));
+  };
+  const auto cell_hi = [](double b, double cells) {
+    return static_cast<std::int64_t>(std::clamp(std::floor(b), 0.0, cells - 1.0));
+  };
+  const std::int64_t i0 = cell_lo(ua, umax), i1 = cell_hi(ub, umax);
+  const std::int64_t j0 = cell_lo(va, vmax), j1 = cell_hi(vb, vmax);
+
+  const Level& leaf = levels_.front();
+  std::size_t added = 0;
+  for (std::int64_t bz = j0 >> kLeafShift; bz <= (j1 >> kLeafShift); ++bz) {
+    for (std::int64_t bx = i0 >> kLeafShift; bx <= (i1 >> kLeafShift); ++bx) {
+      const Range& range = leaf.nodes[std::size_t(bx) + std::size_t(bz) * leaf.nx];
+      if (double(range.max) < ylo || double(range.min) > yhi) continue;
+      const std::int64_t ci_end = std::min(i1, ((bx + 1) << kLeafShift) - 1);
+      const std::int64_t cj_end = std::min(j1, ((bz + 1) << kLeafShift) - 1);
+      for (std::int64_t cj = std::max(j0, bz << kLeafShift); cj <= cj_end; ++cj) {
+        for (std::int64_t ci = std::max(i0, bx << kLeafShift); ci <= ci_end; ++ci) {
+          const auto i = static_cast<std::uint32_t>(ci), j = static_cast<std::uint32_t>(cj);
+          // The box in this cell's fractional coordinates.
+          const double bu0 = ua - double(ci), bu1 = ub - double(ci);
+          const double bv0 = va - double(cj), bv1 = vb - double(cj);
+          for (int which = 0; which < 2; ++which) {
+            const CellTriangle t = detail::cell_triangle(ci, cj, which);
+            float h[3];
+            for (int k = 0; k < 3; ++k) h[k] = hf.local(i + t.di[k], j + t.dj[k]);
+            const double hmin = std::min({h[0], h[1], h[2]}), hmax = std::max({h[0], h[1], h[2]});
+            if (hmax < ylo || hmin > yhi) continue;
+            // Separating axes: the box's axes hold (the cell overlaps the box and the triangle
+            // spans the cell); test the triangle's edge normals.
+            bool separated = false;
+            for (int e = 0; e < 3 && !separated; ++e) {
+              const int a = e, b = (e + 1) % 3, c = (e + 2) % 3;
+              // Normal of edge a-b, turned towards the opposite corner c.
+              double nx = -(double(t.dj[b]) - t.dj[a]), nz = double(t.di[b]) - t.di[a];
+              if (nx * (t.di[c] - t.di[a]) + nz * (t.dj[c] - t.dj[a]) < 0) nx = -nx, nz = -nz;
+              // Separated when even the box corner furthest along the normal lies strictly
+              // behind the edge.
+              const double box_max = nx * (nx >= 0 ? bu1 : bu0) + nz * (nz >= 0 ? bv1 : bv0);
+              separated = box_max < nx * t.di[a] + nz * t.dj[a];
+            }
+            if (separated) continue;
+            if (max_triangles != 0 && added == max_triangles) return added;
+            SurfaceTriangle st;
+            for (int k = 0; k < 3; ++k)
+              st.v[k] = {hf.origin_x() + double(ci + t.di[k]) * sx,
+                         hf.height_offset() + double(h[k]),
+                         hf.origin_z() + double(cj + t.dj[k]) * sz};
+            st.material = hf.material(i, j);
+            out.push_back(st);
+            ++added;
+          }
+        }
+      }
+    }
+  }
+  return added;
 }
 
 std::optional<RayHit> Terrain::raycast(const glm::dvec3& origin, const glm::dvec3& direction,
@@ -15,9 +383,9 @@ std::optional<RayHit> Terrain::raycast(const glm::dvec3& origin, const glm::dvec
   return rays_->raycast(heightfield_, origin, direction, max_distance);
 }
 
-std::size_t Terrain::triangles_in_box(const Box&, std::vector<SurfaceTriangle>&,
-                                      std::size_t) const {
-  return 0;
+std::size_t Terrain::triangles_in_box(const Box& box, std::vector<SurfaceTriangle>& out,
+                                      std::size_t max_triangles) const {
+  return rays_->triangles_in_box(heightfield_, box, out, max_triangles);
 }
 
 }  // namespace ridgeline

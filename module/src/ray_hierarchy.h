@@ -1,26 +1,114 @@
-// Private: the max-height pyramid that raycasts descend (see ray_hierarchy.cpp).
+// Private: the min/max-height pyramid that raycasts descend and box queries cull with, and the
+// exact per-cell surface evaluation they share (see ray_hierarchy.cpp).
 #pragma once
 
+#include <cmath>
 #include <cstddef>
+#include <cstdint>
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
 #include <optional>
 #include <vector>
 
-#include <glm/vec3.hpp>
-
 #include "ridgeline/heightfield.h"
+#include "ridgeline/surface.h"
 #include "ridgeline/terrain.h"
+#include "surface_eval.h"
 
 namespace ridgeline {
 
+namespace detail {
+
+/// Height (metres, relative to the heightfield's offset) of the plane of lattice triangle `t` of
+/// cell (i, j) at fractional position (fu, fv) of the cell, in double precision. (fu, fv) may lie
+/// slightly outside the triangle: the plane is extrapolated. The plane is derived from the
+/// triangle's corners as locate_in_cell() gives them, so the diagonal rule lives in surface.h only.
+struct CellPlane {
+  double h0;   ///< height at the first corner
+  double c0u;  ///< first corner, cell fractions
+  double c0v;
+  double gu, gv;  ///< height gradient per cell fraction along u (x) and v (z)
+  double at(double fu, double fv) const noexcept { return h0 + gu * (fu - c0u) + gv * (fv - c0v); }
+};
+
+inline CellPlane cell_plane(const Heightfield& hf, std::uint32_t i, std::uint32_t j,
+                            const CellTriangle& t) noexcept {
+  const double h0 = hf.local(i + t.di[0], j + t.dj[0]);
+  const double h1 = hf.local(i + t.di[1], j + t.dj[1]);
+  const double h2 = hf.local(i + t.di[2], j + t.dj[2]);
+  const double e1u = double(t.di[1]) - t.di[0], e1v = double(t.dj[1]) - t.dj[0];
+  const double e2u = double(t.di[2]) - t.di[0], e2v = double(t.dj[2]) - t.dj[0];
+  // The corners of a lattice triangle span a unit-area parallelogram: det is +-1.
+  const double det = e1u * e2v - e1v * e2u;
+  const double gu = ((h1 - h0) * e2v - (h2 - h0) * e1v) / det;
+  const double gv = ((h2 - h0) * e1u - (h1 - h0) * e2u) / det;
+  return {h0, double(t.di[0]), double(t.dj[0]), gu, gv};
+}
+
+/// v / |v|. Unlike glm::normalize (v * inversesqrt), a vector along an axis comes out exactly
+/// unit (sqrt(c * c) == |c| in IEEE arithmetic): a flat field's normal is exactly (0, 1, 0).
+template <class V>
+inline V unit(const V& v) noexcept {
+  return v / std::sqrt(glm::dot(v, v));
+}
+
+/// Unit upward face normal of lattice triangle `t` of cell (i, j).
+inline glm::vec3 face_normal(const Heightfield& hf, std::uint32_t i, std::uint32_t j,
+                             const CellTriangle& t) noexcept {
+  return glm::vec3(unit(cell_triangle_cross(hf, i, j, t)));
+}
+
+/// Triangle `which` (0 or 1, as CellTriangle::which) of cell (i, j), located through
+/// locate_in_cell() at a point strictly inside it.
+inline CellTriangle cell_triangle(std::int64_t i, std::int64_t j, int which) noexcept {
+  // Probe points: one inside each triangle for either diagonal, tried in turn.
+  constexpr float kProbe[4][2] = {{0.75f, 0.25f}, {0.25f, 0.75f}, {0.25f, 0.25f}, {0.75f, 0.75f}};
+  CellTriangle t = locate_in_cell(i, j, kProbe[0][0], kProbe[0][1]);
+  for (int k = 1; k < 4 && t.which != which; ++k)
+    t = locate_in_cell(i, j, kProbe[k][0], kProbe[k][1]);
+  return t;
+}
+
+}  // namespace detail
+
+/// Min/max pyramid over the heightfield. Level 0 holds one node per block of kLeafCells x
+/// kLeafCells cells (the block's samples including its borders); each level above halves the node
+/// count per axis, up to a single root. Immutable after construction; const calls are thread-safe.
 class RayHierarchy {
  public:
+  static constexpr std::uint32_t kLeafShift = 2;  ///< log2 of the leaf block size in cells
+  static constexpr std::uint32_t kLeafCells = 1u << kLeafShift;
+
   explicit RayHierarchy(const Heightfield& hf);
+
+  /// Bytes held by the pyramid.
   std::size_t memory_bytes() const noexcept;
+
+  /// See Terrain::raycast.
   std::optional<RayHit> raycast(const Heightfield& hf, const glm::dvec3& origin,
                                 const glm::dvec3& direction, double max_distance) const noexcept;
 
+  /// See Terrain::triangles_in_box.
+  std::size_t triangles_in_box(const Heightfield& hf, const Box& box,
+                               std::vector<SurfaceTriangle>& out, std::size_t max_triangles) const;
+
+  /// Number of levels (level 0 = leaf blocks).
+  std::size_t levels() const noexcept { return levels_.size(); }
+
  private:
-  std::vector<std::vector<float>> levels_;
+  struct Range {
+    float min, max;  ///< local heights (relative to the heightfield offset), metres
+  };
+  struct Level {
+    std::uint32_t nx = 0, nz = 0;  ///< nodes per axis
+    std::vector<Range> nodes;      ///< row-major, index = x + z * nx
+  };
+  struct Ray;
+
+  bool leaf_hit(const Heightfield& hf, const Ray& ray, std::uint32_t bx, std::uint32_t bz,
+                double ta, double tb, RayHit& hit) const noexcept;
+
+  std::vector<Level> levels_;
 };
 
 }  // namespace ridgeline

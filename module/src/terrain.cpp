@@ -64,7 +64,7 @@ std::optional<double> Terrain::height(double x, double z) const noexcept {
 std::optional<glm::vec3> Terrain::face_normal(double x, double z) const noexcept {
   Located p;
   if (!locate(heightfield_, inv_spacing_x_, inv_spacing_z_, x, z, p)) return std::nullopt;
-  return glm::vec3(glm::normalize(detail::cell_triangle_cross(heightfield_, p.i, p.j, p.tri)));
+  return detail::face_normal(heightfield_, p.i, p.j, p.tri);
 }
 
 std::optional<glm::vec3> Terrain::smooth_normal(double x, double z) const noexcept {
@@ -73,7 +73,17 @@ std::optional<glm::vec3> Terrain::smooth_normal(double x, double z) const noexce
   glm::vec3 n(0.0f);
   for (int k = 0; k < 3; ++k)
     n += p.tri.w[k] * detail::vertex_normal(heightfield_, p.i + p.tri.di[k], p.j + p.tri.dj[k]);
-  return glm::normalize(n);
+  return detail::unit(n);
+}
+
+std::optional<HeightNormal> Terrain::height_normal(double x, double z) const noexcept {
+  Located p;
+  if (!locate(heightfield_, inv_spacing_x_, inv_spacing_z_, x, z, p)) return std::nullopt;
+  HeightNormal s;
+  s.height = heightfield_.height_offset() + double(local_height(heightfield_, p));
+  s.face_normal = detail::face_normal(heightfield_, p.i, p.j, p.tri);
+  s.material = heightfield_.material(p.i, p.j);
+  return s;
 }
 
 std::optional<SurfaceSample> Terrain::sample(double x, double z) const noexcept {
@@ -81,12 +91,11 @@ std::optional<SurfaceSample> Terrain::sample(double x, double z) const noexcept 
   if (!locate(heightfield_, inv_spacing_x_, inv_spacing_z_, x, z, p)) return std::nullopt;
   SurfaceSample s;
   s.height = heightfield_.height_offset() + double(local_height(heightfield_, p));
-  s.face_normal =
-      glm::vec3(glm::normalize(detail::cell_triangle_cross(heightfield_, p.i, p.j, p.tri)));
+  s.face_normal = detail::face_normal(heightfield_, p.i, p.j, p.tri);
   glm::vec3 n(0.0f);
   for (int k = 0; k < 3; ++k)
     n += p.tri.w[k] * detail::vertex_normal(heightfield_, p.i + p.tri.di[k], p.j + p.tri.dj[k]);
-  s.smooth_normal = glm::normalize(n);
+  s.smooth_normal = detail::unit(n);
   s.material = heightfield_.material(p.i, p.j);
   return s;
 }
@@ -113,6 +122,10 @@ void Terrain::samples(std::span<const glm::dvec2> xz, std::span<SurfaceSample> o
 
 std::size_t Terrain::memory_bytes() const noexcept {
   return sizeof(*this) + heightfield_.memory_bytes() + rays_->memory_bytes();
+}
+
+std::size_t Terrain::ray_hierarchy_bytes() const noexcept {
+  return rays_->memory_bytes();
 }
 
 }  // namespace ridgeline

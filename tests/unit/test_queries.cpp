@@ -1,9 +1,254 @@
-// Queries on the surface (being extended).
+// Queries on the surface: analytic cases, the diagonal rule, hard points (vertices, edges,
+// diagonals, seams, far edge, off-terrain, non-finite input), cliffs, flat fields, precision far
+// from the origin, smooth normals against a hand computation, batched == single, raycasts against
+// an independent brute-force reference (10^5 random rays plus every special case), triangles in a
+// box against brute force, and the full-detail triangulation's topology.
+//
+// The reference code in this file derives the triangulation from SPEC.md's wording ("cell (i, j)
+// is split along (i, j)-(i+1, j+1) when i + j is even, along (i+1, j)-(i, j+1) when it is odd") on
+// its own; it does not call surface.h, so a mistake there cannot hide itself.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <functional>
+#include <glm/geometric.hpp>
+#include <limits>
+#include <map>
+#include <random>
+#include <set>
+#include <thread>
+#include <tuple>
+#include <vector>
+
+#include "ridgeline/surface.h"
 #include "ridgeline/terrain.h"
 
 using namespace ridgeline;
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+struct FieldSpec {
+  std::uint32_t w = 5, h = 5;
+  double sx = 1, sz = 1, ox = 0, oz = 0, offset = 0;
+};
+
+std::shared_ptr<const Terrain> make_terrain(const FieldSpec& s,
+                                            const std::function<double(int, int)>& f,
+                                            std::vector<std::uint8_t> materials = {}) {
+  HeightfieldDesc d;
+  d.width = s.w;
+  d.height = s.h;
+  d.spacing_x = s.sx;
+  d.spacing_z = s.sz;
+  d.origin_x = s.ox;
+  d.origin_z = s.oz;
+  d.height_offset = s.offset;
+  d.name = "test";
+  std::vector<float> v(std::size_t{s.w} * s.h);
+  for (std::uint32_t j = 0; j < s.h; ++j)
+    for (std::uint32_t i = 0; i < s.w; ++i) v[i + j * s.w] = float(f(int(i), int(j)));
+  auto hf = Heightfield::create(d, v, materials);
+  EXPECT_TRUE(hf) << (hf ? "" : hf.error().message);
+  return Terrain::create(std::move(hf).value());
+}
+
+// ---- An independent reference surface ------------------------------------------------------
+
+// One full-detail triangle in local coordinates: x, z in metres from sample (0, 0), y in metres
+// above the height offset.
+struct RefTri {
+  glm::dvec3 p[3];
+  int i, j;
+};
+
+// The two triangles of cell (i, j), straight from SPEC.md's wording.
+std::array<std::array<int, 6>, 2> spec_cell_corners(int i, int j) {
+  if ((i + j) % 2 == 0)                                 // split along (i, j)-(i+1, j+1)
+    return {{{0, 0, 1, 1, 1, 0}, {0, 0, 0, 1, 1, 1}}};  // (di, dj) pairs
+  // split along (i+1, j)-(i, j+1)
+  return {{{0, 0, 0, 1, 1, 0}, {1, 0, 0, 1, 1, 1}}};
+}
+
+struct Reference {
+  const Heightfield* hf;
+  double shift = 0;  // the surface raised by this much (metres)
+
+  RefTri tri(int i, int j, int which) const {
+    const auto c = spec_cell_corners(i, j)[which];
+    RefTri t;
+    for (int k = 0; k < 3; ++k) {
+      const int vi = i + c[2 * k], vj = j + c[2 * k + 1];
+      t.p[k] = {vi * hf->spacing_x(), double(hf->local(vi, vj)) + shift, vj * hf->spacing_z()};
+    }
+    t.i = i;
+    t.j = j;
+    return t;
+  }
+  static glm::dvec3 up_normal(const RefTri& t) {
+    glm::dvec3 n = glm::cross(t.p[1] - t.p[0], t.p[2] - t.p[0]);
+    return n.y < 0 ? -n : n;
+  }
+  // Height at local (x, z) by locating the cell and the triangle with SPEC's rule, interpolating
+  // on the plane through its three corners.
+  double height(double x, double z) const {
+    const double u = x / hf->spacing_x(), v = z / hf->spacing_z();
+    int i = std::min(int(std::floor(u)), int(hf->width()) - 2);
+    int j = std::min(int(std::floor(v)), int(hf->height()) - 2);
+    i = std::max(i, 0);
+    j = std::max(j, 0);
+    const double fu = u - i, fv = v - j;
+    int which;
+    if ((i + j) % 2 == 0)
+      which = fu >= fv ? 0 : 1;
+    else
+      which = fu + fv <= 1 ? 0 : 1;
+    const RefTri t = tri(i, j, which);
+    const glm::dvec3 n = up_normal(t);
+    return t.p[0].y - (n.x * (x - t.p[0].x) + n.z * (z - t.p[0].z)) / n.y;
+  }
+
+  // First t in [0, max_distance] where the ray is over the footprint and at or below the
+  // surface; +inf when none. `o` is local, `d` unit.
+  double raycast(glm::dvec3 o, glm::dvec3 d, double max_distance) const {
+    const double ex = hf->extent_x(), ez = hf->extent_z();
+    double t0 = 0, t1 = max_distance;
+    auto clip = [&](double p, double dp, double lo, double hi) {
+      if (dp == 0) return p >= lo && p <= hi;
+      double a = (lo - p) / dp, b = (hi - p) / dp;
+      if (a > b) std::swap(a, b);
+      t0 = std::max(t0, a);
+      t1 = std::min(t1, b);
+      return t0 <= t1;
+    };
+    if (!clip(o.x, d.x, 0, ex) || !clip(o.z, d.z, 0, ez)) return kInf;
+    const glm::dvec3 pe = o + d * t0;
+    if (pe.y <= height(std::clamp(pe.x, 0.0, ex), std::clamp(pe.z, 0.0, ez))) return t0;
+    double best = kInf;
+    for_each_candidate(o, d, t0, t1, [&](const RefTri& t) {
+      best = std::min(best, ray_triangle(t, o, d, t0, t1));
+    });
+    return best;
+  }
+
+  // Every triangle of every cell whose row the segment [t0, t1] crosses and whose column range
+  // in that row (widened by a cell each way) holds the segment: conservative by construction.
+  template <class F>
+  void for_each_candidate(glm::dvec3 o, glm::dvec3 d, double t0, double t1, F&& f) const {
+    const double sx = hf->spacing_x(), sz = hf->spacing_z();
+    const int cw = int(hf->width()) - 1, ch = int(hf->height()) - 1;
+    for (int j = 0; j < ch; ++j) {
+      double a = t0, b = t1;
+      if (d.z == 0) {
+        if (o.z < j * sz - 1e-9 || o.z > (j + 1) * sz + 1e-9) continue;
+      } else {
+        double ta = (j * sz - 1e-9 - o.z) / d.z, tb = ((j + 1) * sz + 1e-9 - o.z) / d.z;
+        if (ta > tb) std::swap(ta, tb);
+        a = std::max(a, ta);
+        b = std::min(b, tb);
+        if (a > b) continue;
+      }
+      const double xa = o.x + d.x * a, xb = o.x + d.x * b;
+      const int i0 = std::max(0, int(std::floor(std::min(xa, xb) / sx)) - 1);
+      const int i1 = std::min(cw - 1, int(std::floor(std::max(xa, xb) / sx)) + 1);
+      for (int i = i0; i <= i1; ++i)
+        for (int which = 0; which < 2; ++which) f(tri(i, j, which));
+    }
+  }
+
+  // Part [a, b] of [t0, t1] where the ray's xz lies in the triangle's footprint (closed, widened
+  // by 1e-9 m). False when empty.
+  static bool clip_to_footprint(const RefTri& t, glm::dvec3 o, glm::dvec3 d, double t0, double t1,
+                                double& a, double& b) {
+    a = t0;
+    b = t1;
+    for (int e = 0; e < 3; ++e) {
+      const glm::dvec3 p = t.p[e], q = t.p[(e + 1) % 3], r = t.p[(e + 2) % 3];
+      glm::dvec2 n(-(q.z - p.z), q.x - p.x);  // edge normal, turned inwards below
+      if (n.x * (r.x - p.x) + n.y * (r.z - p.z) < 0) n = -n;
+      n /= glm::length(n);
+      // inside: n . (o + d t - p) >= -1e-9
+      const double c0 = n.x * (o.x - p.x) + n.y * (o.z - p.z) + 1e-9;
+      const double c1 = n.x * d.x + n.y * d.z;
+      if (c1 == 0) {
+        if (c0 < 0) return false;
+      } else if (c1 > 0) {
+        a = std::max(a, -c0 / c1);
+      } else {
+        b = std::min(b, -c0 / c1);
+      }
+    }
+    return a <= b;
+  }
+
+  static double ray_triangle(const RefTri& t, glm::dvec3 o, glm::dvec3 d, double t0, double t1) {
+    double a, b;
+    if (!clip_to_footprint(t, o, d, t0, t1, a, b)) return kInf;
+    const glm::dvec3 n = up_normal(t);
+    auto f = [&](double s) { return glm::dot(n, o + d * s - t.p[0]) / n.y; };
+    const double fa = f(a), fb = f(b);
+    if (fa <= 0) return a;
+    if (fb <= 0) return a + (b - a) * fa / (fa - fb);
+    return kInf;
+  }
+
+  // Unit up normals of the triangles whose footprint (widened by `slack` metres) holds local
+  // (x, z).
+  std::vector<glm::dvec3> normals_at(double x, double z, double slack) const {
+    std::vector<glm::dvec3> out;
+    const int cw = int(hf->width()) - 1, ch = int(hf->height()) - 1;
+    const int i0 = std::max(0, int(std::floor(x / hf->spacing_x())) - 1);
+    const int j0 = std::max(0, int(std::floor(z / hf->spacing_z())) - 1);
+    for (int j = j0; j <= std::min(ch - 1, j0 + 2); ++j)
+      for (int i = i0; i <= std::min(cw - 1, i0 + 2); ++i)
+        for (int w = 0; w < 2; ++w) {
+          const RefTri t = tri(i, j, w);
+          double a, b;
+          // A zero-length "ray" at (x, z): inside when the clip leaves [0, 0] non-empty.
+          RefTri wide = t;
+          (void)wide;
+          bool inside = true;
+          for (int e = 0; e < 3 && inside; ++e) {
+            const glm::dvec3 p = t.p[e], q = t.p[(e + 1) % 3], r = t.p[(e + 2) % 3];
+            glm::dvec2 n(-(q.z - p.z), q.x - p.x);
+            if (n.x * (r.x - p.x) + n.y * (r.z - p.z) < 0) n = -n;
+            n /= glm::length(n);
+            inside = n.x * (x - p.x) + n.y * (z - p.z) >= -slack;
+          }
+          (void)a;
+          (void)b;
+          if (inside) out.push_back(glm::normalize(up_normal(t)));
+        }
+    return out;
+  }
+};
+
+glm::dvec3 local_of(const Heightfield& hf, glm::dvec3 w) {
+  return {w.x - hf.origin_x(), w.y - hf.height_offset(), w.z - hf.origin_z()};
+}
+
+// A rough, deterministic field with flat patches, steps and smooth parts.
+double rough(int i, int j) {
+  std::uint32_t h = std::uint32_t(i) * 374761393u + std::uint32_t(j) * 668265263u;
+  h = (h ^ (h >> 13)) * 1274126177u;
+  const double r = double((h ^ (h >> 16)) & 0xffff) / 65535.0;
+  double v = 6 * std::sin(i * 0.21) * std::cos(j * 0.17) + 3 * r;
+  if (i > 40 && j > 40) v = 2.0;   // flat patch
+  if (i == 20) v += 4.0;           // a wall along a column
+  return std::round(v * 64) / 64;  // exactly representable heights
+}
+
+bool near_vec(glm::vec3 a, glm::dvec3 b, double tol) {
+  return std::abs(a.x - b.x) <= tol && std::abs(a.y - b.y) <= tol && std::abs(a.z - b.z) <= tol;
+}
+
+}  // namespace
+
+// ---- Analytic cases ---------------------------------------------------------------------------
 
 TEST(Queries, PlaneHeight) {
   HeightfieldDesc d;
@@ -14,4 +259,914 @@ TEST(Queries, PlaneHeight) {
   auto t = Terrain::create(std::move(Heightfield::create(d, v)).value());
   EXPECT_NEAR(*t->height(1.25, 2.5), 2 * 1.25 + 3 * 2.5, 1e-5);
   EXPECT_FALSE(t->height(-0.1, 1.0));
+}
+
+TEST(Queries, PlaneExactHeightAndNormals) {
+  // h = 1 + 0.5 x - 0.25 z on non-square cells.
+  FieldSpec s{9, 7, 2.0, 0.5, 10.0, -4.0, 0.0};
+  auto t = make_terrain(s, [&](int i, int j) { return 1 + 0.5 * (i * 2.0) - 0.25 * (j * 0.5); });
+  const glm::dvec3 n = glm::normalize(glm::dvec3(-0.5, 1, 0.25));
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> ux(10.0, 26.0), uz(-4.0, -1.0);
+  for (int k = 0; k < 2000; ++k) {
+    const double x = ux(rng), z = uz(rng);
+    const double expect = 1 + 0.5 * (x - 10.0) - 0.25 * (z + 4.0);
+    ASSERT_NEAR(*t->height(x, z), expect, 1e-5);
+    ASSERT_TRUE(near_vec(*t->face_normal(x, z), n, 1e-6));
+    ASSERT_TRUE(near_vec(*t->smooth_normal(x, z), n, 1e-6));
+    const auto s1 = *t->sample(x, z);
+    ASSERT_NEAR(s1.height, expect, 1e-5);
+    const auto hn = *t->height_normal(x, z);
+    ASSERT_NEAR(hn.height, expect, 1e-5);
+    ASSERT_TRUE(near_vec(hn.face_normal, n, 1e-6));
+  }
+}
+
+TEST(Queries, Bowl) {
+  // h = (x - 8)^2 + (z - 8)^2 sampled at integers: exact at samples, the interpolant lies above
+  // the convex bowl by at most (sx^2 + sz^2) / 2 (curvature 2), normals tilt towards the centre.
+  FieldSpec s{17, 17};
+  auto bowl = [](double x, double z) { return (x - 8) * (x - 8) + (z - 8) * (z - 8); };
+  auto t = make_terrain(s, [&](int i, int j) { return bowl(i, j); });
+  for (int j = 0; j < 17; ++j)
+    for (int i = 0; i < 17; ++i) ASSERT_EQ(*t->height(i, j), bowl(i, j));
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> u(0.0, 16.0);
+  for (int k = 0; k < 2000; ++k) {
+    const double x = u(rng), z = u(rng);
+    const double h = *t->height(x, z);
+    ASSERT_GE(h, bowl(x, z) - 1e-4);
+    ASSERT_LE(h, bowl(x, z) + 1.0 + 1e-4);
+    const glm::vec3 n = *t->smooth_normal(x, z);
+    if (std::abs(x - 8) > 1.5) {
+      ASSERT_EQ(n.x > 0, x < 8) << x << " " << z;
+    }
+  }
+  EXPECT_TRUE(near_vec(*t->smooth_normal(8, 8), glm::dvec3(0, 1, 0), 1e-6));
+}
+
+// ---- The diagonal rule ------------------------------------------------------------------------
+
+TEST(Queries, DiagonalRuleSeenThroughARaisedVertex) {
+  // Raise corner (i+1, j) of each cell in turn. At the cell's centre, a main diagonal
+  // (i, j)-(i+1, j+1) runs through two zero corners (height 0); the anti diagonal
+  // (i+1, j)-(i, j+1) runs through the raised corner (height 1/2).
+  FieldSpec s{7, 6, 1.5, 0.75, -3.0, 2.0};
+  for (int j = 0; j + 1 < 6; ++j) {
+    for (int i = 0; i + 1 < 7; ++i) {
+      auto t = make_terrain(s, [&](int a, int b) { return (a == i + 1 && b == j) ? 1.0 : 0.0; });
+      const bool spec_main = (i + j) % 2 == 0;
+      const double cx = s.ox + (i + 0.5) * s.sx, cz = s.oz + (j + 0.5) * s.sz;
+      EXPECT_NEAR(*t->height(cx, cz), spec_main ? 0.0 : 0.5, 1e-6) << i << "," << j;
+      EXPECT_EQ(cell_has_main_diagonal(i, j), spec_main);
+      // On the other diagonal's line, (0.75, 0.25) from corner (i, j): with the main diagonal
+      // the triangle (i,j),(i+1,j+1),(i+1,j) holds it with weight 1/2 on (i+1, j); with the anti
+      // diagonal it lies on that diagonal, 3/4 of the way to (i+1, j).
+      EXPECT_NEAR(*t->height(s.ox + (i + 0.75) * s.sx, s.oz + (j + 0.25) * s.sz),
+                  spec_main ? 0.5 : 0.75, 1e-6);
+      // (0.25, 0.75): the main diagonal's other triangle does not hold (i+1, j) at all; on the
+      // anti diagonal the weight of (i+1, j) is 1/4.
+      EXPECT_NEAR(*t->height(s.ox + (i + 0.25) * s.sx, s.oz + (j + 0.75) * s.sz),
+                  spec_main ? 0.0 : 0.25, 1e-6);
+    }
+  }
+}
+
+TEST(Queries, LocateInCellMatchesSpecTriangles) {
+  // Both triangles of every cell parity, against the SPEC corners, and counter-clockwise.
+  for (int j = 0; j < 2; ++j) {
+    for (int i = 0; i < 2; ++i) {
+      std::set<std::vector<int>> from_locate, from_spec;
+      for (float fu : {0.1f, 0.9f, 0.4f})
+        for (float fv : {0.1f, 0.9f, 0.6f}) {
+          const CellTriangle t = locate_in_cell(i, j, fu, fv);
+          std::vector<int> c;
+          for (int k = 0; k < 3; ++k) c.push_back(t.di[k] * 2 + t.dj[k]);
+          // CCW seen from above with x right and z down the page, as surface.h says: the y of
+          // (p1 - p0) x (p2 - p0) is positive for a flat triangle lifted to y = 0.
+          const glm::dvec3 p0(t.di[0], 0, t.dj[0]), p1(t.di[1], 0, t.dj[1]),
+              p2(t.di[2], 0, t.dj[2]);
+          EXPECT_GT(glm::cross(p1 - p0, p2 - p0).y, 0);
+          // Barycentric weights reproduce the point.
+          float su = 0, sv = 0, sw = 0;
+          for (int k = 0; k < 3; ++k) su += t.w[k] * t.di[k], sv += t.w[k] * t.dj[k], sw += t.w[k];
+          EXPECT_NEAR(su, fu, 1e-6);
+          EXPECT_NEAR(sv, fv, 1e-6);
+          EXPECT_NEAR(sw, 1.0f, 1e-6);
+          for (int k = 0; k < 3; ++k) EXPECT_GE(t.w[k], -1e-6);
+          std::sort(c.begin(), c.end());
+          from_locate.insert(c);
+        }
+      for (const auto& sc : spec_cell_corners(i, j)) {
+        std::vector<int> c;
+        for (int k = 0; k < 3; ++k) c.push_back(sc[2 * k] * 2 + sc[2 * k + 1]);
+        std::sort(c.begin(), c.end());
+        from_spec.insert(c);
+      }
+      EXPECT_EQ(from_locate, from_spec) << i << "," << j;
+    }
+  }
+}
+
+// ---- Hard points ------------------------------------------------------------------------------
+
+TEST(Queries, VerticesEdgesDiagonalsAndSeams) {
+  FieldSpec s{13, 11, 1.25, 0.5, 100.0, 200.0, 0.0};
+  auto t = make_terrain(s, rough);
+  const Heightfield& hf = t->heightfield();
+  auto X = [&](double u) { return s.ox + u * s.sx; };
+  auto Z = [&](double v) { return s.oz + v * s.sz; };
+  for (int j = 0; j < 11; ++j)
+    for (int i = 0; i < 13; ++i) EXPECT_EQ(*t->height(X(i), Z(j)), hf.world(i, j));
+  for (int j = 0; j + 1 < 11; ++j) {
+    for (int i = 0; i + 1 < 13; ++i) {
+      const double a = hf.world(i, j), b = hf.world(i + 1, j), c = hf.world(i, j + 1),
+                   d = hf.world(i + 1, j + 1);
+      for (double f : {0.25, 0.5, 0.8}) {
+        // Cell edges: linear between their endpoints.
+        EXPECT_NEAR(*t->height(X(i + f), Z(j)), a + f * (b - a), 1e-5);
+        EXPECT_NEAR(*t->height(X(i), Z(j + f)), a + f * (c - a), 1e-5);
+        // The diagonal: linear between its endpoints.
+        if ((i + j) % 2 == 0)
+          EXPECT_NEAR(*t->height(X(i + f), Z(j + f)), a + f * (d - a), 1e-5);
+        else
+          EXPECT_NEAR(*t->height(X(i + 1 - f), Z(j + f)), b + f * (c - b), 1e-5);
+        // Seams: both sides of an edge agree in the limit.
+        const double e = 1e-9;
+        EXPECT_NEAR(*t->height(X(i + f), Z(j) - e * (j > 0)), *t->height(X(i + f), Z(j) + e), 1e-5);
+        EXPECT_NEAR(*t->height(X(i) - e * (i > 0), Z(j + f)), *t->height(X(i) + e, Z(j + f)), 1e-5);
+      }
+    }
+  }
+}
+
+TEST(Queries, FarEdgeIsOnTerrainAndOutsideIsEmpty) {
+  FieldSpec s{6, 4, 2.0, 3.0, 1e6, -1e6, 5.0};
+  auto t = make_terrain(s, rough);
+  const Heightfield& hf = t->heightfield();
+  const double x1 = s.ox + hf.extent_x(), z1 = s.oz + hf.extent_z();
+  EXPECT_EQ(*t->height(x1, z1), hf.world(5, 3));
+  EXPECT_EQ(*t->height(s.ox, s.oz), hf.world(0, 0));
+  EXPECT_TRUE(t->face_normal(x1, z1));
+  EXPECT_TRUE(t->smooth_normal(x1, s.oz));
+  EXPECT_TRUE(t->sample(s.ox, z1));
+  const double bad[][2] = {{x1 + 1e-6, z1},     {x1, z1 + 1e-6}, {s.ox - 1e-6, s.oz},
+                           {s.ox, s.oz - 1e-6}, {kNaN, s.oz},    {s.ox, kNaN},
+                           {kInf, s.oz},        {-kInf, s.oz},   {s.ox, kInf},
+                           {1e308, 1e308},      {-1e308, -1e308}};
+  for (const auto& p : bad) {
+    EXPECT_FALSE(t->height(p[0], p[1])) << p[0] << "," << p[1];
+    EXPECT_FALSE(t->face_normal(p[0], p[1]));
+    EXPECT_FALSE(t->smooth_normal(p[0], p[1]));
+    EXPECT_FALSE(t->sample(p[0], p[1]));
+    EXPECT_FALSE(t->height_normal(p[0], p[1]));
+  }
+}
+
+TEST(Queries, ThousandMetreCliff) {
+  // Samples jump by 1,000 m between columns 3 and 4 (and rows 2 and 3) on 1 m cells.
+  FieldSpec s{9, 8};
+  auto t =
+      make_terrain(s, [](int i, int j) { return (i >= 4 ? 1000.0 : 0.0) + (j >= 3) * 1000.0; });
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> ux(0.0, 8.0), uz(0.0, 7.0);
+  for (int k = 0; k < 5000; ++k) {
+    const double x = k < 100 ? 3.0 + k / 100.0 : ux(rng), z = uz(rng);
+    for (const glm::vec3 n : {*t->face_normal(x, z), *t->smooth_normal(x, z)}) {
+      ASSERT_TRUE(std::isfinite(n.x) && std::isfinite(n.y) && std::isfinite(n.z));
+      ASSERT_NEAR(glm::length(n), 1.0f, 1e-6f);
+      ASSERT_GT(n.y, 0.0f);
+    }
+  }
+  // The face of the cliff (cell 3, row 0): slope 1000 along x.
+  const glm::dvec3 face = glm::normalize(glm::dvec3(-1000, 1, 0));
+  EXPECT_TRUE(near_vec(*t->face_normal(3.6, 0.3), face, 1e-6));
+  // A horizontal ray into the cliff hits its face.
+  auto hit = t->raycast({0.5, 500.0, 0.25}, {1, 0, 0}, kInf);
+  ASSERT_TRUE(hit);
+  EXPECT_NEAR(hit->distance, 3.5 - 0.5, 1e-9);
+  EXPECT_FALSE(hit->started_below);
+  EXPECT_NEAR(glm::length(hit->normal), 1.0f, 1e-6f);
+}
+
+TEST(Queries, PerfectlyFlatFieldNormalIsExactlyUp) {
+  for (double level : {0.0, 123.456, -7.0}) {
+    FieldSpec s{11, 9, 0.3, 7.0, 1e7, -1e7, 1000.0};
+    auto t = make_terrain(s, [&](int, int) { return level; });
+    std::mt19937 rng(6);
+    std::uniform_real_distribution<double> ux(s.ox, s.ox + 3.0), uz(s.oz, s.oz + 56.0);
+    for (int k = 0; k < 500; ++k) {
+      const double x = ux(rng), z = uz(rng);
+      EXPECT_EQ(*t->face_normal(x, z), glm::vec3(0, 1, 0));
+      EXPECT_EQ(*t->smooth_normal(x, z), glm::vec3(0, 1, 0));
+      EXPECT_EQ(t->height_normal(x, z)->face_normal, glm::vec3(0, 1, 0));
+      EXPECT_NEAR(*t->height(x, z), 1000.0 + level, 1e-4);
+    }
+    auto hit = t->raycast({s.ox + 1.0, 2000.0, s.oz + 3.0}, {0.001, -1, 0.002}, kInf);
+    ASSERT_TRUE(hit);
+    EXPECT_EQ(hit->normal, glm::vec3(0, 1, 0));
+  }
+}
+
+TEST(Queries, SameTerrainFarFromOrigin) {
+  const FieldSpec base{33, 29, 1.5, 2.0, 0.0, 0.0, 0.0};
+  auto t0 = make_terrain(base, rough);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> ux(0.0, 48.0), uz(0.0, 56.0), ua(0.0, 6.283185307179586);
+  for (double far : {1e6, 1e7, -1e7}) {
+    FieldSpec s = base;
+    s.ox = far;
+    s.oz = -far * 0.5;
+    auto t1 = make_terrain(s, rough);
+    for (int k = 0; k < 2000; ++k) {
+      const double x = ux(rng), z = uz(rng);
+      const double h0 = *t0->height(x, z), h1 = *t1->height(s.ox + x, s.oz + z);
+      ASSERT_NEAR(h0, h1, 1e-3);
+      ASSERT_TRUE(
+          near_vec(*t1->face_normal(s.ox + x, s.oz + z), glm::dvec3(*t0->face_normal(x, z)), 1e-4));
+      ASSERT_TRUE(near_vec(*t1->smooth_normal(s.ox + x, s.oz + z),
+                           glm::dvec3(*t0->smooth_normal(x, z)), 1e-4));
+      // Rays too: a slanted ray from the same relative origin.
+      const double a = ua(rng);
+      const glm::dvec3 dir(std::cos(a), -0.4, std::sin(a));
+      auto r0 = t0->raycast({x, 20.0, z}, dir, kInf);
+      auto r1 = t1->raycast({s.ox + x, 20.0, s.oz + z}, dir, kInf);
+      ASSERT_EQ(bool(r0), bool(r1));
+      if (r0) {
+        ASSERT_NEAR(r0->distance, r1->distance, 1e-4 * std::max(1.0, r0->distance));
+        ASSERT_NEAR(r0->point.x + s.ox, r1->point.x, 1e-3);
+        ASSERT_NEAR(r0->point.y, r1->point.y, 1e-3);
+      }
+    }
+  }
+}
+
+TEST(Queries, SmoothNormalIsAreaWeightedVertexNormals) {
+  // 3 x 2 samples, spacing 1, h(1,1) = 2 and h(2,0) = 1, all else 0. Vertex (1, 0) is a corner of
+  // two triangles: A = (0,0)-(1,1)-(1,0) in cell (0,0) (main diagonal) and B = (1,0)-(1,1)-(2,0)
+  // in cell (1,0) (anti diagonal). By hand:
+  //   A: (1,2,1) x (1,0,0) = (0, 1, -2)      (|A| = sqrt 5, twice its area)
+  //   B: (0,2,1) x (1,1,0) = (-1, 1, -2)     (|B| = sqrt 6)
+  // Area-weighted: the sum (-1, 2, -4) / sqrt 21. (Equal weights would give a different vector.)
+  FieldSpec s{3, 2};
+  auto t = make_terrain(s, [](int i, int j) {
+    return (i == 1 && j == 1) ? 2.0 : (i == 2 && j == 0) ? 1.0 : 0.0;
+  });
+  const glm::dvec3 expect = glm::dvec3(-1, 2, -4) / std::sqrt(21.0);
+  EXPECT_TRUE(near_vec(*t->smooth_normal(1.0, 0.0), expect, 1e-6));
+  const glm::dvec3 equal_weights = glm::normalize(glm::dvec3(0, 1, -2) / std::sqrt(5.0) +
+                                                  glm::dvec3(-1, 1, -2) / std::sqrt(6.0));
+  EXPECT_FALSE(near_vec(*t->smooth_normal(1.0, 0.0), equal_weights, 1e-3));
+  // Vertex (0, 0): both triangles of cell (0, 0):
+  //   A = (0, 1, -2); C = (0,0,0),(0,0,1),(1,2,1): (0,0,1) x (1,2,1) = (-2, 1, 0). Sum (-2, 2, -2).
+  EXPECT_TRUE(near_vec(*t->smooth_normal(0.0, 0.0), glm::normalize(glm::dvec3(-1, 1, -1)), 1e-6));
+  // Inside triangle A: blend the three vertex normals barycentrically and normalise.
+  // Vertex (1,1): corner of C and A (cell 0,0) and of cell (1,0)'s triangles B and
+  //   D = (2,0),(1,1),(2,1) at heights 1, 2, 0: (1,1,1) - (2,1,0) = (-1, 1, 1) and
+  //   (2,0,1) - (2,1,0) = (0, -1, 1) -> (1*1 - 1*(-1), 1*0 - (-1)*1, (-1)(-1) - 1*0) = (2, 1, 1).
+  //   Sum A + C + B + D = (0,1,-2) + (-2,1,0) + (-1,1,-2) + (2,1,1) = (-1, 4, -3).
+  const glm::dvec3 n00 = glm::normalize(glm::dvec3(-1, 1, -1));
+  const glm::dvec3 n11 = glm::normalize(glm::dvec3(-1, 4, -3));
+  EXPECT_TRUE(near_vec(*t->smooth_normal(1.0, 1.0), n11, 1e-6));
+  // (0.75, 0.25) in A: weights 1/4 on (0,0), 1/4 on (1,1), 1/2 on (1,0).
+  const glm::dvec3 blend = glm::normalize(0.25 * n00 + 0.25 * n11 + 0.5 * expect);
+  EXPECT_TRUE(near_vec(*t->smooth_normal(0.75, 0.25), blend, 1e-6));
+  // And the face normal there is A's.
+  EXPECT_TRUE(near_vec(*t->face_normal(0.75, 0.25), glm::normalize(glm::dvec3(0, 1, -2)), 1e-6));
+}
+
+TEST(Queries, BatchedEqualsSingle) {
+  FieldSpec s{21, 17, 0.5, 1.5, -50.0, 30.0, 2.0};
+  std::vector<std::uint8_t> mats(20 * 16);
+  for (std::size_t k = 0; k < mats.size(); ++k) mats[k] = std::uint8_t(k % 5);
+  auto t = make_terrain(s, rough, mats);
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> ux(-52.0, -38.0), uz(28.0, 56.0);
+  std::vector<glm::dvec2> pts(3000);
+  for (auto& p : pts) p = {ux(rng), uz(rng)};
+  pts[0] = {kNaN, 30.0};
+  pts[1] = {-50.0, kInf};
+  pts[2] = {-40.0, 54.0};  // far corner
+  std::vector<double> hs(pts.size());
+  std::vector<SurfaceSample> ss(pts.size());
+  std::vector<std::uint8_t> valid(pts.size());
+  t->heights(pts, hs);
+  t->samples(pts, ss, valid);
+  int off = 0;
+  for (std::size_t k = 0; k < pts.size(); ++k) {
+    const auto h = t->height(pts[k].x, pts[k].y);
+    const auto sm = t->sample(pts[k].x, pts[k].y);
+    ASSERT_EQ(bool(h), !std::isnan(hs[k]));
+    ASSERT_EQ(bool(sm), bool(valid[k]));
+    off += !h;
+    if (!h) continue;
+    ASSERT_EQ(*h, hs[k]);
+    ASSERT_EQ(sm->height, ss[k].height);
+    ASSERT_EQ(sm->face_normal, ss[k].face_normal);
+    ASSERT_EQ(sm->smooth_normal, ss[k].smooth_normal);
+    ASSERT_EQ(sm->material, ss[k].material);
+    ASSERT_EQ(sm->height, *h);
+    ASSERT_EQ(sm->face_normal, *t->face_normal(pts[k].x, pts[k].y));
+    ASSERT_EQ(sm->smooth_normal, *t->smooth_normal(pts[k].x, pts[k].y));
+    const auto hn = *t->height_normal(pts[k].x, pts[k].y);
+    ASSERT_EQ(hn.height, *h);
+    ASSERT_EQ(hn.face_normal, sm->face_normal);
+    ASSERT_EQ(hn.material, sm->material);
+  }
+  EXPECT_GT(off, 2);
+  // Shorter outputs are not overrun.
+  std::vector<double> small(2);
+  t->heights(pts, small);
+  EXPECT_EQ(small[0] != small[0], true);
+}
+
+TEST(Queries, MaterialsComeFromTheCellUnderThePoint) {
+  FieldSpec s{4, 3};
+  std::vector<std::uint8_t> mats{1, 2, 3, 4, 5, 6};  // per cell, 3 x 2 cells
+  auto t = make_terrain(s, rough, mats);
+  EXPECT_EQ(t->sample(0.5, 0.5)->material, 1);
+  EXPECT_EQ(t->sample(2.5, 1.5)->material, 6);
+  EXPECT_EQ(t->sample(3.0, 2.0)->material, 6);  // far corner: the last cell
+  EXPECT_EQ(t->height_normal(1.5, 0.2)->material, 2);
+  auto hit = t->raycast({2.5, 100, 1.5}, {0, -1, 0}, kInf);
+  ASSERT_TRUE(hit);
+  EXPECT_EQ(hit->material, 6);
+}
+
+// ---- Raycasts ---------------------------------------------------------------------------------
+
+namespace {
+
+// Compares one ray with the reference. Returns false (with a message) on a disagreement that the
+// rules do not allow: distances must agree within 1e-4 relative unless the surface raised and
+// lowered by 1e-6 m gives different answers (the ray passes within 1e-6 m of the surface), in
+// which case the answer must lie between those two.
+struct RayCheck {
+  int hits = 0, misses = 0, ambiguous = 0, started_below = 0;
+};
+
+::testing::AssertionResult check_ray(const Terrain& t, glm::dvec3 o, glm::dvec3 dir, double maxd,
+                                     RayCheck& stats) {
+  const Heightfield& hf = t.heightfield();
+  const glm::dvec3 d = glm::normalize(dir);
+  const glm::dvec3 lo = local_of(hf, o);
+  const Reference exact{&hf, 0.0}, raised{&hf, 1e-6}, lowered{&hf, -1e-6};
+  const double tr = exact.raycast(lo, d, maxd);
+  const auto hit = t.raycast(o, dir, maxd);
+  const double ti = hit ? hit->distance : kInf;
+  auto same = [](double a, double b) {
+    return (std::isinf(a) && std::isinf(b)) || std::abs(a - b) <= 1e-4 * std::max(1.0, b);
+  };
+  if (!same(ti, tr)) {
+    const double t_hi = raised.raycast(lo, d, maxd), t_lo = lowered.raycast(lo, d, maxd);
+    const double slack = 1e-4 * std::max(1.0, std::isinf(t_hi) ? 0.0 : t_hi);
+    const bool between = ti >= t_hi - slack && (std::isinf(t_lo) || ti <= t_lo + slack);
+    if (same(t_hi, t_lo) || !between)
+      return ::testing::AssertionFailure()
+             << "ray o=(" << o.x << "," << o.y << "," << o.z << ") d=(" << dir.x << "," << dir.y
+             << "," << dir.z << ") max=" << maxd << ": got " << ti << ", reference " << tr
+             << " (raised " << t_hi << ", lowered " << t_lo << ")";
+    ++stats.ambiguous;
+  }
+  if (hit) {
+    ++stats.hits;
+    stats.started_below += hit->started_below;
+    // The point is on the ray; started_below means distance 0 and the origin under the surface.
+    const glm::dvec3 expect = o + d * hit->distance;
+    if (glm::length(hit->point - expect) > 1e-6 * std::max(1.0, hit->distance))
+      return ::testing::AssertionFailure() << "hit point off the ray";
+    if (hit->started_below &&
+        !(hit->distance == 0 && lo.y < exact.height(lo.x, lo.z) + 1e-6 && hit->point == o))
+      return ::testing::AssertionFailure() << "started_below inconsistent";
+    if (!hit->started_below && hit->distance == 0 && lo.y < exact.height(lo.x, lo.z) - 1e-6)
+      return ::testing::AssertionFailure() << "origin below the surface not flagged";
+    // The normal belongs to a triangle at the hit point.
+    const glm::dvec3 lp = local_of(hf, hit->point);
+    bool normal_ok = false;
+    for (const glm::dvec3& n : exact.normals_at(lp.x, lp.z, 1e-6))
+      normal_ok |= near_vec(hit->normal, n, 1e-5);
+    if (!normal_ok) return ::testing::AssertionFailure() << "hit normal is not a face normal there";
+  } else {
+    ++stats.misses;
+  }
+  return ::testing::AssertionSuccess();
+}
+
+}  // namespace
+
+TEST(Raycast, HundredThousandRandomRaysAgainstBruteForce) {
+  FieldSpec s{65, 65, 1.0, 1.25, 1000.5, -300.25, 50.0};
+  auto t = make_terrain(s, rough);
+  const Heightfield& hf = t->heightfield();
+  const double lo_y = s.offset + hf.min_local(), hi_y = s.offset + hf.max_local();
+  std::mt19937_64 rng(42);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  auto rand_dir = [&] {
+    const double z = 2 * U(rng) - 1, a = 6.283185307179586 * U(rng), r = std::sqrt(1 - z * z);
+    return glm::dvec3(r * std::cos(a), z, r * std::sin(a));
+  };
+  RayCheck stats;
+  int failures = 0;
+  for (int k = 0; k < 100000; ++k) {
+    // Origins over and around the field, from below the lowest to above the highest sample.
+    glm::dvec3 o(s.ox + (1.4 * U(rng) - 0.2) * hf.extent_x(),
+                 lo_y - 3 + (hi_y - lo_y + 10) * U(rng),
+                 s.oz + (1.4 * U(rng) - 0.2) * hf.extent_z());
+    glm::dvec3 d = rand_dir();
+    const int kind = k % 20;
+    if (kind < 6) d.y = -std::abs(d.y);  // bias towards the ground
+    if (kind == 6) d = {0, U(rng) < 0.5 ? -1 : 1, 0};
+    if (kind == 7) d.x = 0;  // in a plane of constant x
+    if (kind == 8) d.z = 0;
+    if (kind == 9) o.x = s.ox + std::floor(U(rng) * 65) * s.sx, d.x = 0;  // along a cell edge
+    if (kind == 10) o.z = s.oz + std::floor(U(rng) * 65) * s.sz, d.z = 0;
+    if (kind == 11) {  // aimed at a lattice vertex
+      const glm::dvec3 v(s.ox + std::floor(U(rng) * 65) * s.sx, 0,
+                         s.oz + std::floor(U(rng) * 65) * s.sz);
+      d = glm::dvec3(v.x, *t->height(v.x, v.z), v.z) - o;
+    }
+    if (kind == 12) d.y *= 0.02;                   // shallow, nearly grazing
+    if (kind == 13 && !(std::abs(d.x) < 1e-12)) {  // along a diagonal direction of the lattice
+      d.z = (U(rng) < 0.5 ? 1 : -1) * std::abs(d.x) * s.sz / s.sx;
+    }
+    const double maxd = k % 3 == 0 ? kInf : 0.1 + 100 * U(rng);
+    if (glm::length(d) == 0) continue;
+    auto r = check_ray(*t, o, d, maxd, stats);
+    if (!r) {
+      ADD_FAILURE() << r.message();
+      if (++failures > 10) break;
+    }
+  }
+  // A healthy mix, and ambiguous (within 1e-6 m) rays are rare.
+  EXPECT_GT(stats.hits, 30000);
+  EXPECT_GT(stats.misses, 10000);
+  EXPECT_GT(stats.started_below, 1000);
+  EXPECT_LT(stats.ambiguous, 100);
+  std::printf("hits %d misses %d started below %d ambiguous %d\n", stats.hits, stats.misses,
+              stats.started_below, stats.ambiguous);
+}
+
+TEST(Raycast, FieldsOfOtherShapes) {
+  // Sizes that are not block multiples, a single cell, long thin strips, non-square cells.
+  const FieldSpec shapes[] = {{2, 2, 1, 1, 0, 0, 0},
+                              {3, 9, 2.0, 0.5, 5, 5, 0},
+                              {67, 13, 0.7, 1.3, 0, 0, 0},
+                              {130, 5, 1, 1, -1e6, 1e6, 100},
+                              {6, 70, 3, 1, 0, 0, -20}};
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  for (const FieldSpec& s : shapes) {
+    auto t = make_terrain(s, rough);
+    const Heightfield& hf = t->heightfield();
+    RayCheck stats;
+    for (int k = 0; k < 5000; ++k) {
+      glm::dvec3 o(s.ox + (1.2 * U(rng) - 0.1) * hf.extent_x(), s.offset - 5 + 25 * U(rng),
+                   s.oz + (1.2 * U(rng) - 0.1) * hf.extent_z());
+      glm::dvec3 d(2 * U(rng) - 1, -U(rng), 2 * U(rng) - 1);
+      ASSERT_TRUE(check_ray(*t, o, d, k % 2 ? kInf : 30 * U(rng), stats)) << s.w << "x" << s.h;
+    }
+    EXPECT_GT(stats.hits, 100);
+  }
+}
+
+TEST(Raycast, StartingBelowOrOnTheSurface) {
+  FieldSpec s{9, 9};
+  auto t = make_terrain(s, rough);
+  const double h = *t->height(3.3, 4.6);
+  for (glm::dvec3 dir : {glm::dvec3(0, -1, 0), glm::dvec3(0, 1, 0), glm::dvec3(1, 0.5, -0.3)}) {
+    auto hit = t->raycast({3.3, h - 0.5, 4.6}, dir, 10.0);
+    ASSERT_TRUE(hit);
+    EXPECT_EQ(hit->distance, 0.0);
+    EXPECT_TRUE(hit->started_below);
+    EXPECT_EQ(hit->point, glm::dvec3(3.3, h - 0.5, 4.6));
+    EXPECT_EQ(hit->normal, *t->face_normal(3.3, 4.6));
+  }
+  // Exactly on the surface (a vertex with an exact height): touching, distance 0, not below.
+  const double hv = *t->height(4.0, 4.0);
+  auto on = t->raycast({4.0, hv, 4.0}, {0.3, 1, 0.1}, 10.0);
+  ASSERT_TRUE(on);
+  EXPECT_EQ(on->distance, 0.0);
+  EXPECT_FALSE(on->started_below);
+}
+
+TEST(Raycast, VerticalRays) {
+  FieldSpec s{9, 9, 2.0, 1.0, -7.0, 3.0, 10.0};
+  auto t = make_terrain(s, rough);
+  const double x = -7.0 + 5.3, z = 3.0 + 2.9, h = *t->height(x, z);
+  auto down = t->raycast({x, h + 7.0, z}, {0, -3, 0}, kInf);
+  ASSERT_TRUE(down);
+  EXPECT_NEAR(down->distance, 7.0, 1e-5);
+  EXPECT_NEAR(down->point.y, h, 1e-5);
+  EXPECT_EQ(down->point.x, x);
+  EXPECT_EQ(down->normal, *t->face_normal(x, z));
+  EXPECT_FALSE(t->raycast({x, h + 7.0, z}, {0, 1, 0}, kInf));   // up from above
+  EXPECT_FALSE(t->raycast({x, h + 7.0, z}, {0, -1, 0}, 6.99));  // too short
+  EXPECT_TRUE(t->raycast({x, h + 7.0, z}, {0, -1, 0}, 7.01));
+  // At a vertex with an exact height: max_distance exactly the gap touches.
+  const double hv = *t->height(-7.0 + 4.0, 3.0 + 5.0);
+  auto exact = t->raycast({-3.0, hv + 4.0, 8.0}, {0, -1, 0}, 4.0);
+  ASSERT_TRUE(exact);
+  EXPECT_EQ(exact->distance, 4.0);
+  // Off the footprint: nothing, even pointing down.
+  EXPECT_FALSE(t->raycast({-7.5, 100.0, 5.0}, {0, -1, 0}, kInf));
+  EXPECT_FALSE(t->raycast({-7.0 + 16.0 + 1e-9, 100.0, 5.0}, {0, -1, 0}, kInf));
+  // On the far edge: a hit.
+  EXPECT_TRUE(t->raycast({-7.0 + 16.0, 100.0, 3.0 + 8.0}, {0, -1, 0}, kInf));
+  // Tiny or huge direction components are normalised without trouble.
+  auto tiny = t->raycast({x, h + 7.0, z}, {0, -1e-300, 0}, kInf);
+  ASSERT_TRUE(tiny);
+  EXPECT_NEAR(tiny->distance, 7.0, 1e-5);
+  auto huge = t->raycast({x, h + 7.0, z}, {1e-320, -1e300, 0}, kInf);
+  ASSERT_TRUE(huge);
+  EXPECT_NEAR(huge->distance, 7.0, 1e-5);
+}
+
+TEST(Raycast, AlongCellEdgesAndBlockBoundaries) {
+  // A ridge of height 5 along column `c` (all else 0): a ray in the vertical plane x = c descends
+  // onto the ridge line, which is a lattice edge (and for c = 8 a boundary of the 4 x 4 blocks
+  // the hierarchy is built from).
+  for (int c : {5, 8, 0, 16}) {
+    FieldSpec s{17, 17};
+    auto t = make_terrain(s, [&](int i, int) { return i == c ? 5.0 : 0.0; });
+    for (double sign : {1.0, -1.0}) {
+      const double z0 = sign > 0 ? 0.5 : 15.5;
+      auto hit = t->raycast({double(c), 9.0, z0}, {0, -1, sign * 2}, kInf);
+      ASSERT_TRUE(hit) << c;
+      // y drops 4 m at 1 m per 2 m along z: hit at z0 + 8 sign, distance 4 * sqrt(5).
+      EXPECT_NEAR(hit->distance, 4 * std::sqrt(5.0), 1e-9) << c;
+      EXPECT_NEAR(hit->point.z, z0 + 8 * sign, 1e-9);
+      EXPECT_EQ(hit->point.x, double(c));
+    }
+    // The same along a row (z = c).
+    auto tz = make_terrain(s, [&](int, int j) { return j == c ? 5.0 : 0.0; });
+    auto hz = tz->raycast({0.5, 9.0, double(c)}, {2, -1, 0}, kInf);
+    ASSERT_TRUE(hz);
+    EXPECT_NEAR(hz->distance, 4 * std::sqrt(5.0), 1e-9);
+    // Horizontal along the ridge line, just above it: a miss; exactly at it: touches at once.
+    EXPECT_FALSE(t->raycast({double(c), 5.0 + 1e-6, -1.0}, {0, 0, 1}, kInf));
+    auto touch = t->raycast({double(c), 5.0, -1.0}, {0, 0, 1}, kInf);
+    ASSERT_TRUE(touch);
+    EXPECT_NEAR(touch->distance, 1.0, 1e-12);  // where the ray enters the footprint
+    EXPECT_FALSE(touch->started_below);
+  }
+}
+
+TEST(Raycast, AlongDiagonals) {
+  // Main diagonals: cells (k, k) have i + j even, so the line x = z runs along their diagonals.
+  FieldSpec s{17, 17};
+  auto t = make_terrain(s, [](int i, int j) { return i == j ? 5.0 : 0.0; });
+  auto hit = t->raycast({0.5, 15.5, 0.5}, {1, -1, 1}, kInf);
+  ASSERT_TRUE(hit);
+  // y falls from 15.5 to 5 while x and z move 10.5 each (through lattice vertices (k, k)).
+  EXPECT_NEAR(hit->distance, 10.5 * std::sqrt(3.0), 1e-9);
+  EXPECT_NEAR(hit->point.x, hit->point.z, 1e-9);
+  // Anti diagonals: cells with i + j = 7 (odd) are split along x + z = 8.
+  auto ta = make_terrain(s, [](int i, int j) { return i + j == 8 ? 5.0 : 0.0; });
+  auto ha = ta->raycast({0.5, 12.0, 7.5}, {1, -1, -1}, kInf);
+  ASSERT_TRUE(ha);
+  EXPECT_NEAR(ha->distance, 7.0 * std::sqrt(3.0), 1e-9);
+  EXPECT_NEAR(ha->point.x + ha->point.z, 8.0, 1e-9);
+  // A horizontal ray exactly along the ridge line touches at once (on the footprint).
+  auto along = t->raycast({2.0, 5.0, 2.0}, {1, 0, 1}, kInf);
+  ASSERT_TRUE(along);
+  EXPECT_EQ(along->distance, 0.0);
+  // Just above it: nothing.
+  EXPECT_FALSE(t->raycast({2.0, 5.0 + 1e-6, 2.0}, {1, 0, 1}, kInf));
+}
+
+TEST(Raycast, ThroughVerticesAndGrazing) {
+  // A spike of height 10 at vertex (8, 8) on a flat field at 0.
+  FieldSpec s{17, 17};
+  auto t = make_terrain(s, [](int i, int j) { return (i == 8 && j == 8) ? 10.0 : 0.0; });
+  // Aimed exactly at the tip from above, along a lattice diagonal direction.
+  auto tip = t->raycast({4.0, 14.0, 4.0}, {1, -1, 1}, kInf);
+  ASSERT_TRUE(tip);
+  EXPECT_NEAR(tip->point.x, 8.0, 1e-6);
+  EXPECT_NEAR(tip->point.y, 10.0, 1e-6);
+  // Horizontal through the tip, along the lattice line z = 8: grazes the tip only.
+  auto graze = t->raycast({1.0, 10.0, 8.0}, {1, 0, 0}, kInf);
+  ASSERT_TRUE(graze);
+  EXPECT_NEAR(graze->distance, 7.0, 1e-9);
+  EXPECT_FALSE(t->raycast({1.0, 10.0 + 1e-6, 8.0}, {1, 0, 0}, kInf));
+  // Horizontal through the tip along a diagonal direction, and across cells at an odd angle.
+  auto graze_diag = t->raycast({2.0, 10.0, 2.0}, {1, 0, 1}, kInf);
+  ASSERT_TRUE(graze_diag);
+  EXPECT_NEAR(graze_diag->distance, 6 * std::sqrt(2.0), 1e-9);
+  auto graze_odd = t->raycast({2.0, 10.0, 5.0}, {2, 0, 1}, kInf);
+  ASSERT_TRUE(graze_odd);
+  EXPECT_NEAR(graze_odd->point.x, 8.0, 1e-6);
+  // Grazing a ridge crosswise: a ridge of height 3 along column 5 (a lattice edge).
+  auto ridge = make_terrain(s, [](int i, int) { return i == 5 ? 3.0 : 0.0; });
+  auto cross = ridge->raycast({0.5, 3.0, 2.3}, {1, 0, 0.1}, kInf);
+  ASSERT_TRUE(cross);
+  EXPECT_NEAR(cross->point.x, 5.0, 1e-9);
+  EXPECT_FALSE(ridge->raycast({0.5, 3.0 + 1e-6, 2.3}, {1, 0, 0.1}, kInf));
+  // Running along a flat field at its exact height, entering from outside: touches at entry.
+  auto flat = make_terrain(s, [](int, int) { return 2.0; });
+  auto run = flat->raycast({-3.0, 2.0, 4.5}, {1, 0, 0.2}, kInf);
+  ASSERT_TRUE(run);
+  EXPECT_NEAR(run->point.x, 0.0, 1e-12);
+}
+
+TEST(Raycast, LeavingAndEnteringTheTerrain) {
+  FieldSpec s{9, 9};
+  auto t = make_terrain(s, [](int, int) { return 1.0; });
+  // Starts over the field, leaves it before coming down: no hit beyond the edge.
+  EXPECT_FALSE(t->raycast({7.0, 3.0, 4.0}, {1, -0.1, 0}, kInf));
+  // Starts outside, enters, hits.
+  auto in = t->raycast({-2.0, 3.0, 4.0}, {1, -0.5, 0}, kInf);
+  ASSERT_TRUE(in);
+  EXPECT_NEAR(in->point.x, 2.0, 1e-9);
+  // Starts outside below the surface level and enters: hits the solid's side at the entry point.
+  auto side = t->raycast({-2.0, 0.0, 4.0}, {1, 0, 0}, kInf);
+  ASSERT_TRUE(side);
+  EXPECT_NEAR(side->distance, 2.0, 1e-12);
+  EXPECT_FALSE(side->started_below);
+  // Outside going away, or passing beside the field: nothing.
+  EXPECT_FALSE(t->raycast({-2.0, 0.0, 4.0}, {-1, 0, 0}, kInf));
+  EXPECT_FALSE(t->raycast({-2.0, 0.0, 4.0}, {0, -1, 1}, kInf));
+  EXPECT_FALSE(t->raycast({-2.0, 0.0, -1.0}, {1, 0, 0}, kInf));
+  // Ends just before reaching the surface: nothing; just after: a hit.
+  EXPECT_FALSE(t->raycast({4.0, 3.0, 4.0}, {0, -1, 0}, 1.999));
+  EXPECT_TRUE(t->raycast({4.0, 3.0, 4.0}, {0, -1, 0}, 2.001));
+}
+
+TEST(Raycast, BadInputIsNoHit) {
+  FieldSpec s{9, 9};
+  auto t = make_terrain(s, rough);
+  const glm::dvec3 o(4, 50, 4), d(0.01, -1, 0.02);
+  EXPECT_TRUE(t->raycast(o, d, kInf));
+  EXPECT_FALSE(t->raycast(o, {0, 0, 0}, kInf));
+  EXPECT_FALSE(t->raycast(o, {-0.0, 0.0, -0.0}, kInf));
+  EXPECT_FALSE(t->raycast(o, d, 0.0));
+  EXPECT_FALSE(t->raycast(o, d, -1.0));
+  EXPECT_FALSE(t->raycast(o, d, kNaN));
+  EXPECT_FALSE(t->raycast(o, d, -kInf));
+  for (int a = 0; a < 3; ++a) {
+    for (double bad : {kNaN, kInf, -kInf}) {
+      glm::dvec3 ob = o, db = d;
+      ob[a] = bad;
+      db[a] = bad;
+      EXPECT_FALSE(t->raycast(ob, d, kInf));
+      EXPECT_FALSE(t->raycast(o, db, kInf));
+    }
+  }
+  // Started below, but with bad input: still nothing.
+  EXPECT_FALSE(t->raycast({4, -50, 4}, {0, 0, 0}, kInf));
+  EXPECT_FALSE(t->raycast({4, -50, 4}, {0, 1, 0}, kNaN));
+}
+
+TEST(Raycast, ConcurrentQueriesAgree) {
+  FieldSpec s{65, 65};
+  auto t = make_terrain(s, rough);
+  std::vector<glm::dvec3> origins, dirs;
+  std::mt19937 rng(10);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  for (int k = 0; k < 4000; ++k) {
+    origins.push_back({64 * U(rng), 20 * U(rng), 64 * U(rng)});
+    dirs.push_back({U(rng) - 0.5, -U(rng), U(rng) - 0.5});
+  }
+  std::vector<double> serial(origins.size()), a(origins.size()), b(origins.size());
+  auto run = [&](std::vector<double>& out) {
+    for (std::size_t k = 0; k < origins.size(); ++k) {
+      auto h = t->raycast(origins[k], dirs[k], kInf);
+      out[k] = (h ? h->distance : -1) + *t->height(origins[k].x, origins[k].z);
+    }
+  };
+  run(serial);
+  std::thread ta([&] { run(a); }), tb([&] { run(b); });
+  ta.join();
+  tb.join();
+  EXPECT_EQ(serial, a);
+  EXPECT_EQ(serial, b);
+}
+
+// ---- Triangles in a box -----------------------------------------------------------------------
+
+namespace {
+
+using TriKey = std::array<double, 9>;
+
+TriKey key_of(const SurfaceTriangle& t) {
+  return {t.v[0].x, t.v[0].y, t.v[0].z, t.v[1].x, t.v[1].y, t.v[1].z, t.v[2].x, t.v[2].y, t.v[2].z};
+}
+
+// Rotates a triangle so that its smallest corner comes first (the winding is kept).
+TriKey canonical(TriKey k) {
+  auto corner = [&](int c) { return std::make_tuple(k[3 * c], k[3 * c + 1], k[3 * c + 2]); };
+  int first = 0;
+  for (int c = 1; c < 3; ++c)
+    if (corner(c) < corner(first)) first = c;
+  TriKey out;
+  for (int c = 0; c < 3; ++c)
+    for (int a = 0; a < 3; ++a) out[3 * c + a] = k[3 * ((first + c) % 3) + a];
+  return out;
+}
+
+// Closed 2D overlap of a triangle and a rectangle by brute force: a vertex of one inside the
+// other, or crossing edges.
+bool tri_rect_overlap(const glm::dvec2 p[3], glm::dvec2 lo, glm::dvec2 hi) {
+  auto in_rect = [&](glm::dvec2 q) {
+    return q.x >= lo.x && q.x <= hi.x && q.y >= lo.y && q.y <= hi.y;
+  };
+  auto cross2 = [](glm::dvec2 a, glm::dvec2 b) { return a.x * b.y - a.y * b.x; };
+  auto in_tri = [&](glm::dvec2 q) {
+    double s[3];
+    for (int e = 0; e < 3; ++e) s[e] = cross2(p[(e + 1) % 3] - p[e], q - p[e]);
+    return (s[0] >= 0 && s[1] >= 0 && s[2] >= 0) || (s[0] <= 0 && s[1] <= 0 && s[2] <= 0);
+  };
+  auto seg_cross = [&](glm::dvec2 a, glm::dvec2 b, glm::dvec2 c, glm::dvec2 d) {
+    const double d1 = cross2(b - a, c - a), d2 = cross2(b - a, d - a);
+    const double d3 = cross2(d - c, a - c), d4 = cross2(d - c, b - c);
+    return ((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0));
+  };
+  for (int k = 0; k < 3; ++k)
+    if (in_rect(p[k])) return true;
+  const glm::dvec2 r[4] = {lo, {hi.x, lo.y}, hi, {lo.x, hi.y}};
+  for (const auto& q : r)
+    if (in_tri(q)) return true;
+  for (int e = 0; e < 3; ++e)
+    for (int f = 0; f < 4; ++f)
+      if (seg_cross(p[e], p[(e + 1) % 3], r[f], r[(f + 1) % 4])) return true;
+  return false;
+}
+
+}  // namespace
+
+TEST(TrianglesInBox, MatchesBruteForce) {
+  FieldSpec s{23, 19, 1.0, 1.0, 0.0, 0.0, 0.0};
+  std::vector<std::uint8_t> mats(22 * 18);
+  for (std::size_t k = 0; k < mats.size(); ++k) mats[k] = std::uint8_t(k * 7 % 11);
+  auto t = make_terrain(s, rough, mats);
+  const Heightfield& hf = t->heightfield();
+  const Reference ref{&hf, 0.0};
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  for (int k = 0; k < 3000; ++k) {
+    Box b;
+    double x0 = -3 + 28 * U(rng), z0 = -3 + 24 * U(rng);
+    double wx = 6 * U(rng) * U(rng), wz = 6 * U(rng) * U(rng);
+    if (k % 4 == 0)
+      x0 = std::round(x0), z0 = std::round(z0), wx = std::round(wx), wz = std::round(wz);
+    if (k % 7 == 0) wx = 0;  // degenerate (a plane)
+    const double y0 = -6 + 18 * U(rng), wy = 8 * U(rng) * U(rng);
+    b.min = {x0, y0, z0};
+    b.max = {x0 + wx, y0 + wy, z0 + wz};
+    std::vector<SurfaceTriangle> got;
+    const std::size_t n = t->triangles_in_box(b, got);
+    ASSERT_EQ(n, got.size());
+    std::multiset<TriKey> got_keys, want_keys;
+    for (const auto& tri : got) {
+      // Counter-clockwise seen from above (surface.h's convention) and the cell's material.
+      const glm::dvec3 c = glm::cross(tri.v[1] - tri.v[0], tri.v[2] - tri.v[0]);
+      ASSERT_GT(c.y, 0);
+      const double cx = (tri.v[0].x + tri.v[1].x + tri.v[2].x) / 3;
+      const double cz = (tri.v[0].z + tri.v[1].z + tri.v[2].z) / 3;
+      ASSERT_EQ(tri.material, hf.material(std::uint32_t(cx), std::uint32_t(cz)));
+      got_keys.insert(canonical(key_of(tri)));
+    }
+    for (int j = 0; j + 1 < 19; ++j)
+      for (int i = 0; i + 1 < 23; ++i)
+        for (int w = 0; w < 2; ++w) {
+          RefTri r = ref.tri(i, j, w);
+          const glm::dvec2 p[3] = {
+              {r.p[0].x, r.p[0].z}, {r.p[1].x, r.p[1].z}, {r.p[2].x, r.p[2].z}};
+          const double ylo = std::min({r.p[0].y, r.p[1].y, r.p[2].y});
+          const double yhi = std::max({r.p[0].y, r.p[1].y, r.p[2].y});
+          if (yhi < b.min.y || ylo > b.max.y) continue;
+          if (!tri_rect_overlap(p, {b.min.x, b.min.z}, {b.max.x, b.max.z})) continue;
+          // Wind it counter-clockwise about +y like the module does.
+          if (glm::cross(r.p[1] - r.p[0], r.p[2] - r.p[0]).y < 0) std::swap(r.p[1], r.p[2]);
+          SurfaceTriangle st;
+          for (int c = 0; c < 3; ++c) st.v[c] = r.p[c];
+          want_keys.insert(canonical(key_of(st)));
+        }
+    ASSERT_EQ(got_keys, want_keys) << "box " << k;
+  }
+}
+
+TEST(TrianglesInBox, CapsBadBoxesAndPlacement) {
+  FieldSpec s{9, 9, 2.0, 0.5, 1e7, -1e7, 300.0};
+  auto t = make_terrain(s, rough);
+  std::vector<SurfaceTriangle> out;
+  Box all{{1e7 - 1, -1e6, -1e7 - 1}, {1e7 + 100, 1e6, -1e7 + 100}};
+  EXPECT_EQ(t->triangles_in_box(all, out), 2u * 8 * 8);
+  // World coordinates: corners at the lattice positions, heights with the offset.
+  for (const auto& tri : out)
+    for (const auto& v : tri.v) {
+      const double u = (v.x - 1e7) / 2.0, w = (v.z + 1e7) / 0.5;
+      ASSERT_EQ(u, std::round(u));
+      ASSERT_EQ(w, std::round(w));
+      ASSERT_EQ(v.y, t->heightfield().world(std::uint32_t(u), std::uint32_t(w)));
+    }
+  out.clear();
+  EXPECT_EQ(t->triangles_in_box(all, out, 5), 5u);
+  EXPECT_EQ(out.size(), 5u);
+  const Box bad[] = {{{kNaN, 0, 0}, {1, 1, 1}},
+                     {{1e7, 0, -1e7}, {1e7 + 1, kInf, -1e7 + 1}},
+                     {{1e7 + 5, -1e6, -1e7}, {1e7 + 4, 1e6, -1e7 + 1}},  // min > max
+                     {{0, -1e6, 0}, {10, 1e6, 10}},                      // off terrain
+                     {{1e7, 1e5, -1e7}, {1e7 + 10, 1e6, -1e7 + 4}}};     // above everything
+  for (const Box& b : bad) {
+    out.clear();
+    EXPECT_EQ(t->triangles_in_box(b, out), 0u);
+    EXPECT_TRUE(out.empty());
+  }
+}
+
+// ---- The full-detail triangulation -------------------------------------------------------------
+
+TEST(Triangulation, ClosedManifoldAgreeingWithHeight) {
+  FieldSpec s{31, 26, 0.8, 1.7, 12.0, -5.0, 40.0};
+  auto t = make_terrain(s, rough);
+  const Heightfield& hf = t->heightfield();
+  // Every cell, both triangles, located through locate_in_cell.
+  struct Tri {
+    int vi[3], vj[3];
+  };
+  std::vector<Tri> tris;
+  for (int j = 0; j + 1 < 26; ++j)
+    for (int i = 0; i + 1 < 31; ++i) {
+      std::set<int> seen;
+      for (float fu : {0.2f, 0.8f})
+        for (float fv : {0.2f, 0.8f}) {
+          const CellTriangle c = locate_in_cell(i, j, fu, fv);
+          if (!seen.insert(c.which).second) continue;
+          Tri tr;
+          for (int k = 0; k < 3; ++k) tr.vi[k] = i + c.di[k], tr.vj[k] = j + c.dj[k];
+          tris.push_back(tr);
+        }
+      ASSERT_EQ(seen.size(), 2u);
+    }
+  ASSERT_EQ(tris.size(), 2u * 30 * 25);
+  // Edges: interior ones shared by exactly two triangles (with opposite directions, as a
+  // consistently wound manifold has), boundary ones by one.
+  std::map<std::pair<int, int>, int> directed;
+  auto id = [](int i, int j) { return i + j * 1000; };
+  for (const Tri& tr : tris)
+    for (int k = 0; k < 3; ++k)
+      ++directed[{id(tr.vi[k], tr.vj[k]), id(tr.vi[(k + 1) % 3], tr.vj[(k + 1) % 3])}];
+  int boundary = 0;
+  std::set<std::pair<int, int>> undirected;
+  for (const auto& [e, n] : directed) {
+    ASSERT_EQ(n, 1);  // no edge used twice in the same direction
+    undirected.insert({std::min(e.first, e.second), std::max(e.first, e.second)});
+  }
+  for (const auto& e : undirected) {
+    const int uses = directed.count({e.first, e.second}) + directed.count({e.second, e.first});
+    const int ai = e.first % 1000, aj = e.first / 1000, bi = e.second % 1000, bj = e.second / 1000;
+    const bool on_border =
+        (ai == bi && (ai == 0 || ai == 30)) || (aj == bj && (aj == 0 || aj == 25));
+    ASSERT_EQ(uses, on_border ? 1 : 2);
+    boundary += on_border;
+  }
+  EXPECT_EQ(boundary, 2 * (30 + 25));
+  // Height at random points equals the plane of the triangle holding the point (found by
+  // brute force over all triangles), to float precision.
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  for (int k = 0; k < 5000; ++k) {
+    const double u = U(rng) * 30, v = U(rng) * 25;
+    bool found = false;
+    for (const Tri& tr : tris) {
+      // Barycentric coordinates in the lattice plane.
+      const double x0 = tr.vi[0], z0 = tr.vj[0];
+      const double ax = tr.vi[1] - x0, az = tr.vj[1] - z0, bx = tr.vi[2] - x0, bz = tr.vj[2] - z0;
+      const double det = ax * bz - az * bx;
+      const double l1 = ((u - x0) * bz - (v - z0) * bx) / det;
+      const double l2 = (ax * (v - z0) - az * (u - x0)) / det;
+      const double l0 = 1 - l1 - l2;
+      if (l0 < -1e-12 || l1 < -1e-12 || l2 < -1e-12) continue;
+      const double h = l0 * hf.local(tr.vi[0], tr.vj[0]) + l1 * hf.local(tr.vi[1], tr.vj[1]) +
+                       l2 * hf.local(tr.vi[2], tr.vj[2]);
+      ASSERT_NEAR(*t->height(s.ox + u * s.sx, s.oz + v * s.sz) - s.offset, h,
+                  1e-6 * (1 + std::abs(h)));
+      found = true;
+      break;
+    }
+    ASSERT_TRUE(found);
+  }
+  // The mesh that triangles_in_box hands to physics is exactly this triangulation.
+  std::vector<SurfaceTriangle> all;
+  t->triangles_in_box({{-1e9, -1e9, -1e9}, {1e9, 1e9, 1e9}}, all);
+  std::set<TriKey> a, b;
+  for (const auto& st : all) a.insert(canonical(key_of(st)));
+  for (const Tri& tr : tris) {
+    SurfaceTriangle st;
+    for (int k = 0; k < 3; ++k)
+      st.v[k] = {s.ox + tr.vi[k] * s.sx, hf.world(tr.vi[k], tr.vj[k]), s.oz + tr.vj[k] * s.sz};
+    b.insert(canonical(key_of(st)));
+  }
+  EXPECT_EQ(a, b);
+}
+
+TEST(Terrain, MemoryReport) {
+  FieldSpec s{257, 257};
+  auto t = make_terrain(s, rough);
+  const double samples = 257.0 * 257.0;
+  const double bytes =
+      double(t->heightfield().local_heights().size() * 4 + t->ray_hierarchy_bytes());
+  EXPECT_LE(bytes / samples, 6.0);
+  EXPECT_GT(t->ray_hierarchy_bytes(), 0u);
+  EXPECT_GE(t->memory_bytes(), std::size_t(bytes));
 }

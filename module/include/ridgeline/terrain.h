@@ -26,6 +26,14 @@ struct SurfaceSample {
   std::uint8_t material = 0;     ///< material id of the cell under the point
 };
 
+/// Height, face normal and material at a point: what a physics contact needs, cheaper than
+/// SurfaceSample (no smooth normal).
+struct HeightNormal {
+  double height = 0;                ///< world height, metres
+  glm::vec3 face_normal{0, 1, 0};   ///< unit normal of the triangle under the point
+  std::uint8_t material = 0;        ///< material id of the cell under the point
+};
+
 /// The first intersection of a ray with the surface.
 struct RayHit {
   double distance = 0;        ///< metres along the (normalised) direction from the origin
@@ -77,6 +85,9 @@ class Terrain {
   /// (x, z); a vertex normal is the area-weighted mean of the face normals of the triangles
   /// around the vertex.
   std::optional<glm::vec3> smooth_normal(double x, double z) const noexcept;
+  /// Height, face normal and material in one call (one lookup instead of two); empty off-terrain
+  /// or for non-finite input.
+  std::optional<HeightNormal> height_normal(double x, double z) const noexcept;
   /// Height, both normals and the material in one call.
   std::optional<SurfaceSample> sample(double x, double z) const noexcept;
 
@@ -103,6 +114,9 @@ class Terrain {
 
   /// Bytes held: heights, materials, ray hierarchy.
   std::size_t memory_bytes() const noexcept;
+  /// Bytes held by the ray hierarchy alone (the min/max pyramid over 4 x 4-cell blocks, about
+  /// 0.67 bytes per sample).
+  std::size_t ray_hierarchy_bytes() const noexcept;
 
  private:
   explicit Terrain(Heightfield heightfield);
