@@ -1,6 +1,148 @@
-// (being written)
+// `ridge bench queries`: nanoseconds per query on uniformly random points, medians over
+// repetitions (definitions in issue 2, "Speed to reach").
 #include "bench_queries.h"
 
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <glm/geometric.hpp>
+#include <random>
+#include <vector>
+
 namespace ridgeline::cli {
-nlohmann::json bench_queries(const Terrain&, const BenchQueriesOptions&) { return {}; }
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// Runs `body` once and returns nanoseconds per item.
+template <class F>
+double ns_per(std::size_t items, F&& body) {
+  const auto t0 = Clock::now();
+  body();
+  const auto t1 = Clock::now();
+  return std::chrono::duration<double, std::nano>(t1 - t0).count() / double(items);
+}
+
+struct Ray {
+  glm::dvec3 origin, direction;
+  double max_distance;
+};
+
+}  // namespace
+
+nlohmann::json bench_queries(const Terrain& terrain, const BenchQueriesOptions& options) {
+  const Heightfield& hf = terrain.heightfield();
+  const std::size_t n = std::max<std::size_t>(options.points, 1);
+  const int reps = std::max(options.repetitions, 1);
+  std::mt19937_64 rng(options.seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+
+  // Uniformly random points over the whole terrain.
+  std::vector<glm::dvec2> points(n);
+  for (auto& p : points)
+    p = {hf.origin_x() + unit(rng) * hf.extent_x(), hf.origin_z() + unit(rng) * hf.extent_z()};
+
+  const double top = hf.height_offset() + double(hf.max_local()) + 1.0;
+  const double bottom = hf.height_offset() + double(hf.min_local()) - 1.0;
+
+  // Vertical rays: straight down from above the highest sample, unbounded length.
+  std::vector<Ray> vertical(n);
+  for (std::size_t k = 0; k < n; ++k)
+    vertical[k] = {{points[k].x, top, points[k].y}, {0, -1, 0}, HUGE_VAL};
+
+  // Slanted rays: from above the highest sample at a random point of the middle half of the
+  // field, 256 cells horizontally at a random azimuth, ending below the lowest sample.
+  std::vector<Ray> slanted(n);
+  constexpr double kCells = 256.0;
+  constexpr double kTwoPi = 6.283185307179586;
+  for (auto& r : slanted) {
+    const double u = (0.25 + 0.5 * unit(rng)) * (hf.width() - 1.0);
+    const double v = (0.25 + 0.5 * unit(rng)) * (hf.height() - 1.0);
+    const double a = kTwoPi * unit(rng);
+    r.origin = {hf.origin_x() + u * hf.spacing_x(), top, hf.origin_z() + v * hf.spacing_z()};
+    r.direction = {kCells * std::cos(a) * hf.spacing_x(), bottom - top,
+                   kCells * std::sin(a) * hf.spacing_z()};
+    r.max_distance = glm::length(r.direction);
+  }
+
+  std::vector<double> t_height, t_height_normal, t_sample, t_vertical, t_slanted;
+  std::size_t hits_height = 0, hits_height_normal = 0, hits_sample = 0, hits_vertical = 0,
+              hits_slanted = 0;
+  double checksum = 0;
+  for (int rep = 0; rep < reps; ++rep) {
+    std::size_t hits = 0;
+    double sum = 0;
+    t_height.push_back(ns_per(n, [&] {
+      for (const auto& p : points)
+        if (auto h = terrain.height(p.x, p.y)) sum += *h, ++hits;
+    }));
+    hits_height = hits;
+    hits = 0;
+    t_height_normal.push_back(ns_per(n, [&] {
+      for (const auto& p : points)
+        if (auto s = terrain.height_normal(p.x, p.y)) sum += s->height + s->face_normal.x, ++hits;
+    }));
+    hits_height_normal = hits;
+    hits = 0;
+    t_sample.push_back(ns_per(n, [&] {
+      for (const auto& p : points)
+        if (auto s = terrain.sample(p.x, p.y)) sum += s->height + s->smooth_normal.x, ++hits;
+    }));
+    hits_sample = hits;
+    hits = 0;
+    t_vertical.push_back(ns_per(n, [&] {
+      for (const auto& r : vertical)
+        if (auto h = terrain.raycast(r.origin, r.direction, r.max_distance))
+          sum += h->distance, ++hits;
+    }));
+    hits_vertical = hits;
+    hits = 0;
+    t_slanted.push_back(ns_per(n, [&] {
+      for (const auto& r : slanted)
+        if (auto h = terrain.raycast(r.origin, r.direction, r.max_distance))
+          sum += h->distance, ++hits;
+    }));
+    hits_slanted = hits;
+    checksum += sum;
+  }
+
+  const double samples = double(hf.width()) * hf.height();
+  const std::size_t height_bytes = hf.local_heights().size() * sizeof(float);
+  const std::size_t hierarchy_bytes = terrain.ray_hierarchy_bytes();
+  nlohmann::json j;
+  j["height_ns"] = median(t_height);
+  j["height_normal_ns"] = median(t_height_normal);
+  j["sample_ns"] = median(t_sample);
+  j["vertical_ray_ns"] = median(t_vertical);
+  j["slanted_ray_ns"] = median(t_slanted);
+  j["bytes_per_sample"] = double(height_bytes + hierarchy_bytes) / samples;
+  j["height_bytes"] = height_bytes;
+  j["ray_hierarchy_bytes"] = hierarchy_bytes;
+  j["memory_bytes"] = terrain.memory_bytes();
+  j["width"] = hf.width();
+  j["height"] = hf.height();
+  j["points"] = n;
+  j["repetitions"] = reps;
+  j["seed"] = options.seed;
+  j["slanted_ray_cells"] = kCells;
+  j["hits"] = {{"height", hits_height},
+               {"height_normal", hits_height_normal},
+               {"sample", hits_sample},
+               {"vertical_ray", hits_vertical},
+               {"slanted_ray", hits_slanted}};
+  j["checksum"] = checksum;
+  j["notes"] =
+      "ns per query, median over repetitions; height_normal = height + face normal + material "
+      "(Terrain::height_normal); sample = height + face and smooth normals + material; "
+      "bytes_per_sample = (float heights + ray hierarchy) / samples";
+  return j;
+}
+
 }  // namespace ridgeline::cli
