@@ -40,7 +40,8 @@ struct Node {
   std::uint32_t qslot = kNone;  // position in the split heap (leaf) or merge heap (internal)
   std::uint32_t root = 0;
   std::uint32_t heap = 1;
-  std::uint32_t stamp = 0;  // generation of the node's newest expiry records
+  std::uint32_t stamp = 0;      // generation of the node's newest expiry records
+  std::int32_t ax = 0, az = 0;  // apex in global lattice coordinates (geometry in O(1))
 };
 
 struct HeapEntry {
@@ -128,7 +129,91 @@ struct Expiry {
   std::uint32_t stamp;
   bool operator>(const Expiry& o) const { return key > o.key; }
 };
-using ExpiryQueue = std::priority_queue<Expiry, std::vector<Expiry>, std::greater<Expiry>>;
+
+// Expiry records on a timing wheel over a monotone "clock" (the eye's odometer in metres, or its
+// accumulated rotation in radians): O(1) push and pop, where a binary heap cost ~16 levels per
+// record. Keys beyond the wheel's horizon wait in a small heap until the wheel reaches them.
+class ExpiryWheel {
+ public:
+  explicit ExpiryWheel(double width) : width_(width), ring_(kBuckets) {}
+  // Empties the wheel and sets its clock to `now`.
+  void clear(double now) {
+    for (auto& b : ring_) b.clear();
+    overflow_ = {};
+    size_ = 0;
+    cursor_ = bucket(now);
+  }
+  std::size_t size() const { return size_; }
+  void push(double key, std::uint32_t node, std::uint32_t stamp) {
+    const std::uint64_t b = bucket(key);
+    ++size_;
+    if (b < cursor_ + kBuckets)
+      ring_[std::max(b, cursor_) % kBuckets].push_back({key, node, stamp});
+    else
+      overflow_.push({key, node, stamp});
+  }
+  // Calls fn(node, stamp) for every record with key <= now; stops early when fn returns false.
+  template <class Fn>
+  bool drain(double now, Fn&& fn) {
+    const std::uint64_t target = bucket(now);
+    const std::uint64_t last = std::min(target, cursor_ + kBuckets - 1);
+    for (std::uint64_t b = cursor_; b <= last; ++b) {
+      std::vector<Expiry>& v = ring_[b % kBuckets];
+      std::size_t keep = 0;
+      for (std::size_t k = 0; k < v.size(); ++k) {
+        if (v[k].key <= now) {
+          --size_;
+          if (!fn(v[k].node, v[k].stamp)) {
+            // Abandoned: the caller rebuilds and clears the wheel.
+            return false;
+          }
+        } else {
+          v[keep++] = v[k];
+        }
+      }
+      v.resize(keep);
+      if (keep == 0 && v.capacity() > 256) std::vector<Expiry>().swap(v);  // bound idle memory
+    }
+    cursor_ = std::max(cursor_, target > cursor_ + kBuckets - 1 ? target : last);
+    // Records whose buckets the ring now reaches come in from the overflow heap.
+    while (!overflow_.empty() && bucket(overflow_.top().key) < cursor_ + kBuckets) {
+      const Expiry e = overflow_.top();
+      overflow_.pop();
+      ring_[std::max(bucket(e.key), cursor_) % kBuckets].push_back(e);
+    }
+    // A jump past the horizon (teleport) may leave due records in the ring's current bucket.
+    if (target >= cursor_) {
+      std::vector<Expiry>& v = ring_[cursor_ % kBuckets];
+      std::size_t keep = 0;
+      for (std::size_t k = 0; k < v.size(); ++k) {
+        if (v[k].key <= now) {
+          --size_;
+          if (!fn(v[k].node, v[k].stamp)) return false;
+        } else {
+          v[keep++] = v[k];
+        }
+      }
+      v.resize(keep);
+    }
+    return true;
+  }
+  std::size_t memory_bytes() const {
+    std::size_t b = ring_.capacity() * sizeof(std::vector<Expiry>);
+    for (const auto& v : ring_) b += v.capacity() * sizeof(Expiry);
+    return b + overflow_.size() * sizeof(Expiry);
+  }
+
+ private:
+  static constexpr std::uint64_t kBuckets = 2048;
+  std::uint64_t bucket(double key) const {
+    return key <= 0.0 ? 0 : static_cast<std::uint64_t>(key / width_);
+  }
+  double width_;
+  std::vector<std::vector<Expiry>> ring_;
+  std::priority_queue<Expiry, std::vector<Expiry>, std::greater<Expiry>> overflow_;
+  std::size_t size_ = 0;
+  std::uint64_t cursor_ = 0;
+};
 
 struct Validity {
   double distance = std::numeric_limits<double>::infinity();  // eye travel allowed, metres
@@ -164,7 +249,7 @@ struct RoamView::Impl {
   std::vector<std::uint32_t> free_pairs;
   IndexedHeap<true> split;
   IndexedHeap<false> merge;
-  ExpiryQueue by_distance, by_angle;
+  ExpiryWheel by_distance{0.25}, by_angle{0.001};
 
   // Camera state.
   bool have_camera = false;
@@ -177,6 +262,7 @@ struct RoamView::Impl {
   // Settings snapshot used by priorities.
   ErrorMetric metric = ErrorMetric::kScreenPixels;
   double slack = 0.05;
+  double threshold = 2.0;  // used only to size priority windows
   bool reset_pending = true;
 
   // Output.
@@ -233,8 +319,8 @@ struct RoamView::Impl {
   void reset_to_roots() {
     split.clear();
     merge.clear();
-    by_distance = {};
-    by_angle = {};
+    by_distance.clear(odometer);
+    by_angle.clear(angometer);
     free_pairs.clear();
     const std::uint32_t px = land.patches_x(), pz = land.patches_z();
     nodes.assign(land.root_count(), Node{});
@@ -245,6 +331,11 @@ struct RoamView::Impl {
         Node& r1 = nodes[2 * p + 1];
         r0.root = 2 * p;
         r1.root = 2 * p + 1;
+        const LatticeTriangle t0 = land.triangle(2 * p, 1), t1 = land.triangle(2 * p + 1, 1);
+        r0.ax = static_cast<std::int32_t>(t0.ax);
+        r0.az = static_cast<std::int32_t>(t0.az);
+        r1.ax = static_cast<std::int32_t>(t1.ax);
+        r1.az = static_cast<std::int32_t>(t1.az);
         r0.base = 2 * p + 1;
         r1.base = 2 * p;
         // root 0: apex (P, 0), left edge z = 0 (towards -z), right edge x = P (towards +x)
@@ -269,7 +360,7 @@ struct RoamView::Impl {
     const float b = land.bound(nd.root, nd.heap);
     v = Validity{};
     if (metric == ErrorMetric::kWorldMetres || b == 0.0f) return b;
-    const LatticeTriangle t = land.triangle(nd.root, nd.heap);
+    const LatticeTriangle t = land.triangle_at(nd.ax, nd.az, nd.root, nd.heap);
     const std::int64_t i0 = std::min({t.ax, t.lx, t.rx}), i1 = std::max({t.ax, t.lx, t.rx});
     const std::int64_t j0 = std::min({t.az, t.lz, t.rz}), j1 = std::max({t.az, t.lz, t.rz});
     const float ha = land.lattice_height(t.ax, t.az), hl = land.lattice_height(t.lx, t.lz),
@@ -303,8 +394,15 @@ struct RoamView::Impl {
       v.angle = 0.5 * margin / std::max(reach, 1e-9);
       return 0.0f;
     }
-    v.distance = r;
-    const double dd = d - r;
+    // Window: at least slack * d; wider when the node is far from the threshold either way
+    // (half the way to the distance at which its priority would equal the threshold), so nodes
+    // that are clearly fine or clearly too coarse are not recomputed every frame. The key stays
+    // below the threshold if the node was below it (and above if above), so decisions only ever
+    // err on the side of more detail.
+    double window = r;
+    if (threshold > 0.0) window = std::max(window, 0.5 * std::abs(d - double(b) * K / threshold));
+    v.distance = window;
+    const double dd = d - window;
     if (dd <= 0.0) return kInf;
     return static_cast<float>(double(b) * K / dd);
   }
@@ -312,8 +410,8 @@ struct RoamView::Impl {
   void push_records(std::uint32_t n, const Validity& v) {
     Node& nd = nodes[n];
     ++nd.stamp;
-    if (std::isfinite(v.distance)) by_distance.push({odometer + v.distance, n, nd.stamp});
-    if (std::isfinite(v.angle)) by_angle.push({angometer + v.angle, n, nd.stamp});
+    if (std::isfinite(v.distance)) by_distance.push(odometer + v.distance, n, nd.stamp);
+    if (std::isfinite(v.angle)) by_angle.push(angometer + v.angle, n, nd.stamp);
   }
 
   void push_split(std::uint32_t n) {
@@ -410,6 +508,9 @@ struct RoamView::Impl {
     c0.root = c1.root = p.root;
     c0.heap = 2 * p.heap;
     c1.heap = 2 * p.heap + 1;
+    const LatticeTriangle t = land.triangle_at(p.ax, p.az, p.root, p.heap);
+    c0.ax = c1.ax = static_cast<std::int32_t>((t.lx + t.rx) / 2);
+    c0.az = c1.az = static_cast<std::int32_t>((t.lz + t.rz) / 2);
     p.child = c;
   }
 
@@ -521,8 +622,8 @@ struct RoamView::Impl {
   }
 
   void recompute_all() {
-    by_distance = {};
-    by_angle = {};
+    by_distance.clear(odometer);
+    by_angle.clear(angometer);
     std::vector<std::uint32_t> queued;
     queued.reserve(split.size() + merge.size());
     for (const auto& e : split.entries()) queued.push_back(e.node);
@@ -533,18 +634,15 @@ struct RoamView::Impl {
   // Recomputes expired keys. Returns false when so many expired that rebuilding is cheaper.
   bool refresh_expired(std::size_t rebuild_above) {
     std::size_t done = 0;
-    auto drain = [&](ExpiryQueue& q, double now) {
-      while (!q.empty() && q.top().key <= now) {
-        const Expiry e = q.top();
-        q.pop();
-        const Node& nd = nodes[e.node];
-        if (nd.stamp != e.stamp || nd.qslot == kNone) continue;  // stale record
-        requeue(e.node);
-        if (++done > rebuild_above) return false;
-      }
-      return true;
+    auto visit = [&](std::uint32_t node, std::uint32_t stamp) {
+      ++st.expiry_records;
+      const Node& nd = nodes[node];
+      if (nd.stamp != stamp || nd.qslot == kNone) return true;  // stale record
+      ++st.expired;
+      requeue(node);
+      return ++done <= rebuild_above;
     };
-    return drain(by_angle, angometer) && drain(by_distance, odometer);
+    return by_angle.drain(angometer, visit) && by_distance.drain(odometer, visit);
   }
 };
 
@@ -615,6 +713,7 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
   m.metric = settings_.metric;
   m.slack = settings_.slack;
   const double threshold = settings_.threshold;
+  m.threshold = settings_.metric == ErrorMetric::kScreenPixels ? threshold : 0.0;
   const std::uint32_t cap = settings_.max_triangles;
   const double budget = settings_.budget_ms;
   auto elapsed_ms = [&] {
@@ -632,7 +731,11 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
     // Coherence loses when most keys expire at once (a teleport, a snap turn): rebuilding
     // top-down then costs less than requeueing everything and merging most of the mesh away.
     const std::size_t queued = m.split.size() + m.merge.size();
-    if (!m.refresh_expired(std::max<std::size_t>(2048, queued / 2))) m.reset_to_roots();
+    if (!m.refresh_expired(std::max<std::size_t>(2048, queued / 2))) {
+      m.reset_to_roots();
+    } else if (m.by_distance.size() + m.by_angle.size() > 2 * queued + 8192) {
+      m.recompute_all();  // stale records piled up: start the wheels afresh
+    }
   }
 
   // Greedy split/merge (D97 section 5): split the worst leaf while it exceeds the threshold,
@@ -680,9 +783,8 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
   m.st.max_remaining_error = m.split.empty() ? 0.0 : std::max(0.0f, m.split.top().key);
   m.st.dirty_patches = static_cast<std::uint32_t>(m.dirty_list.size());
   m.st.memory_bytes = m.nodes.capacity() * sizeof(Node) + m.split.memory_bytes() +
-                      m.merge.memory_bytes() +
-                      (m.by_distance.size() + m.by_angle.size()) * sizeof(Expiry) +
-                      m.free_pairs.capacity() * sizeof(std::uint32_t);
+                      m.merge.memory_bytes() + m.by_distance.memory_bytes() +
+                      m.by_angle.memory_bytes() + m.free_pairs.capacity() * sizeof(std::uint32_t);
   for (const PatchMesh& pm : m.meshes)
     m.st.memory_bytes += pm.vertices.capacity() * sizeof(MeshVertex) +
                          pm.indices.capacity() * sizeof(std::uint32_t) + pm.padding.capacity();

@@ -11,6 +11,7 @@
 #include <optional>
 #include <random>
 #include <set>
+#include <tuple>
 
 #include "ridgeline/roam_view.h"
 
@@ -476,4 +477,15 @@ TEST(Roam, GeomorphFactorIsZeroAtTheSplitAndOneAtTwiceTheThreshold) {
   EXPECT_FLOAT_EQ(morph_factor(1.0f, 50.0, 200.0, 2.0), 1.0f);   // p = 4
   EXPECT_NEAR(morph_factor(1.0f, 66.6667, 200.0, 2.0), 0.5f, 1e-3f);
   EXPECT_FLOAT_EQ(morph_factor(0.0f, 10.0, 200.0, 2.0), 1.0f);
+}
+
+TEST(Landscape, ConstantTimeGeometryMatchesThePathWalk) {
+  auto l = make_landscape(129, 5);
+  for (std::uint32_t root = 0; root < l->root_count(); ++root)
+    for (std::uint64_t h = 1; h < (std::uint64_t{1} << (l->max_level() + 1)); ++h) {
+      const LatticeTriangle a = l->triangle(root, h);
+      const LatticeTriangle b = l->triangle_at(a.ax, a.az, root, h);
+      ASSERT_EQ(std::tie(a.lx, a.lz, a.rx, a.rz), std::tie(b.lx, b.lz, b.rx, b.rz))
+          << "root " << root << " heap " << h;
+    }
 }

@@ -57,6 +57,25 @@ class Landscape {
 
   /// Geometry of node `heap` of root `root`.
   LatticeTriangle triangle(std::uint32_t root, std::uint64_t heap) const noexcept;
+  /// Geometry of node `heap` of root `root` whose apex is (ax, az), in O(1): the direction from
+  /// the apex to the hypotenuse midpoint follows from the root and the path bits, its length from
+  /// the level.
+  LatticeTriangle triangle_at(std::int64_t ax, std::int64_t az, std::uint32_t root,
+                              std::uint64_t heap) const noexcept {
+    static constexpr int kUx[8] = {1, 1, 0, -1, -1, -1, 0, 1};
+    static constexpr int kUz[8] = {0, 1, 1, 1, 0, -1, -1, -1};
+    const int level = 63 - __builtin_clzll(heap);
+    const int dir = ((root & 1) ? 7 : 3) + 3 * level + 2 * (__builtin_popcountll(heap) - 1);
+    const int k = dir & 7;
+    const std::int64_t s2 = patch_cells() >> (level / 2);  // twice the apex-midpoint distance
+    const std::int64_t ux = kUx[k], uz = kUz[k], px = -uz, pz = ux;  // p: u turned +90 degrees
+    return {ax,
+            az,
+            ax + (ux + px) * s2 / 2,
+            az + (uz + pz) * s2 / 2,
+            ax + (ux - px) * s2 / 2,
+            az + (uz - pz) * s2 / 2};
+  }
   /// Geometry of a child given its parent's (child 0 or 1).
   static LatticeTriangle child_triangle(const LatticeTriangle& parent, int child) noexcept;
 
@@ -72,7 +91,10 @@ class Landscape {
 
   /// Height of lattice vertex (i, j) relative to the heightfield's offset, with the padding rule.
   float lattice_height(std::int64_t i, std::int64_t j) const noexcept {
-    return terrain_->heightfield().local_clamped(i, j);
+    const Heightfield& hf = terrain_->heightfield();
+    if (i >= 0 && j >= 0 && i < std::int64_t(hf.width()) && j < std::int64_t(hf.height()))
+      return hf.local(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j));
+    return hf.local_clamped(i, j);
   }
   /// World x / z of a lattice index.
   double world_x(std::int64_t i) const noexcept { return origin_x_ + double(i) * spacing_x_; }

@@ -53,6 +53,8 @@ struct RoamStats {
   std::uint32_t forced_splits = 0;  ///< splits forced to keep the mesh conforming
   std::uint32_t merges = 0;
   std::uint32_t priority_updates = 0;  ///< nodes whose priority was (re)computed ("visited")
+  std::uint32_t expired = 0;  ///< queued keys recomputed because the camera left their window
+  std::uint32_t expiry_records = 0;  ///< expiry records examined (including stale ones)
   double update_ms = 0;
   StopReason stop = StopReason::kConverged;
   bool rebuilt = false;  ///< the mesh was rebuilt top-down (rebuild mode, a teleport, a snap turn)
