@@ -24,18 +24,9 @@ namespace ridgeline {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-// Footprints of nodes are widened by this many grid units so that rounding in u0 + du * t never
-// drops a node the ray touches; the exact cell tests decide.
-constexpr double kPad = 1e-7;
 // Direction components below this (after normalisation) are zero: over any representable ray
 // length they move the ray by far less than a nanometre, and they would overflow 1 / d.
 constexpr double kTinyDirection = 1e-150;
-
-// A ray "touches" the surface where its height above it is at most this (metres): a few units of
-// double rounding of heights of that size, far below anything physical.
-inline double touch_tolerance(double h) noexcept {
-  return 1e-9 * (1.0 + std::abs(h));
-}
 
 // Narrows [t0, t1] to the part where o + d * t lies in [a, b]. False when empty.
 inline bool clip_axis(double o, double d, double inv, double a, double b, double& t0,
@@ -58,7 +49,11 @@ struct RayHierarchy::Ray {
   glm::dvec3 origin, dir;  // world origin and unit direction
 };
 
-RayHierarchy::RayHierarchy(const Heightfield& hf) {
+RayHierarchy::RayHierarchy(const Heightfield& hf)
+    : inv_sx_(1.0 / hf.spacing_x()),
+      inv_sz_(1.0 / hf.spacing_z()),
+      touch_(1e-9 *
+             (1.0 + std::max(std::abs(double(hf.min_local())), std::abs(double(hf.max_local()))))) {
   const std::uint32_t cells_x = hf.width() - 1, cells_z = hf.height() - 1;
   Level leaf;
   leaf.nx = (cells_x + kLeafCells - 1) >> kLeafShift;
@@ -112,12 +107,12 @@ std::size_t RayHierarchy::memory_bytes() const noexcept {
 namespace {
 
 // Fills a hit on triangle `tri` of cell (i, j) at distance t.
-void fill_hit(const Heightfield& hf, const glm::dvec3& origin, const glm::dvec3& dir,
-              std::uint32_t i, std::uint32_t j, const CellTriangle& tri, double t,
-              bool started_below, RayHit& hit) noexcept {
+void fill_hit(const Heightfield& hf, double inv_sx, double inv_sz, const glm::dvec3& origin,
+              const glm::dvec3& dir, std::uint32_t i, std::uint32_t j, const CellTriangle& tri,
+              double t, bool started_below, RayHit& hit) noexcept {
   hit.distance = t;
   hit.point = t == 0.0 ? origin : origin + dir * t;
-  hit.normal = detail::face_normal(hf, i, j, tri);
+  hit.normal = detail::face_normal(hf, inv_sx, inv_sz, i, j, tri);
   hit.material = hf.material(i, j);
   hit.started_below = started_below;
 }
@@ -131,10 +126,11 @@ bool RayHierarchy::leaf_hit(const Heightfield& hf, const Ray& r, std::uint32_t b
   const std::int64_t cj0 = std::int64_t{bz} << kLeafShift;
   const std::int64_t ci1 = std::min<std::int64_t>(ci0 + kLeafCells, hf.width() - 1) - 1;
   const std::int64_t cj1 = std::min<std::int64_t>(cj0 + kLeafCells, hf.height() - 1) - 1;
-  std::int64_t ci =
-      std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor(r.u0 + r.du * ta)), ci0, ci1);
-  std::int64_t cj =
-      std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor(r.v0 + r.dv * ta)), cj0, cj1);
+  // Truncation acts as floor here: anything below 0 is clamped up to ci0 >= 0 anyway.
+  std::int64_t ci = std::clamp<std::int64_t>(
+      static_cast<std::int64_t>(std::max(r.u0 + r.du * ta, -1.0)), ci0, ci1);
+  std::int64_t cj = std::clamp<std::int64_t>(
+      static_cast<std::int64_t>(std::max(r.v0 + r.dv * ta, -1.0)), cj0, cj1);
   const int step_u = r.du > 0 ? 1 : -1, step_v = r.dv > 0 ? 1 : -1;
   double t = ta;
   for (;;) {
@@ -155,7 +151,7 @@ bool RayHierarchy::leaf_hit(const Heightfield& hf, const Ray& r, std::uint32_t b
     const float h01 = hf.local(i, j + 1), h11 = hf.local(i + 1, j + 1);
     const double cmax = std::max(std::max(h00, h10), std::max(h01, h11));
     const double ylow = r.y0 + r.dy * (r.dy < 0 ? tc : t);
-    if (ylow <= cmax + touch_tolerance(cmax)) {
+    if (ylow <= cmax + touch_) {
       // Split [t, tc] where the ray crosses the cell's diagonal (surface.h decides which one).
       const double ou = r.u0 - double(ci), ov = r.v0 - double(cj);
       const bool main = cell_has_main_diagonal(ci, cj);
@@ -180,15 +176,15 @@ bool RayHierarchy::leaf_hit(const Heightfield& hf, const Ray& r, std::uint32_t b
         const double ha = plane.at(ou + r.du * pa, ov + r.dv * pa);
         const double fa = (r.y0 + r.dy * pa) - ha;
         double th;
-        if (fa <= touch_tolerance(ha)) {
+        if (fa <= touch_) {
           th = pa;
         } else {
           const double hb = plane.at(ou + r.du * pb, ov + r.dv * pb);
           const double fb = (r.y0 + r.dy * pb) - hb;
-          if (fb > touch_tolerance(hb)) continue;
+          if (fb > touch_) continue;
           th = fb <= 0 ? std::clamp(pa + (pb - pa) * (fa / (fa - fb)), pa, pb) : pb;
         }
-        fill_hit(hf, r.origin, r.dir, i, j, tri, th, false, hit);
+        fill_hit(hf, inv_sx_, inv_sz_, r.origin, r.dir, i, j, tri, th, false, hit);
         return true;
       }
     }
@@ -213,20 +209,24 @@ std::optional<RayHit> RayHierarchy::raycast(const Heightfield& hf, const glm::dv
     if (!std::isfinite(origin[a]) || !std::isfinite(direction[a])) return std::nullopt;
   // Normalise without overflow: scale by the largest component first.
   const double m = std::max({std::abs(direction.x), std::abs(direction.y), std::abs(direction.z)});
-  if (!(m > 0.0)) return std::nullopt;  // zero direction
-  glm::dvec3 d = direction / m;
-  d /= std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
-  if (std::abs(d.x) < kTinyDirection) d.x = 0.0;
-  if (std::abs(d.z) < kTinyDirection) d.z = 0.0;
+  if (!(m > 0.0)) return std::nullopt;                     // zero direction
+  glm::dvec3 d(0.0, direction.y > 0.0 ? 1.0 : -1.0, 0.0);  // vertical: nothing to compute
+  if (direction.x != 0.0 || direction.z != 0.0) {
+    d = direction / m;
+    d /= std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+    if (std::abs(d.x) < kTinyDirection) d.x = 0.0;
+    if (std::abs(d.z) < kTinyDirection) d.z = 0.0;
+  }
 
   Ray r;
   r.origin = origin;
   r.dir = d;
-  r.u0 = (origin.x - hf.origin_x()) / hf.spacing_x();
-  r.v0 = (origin.z - hf.origin_z()) / hf.spacing_z();
+  // Multiplied by 1 / spacing like Terrain's point queries, so both locate the same cell.
+  r.u0 = (origin.x - hf.origin_x()) * inv_sx_;
+  r.v0 = (origin.z - hf.origin_z()) * inv_sz_;
   r.y0 = origin.y - hf.height_offset();
-  r.du = d.x / hf.spacing_x();
-  r.dv = d.z / hf.spacing_z();
+  r.du = d.x * inv_sx_;
+  r.dv = d.z * inv_sz_;
   r.dy = d.y;
   r.inv_du = r.du != 0.0 ? 1.0 / r.du : 0.0;
   r.inv_dv = r.dv != 0.0 ? 1.0 / r.dv : 0.0;
@@ -250,8 +250,8 @@ std::optional<RayHit> RayHierarchy::raycast(const Heightfield& hf, const glm::dv
     const CellTriangle tri = locate_in_cell(i, j, static_cast<float>(fu), static_cast<float>(fv));
     const double h = detail::cell_plane(hf, i, j, tri).at(fu, fv);
     const double f = (r.y0 + r.dy * t) - h;
-    if (f <= touch_tolerance(h)) {
-      fill_hit(hf, origin, d, i, j, tri, t, t == 0.0 && f < 0.0, hit);
+    if (f <= touch_) {
+      fill_hit(hf, inv_sx_, inv_sz_, origin, d, i, j, tri, t, t == 0.0 && f < 0.0, hit);
       return hit;
     }
     if (r.du == 0.0 && r.dv == 0.0) {
@@ -259,50 +259,65 @@ std::optional<RayHit> RayHierarchy::raycast(const Heightfield& hf, const glm::dv
       if (r.dy >= 0.0) return std::nullopt;
       const double th = f / -r.dy;
       if (th > r.t_exit) return std::nullopt;
-      fill_hit(hf, origin, d, i, j, tri, th, false, hit);
+      fill_hit(hf, inv_sx_, inv_sz_, origin, d, i, j, tri, th, false, hit);
       return hit;
     }
   }
 
-  // Front-to-back descent. Children are visited near first, far last; of the two others, the
-  // one across the axis the ray does not move along comes first (a ray exactly on a node
-  // boundary touches both halves along that axis during the same t).
-  struct Entry {
-    std::uint32_t level, x, z;
-  };
-  Entry stack[4 * 40];
-  int sp = 0;
-  stack[sp++] = {static_cast<std::uint32_t>(levels_.size() - 1), 0, 0};
-  const std::uint32_t nu = r.du < 0 ? 1 : 0, nv = r.dv < 0 ? 1 : 0;
-  const bool u_first = r.du == 0.0 || r.dv != 0.0;
-  const std::uint32_t order_x[4] = {nu, u_first ? 1 - nu : nu, u_first ? nu : 1 - nu, 1 - nu};
-  const std::uint32_t order_z[4] = {nv, u_first ? nv : 1 - nv, u_first ? 1 - nv : nv, 1 - nv};
-
-  while (sp > 0) {
-    const Entry e = stack[--sp];
-    const Level& level = levels_[e.level];
-    const Range range = level.nodes[e.x + std::size_t{e.z} * level.nx];
-    const std::uint32_t shift = e.level + kLeafShift;
-    const double ua = double(std::uint64_t{e.x} << shift);
-    const double ub = std::min(double(std::uint64_t{e.x + 1} << shift), umax);
-    const double va = double(std::uint64_t{e.z} << shift);
-    const double vb = std::min(double(std::uint64_t{e.z + 1} << shift), vmax);
-    double ta = r.t_enter, tb = r.t_exit;
-    if (!clip_axis(r.u0, r.du, r.inv_du, ua - kPad, ub + kPad, ta, tb)) continue;
-    if (!clip_axis(r.v0, r.dv, r.inv_dv, va - kPad, vb + kPad, ta, tb)) continue;
-    const double ylow = r.y0 + r.dy * (r.dy < 0 ? tb : ta);
-    if (ylow > double(range.max) + touch_tolerance(range.max)) continue;
-    if (e.level == 0) {
-      if (leaf_hit(hf, r, e.x, e.z, ta, tb, hit)) return hit;
-      continue;
+  // Hierarchical DDA (after Tevs et al. 2008): walk the nodes of level L along the ray; a node
+  // the ray passes above is skipped, stepping to its neighbour and climbing a level when that
+  // crosses the parent's boundary; otherwise descend into the child holding the ray, down to the
+  // leaf blocks, whose cells are tested in ray order. Stepping is in integer node coordinates,
+  // one axis at a time, so every node the ray touches is visited (through a corner, the side node
+  // gets an empty interval) and the walk always advances.
+  const int top = static_cast<int>(levels_.size()) - 1;
+  int l = top;
+  std::int64_t x = 0, z = 0;
+  double t = r.t_enter;
+  const int step_u = r.du > 0 ? 1 : -1, step_v = r.dv > 0 ? 1 : -1;
+  for (;;) {
+    const Level& level = levels_[l];
+    const double size = double(std::int64_t{1} << (l + kLeafShift));
+    const double ua = double(x) * size, va = double(z) * size;
+    const double ub = std::min(ua + size, umax), vb = std::min(va + size, vmax);
+    const double tnu = r.du > 0 ? (ub - r.u0) * r.inv_du : r.du < 0 ? (ua - r.u0) * r.inv_du : kInf;
+    const double tnv = r.dv > 0 ? (vb - r.v0) * r.inv_dv : r.dv < 0 ? (va - r.v0) * r.inv_dv : kInf;
+    const double t_out = std::max(t, std::min(std::min(tnu, tnv), r.t_exit));
+    const float node_max = level.nodes[std::size_t(x) + std::size_t(z) * level.nx].max;
+    const double ylow = r.y0 + r.dy * (r.dy < 0 ? t_out : t);
+    if (ylow <= double(node_max) + touch_) {
+      if (l > 0) {
+        // Descend into the child that holds the ray at t (ties go the way the ray moves).
+        --l;
+        const double mu = ua + 0.5 * size, mv = va + 0.5 * size;
+        const double u = r.u0 + r.du * t, v = r.v0 + r.dv * t;
+        x = 2 * x + ((u > mu || (u == mu && r.du > 0)) ? 1 : 0);
+        z = 2 * z + ((v > mv || (v == mv && r.dv > 0)) ? 1 : 0);
+        x = std::min<std::int64_t>(x, levels_[l].nx - 1);
+        z = std::min<std::int64_t>(z, levels_[l].nz - 1);
+        continue;
+      }
+      if (leaf_hit(hf, r, std::uint32_t(x), std::uint32_t(z), t, t_out, hit)) return hit;
     }
-    const Level& below = levels_[e.level - 1];
-    for (int k = 3; k >= 0; --k) {
-      const std::uint32_t cx = 2 * e.x + order_x[k], cz = 2 * e.z + order_z[k];
-      if (cx < below.nx && cz < below.nz) stack[sp++] = {e.level - 1, cx, cz};
+    // Step to the next node along the ray.
+    if (t_out >= r.t_exit) return std::nullopt;
+    bool climb;
+    if (tnu <= tnv) {
+      x += step_u;
+      if (x < 0 || x >= level.nx) return std::nullopt;
+      climb = (x & 1) == (step_u > 0 ? 0 : 1);  // crossed into another parent
+    } else {
+      z += step_v;
+      if (z < 0 || z >= level.nz) return std::nullopt;
+      climb = (z & 1) == (step_v > 0 ? 0 : 1);
+    }
+    t = t_out;
+    if (climb && l < top) {
+      ++l;
+      x >>= 1;
+      z >>= 1;
     }
   }
-  return std::nullopt;
 }
 
 std::size_t RayHierarchy::triangles_in_box(const Heightfield& hf, const Box& box,

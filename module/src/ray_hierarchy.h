@@ -40,8 +40,8 @@ inline CellPlane cell_plane(const Heightfield& hf, std::uint32_t i, std::uint32_
   const double e2u = double(t.di[2]) - t.di[0], e2v = double(t.dj[2]) - t.dj[0];
   // The corners of a lattice triangle span a unit-area parallelogram: det is +-1.
   const double det = e1u * e2v - e1v * e2u;
-  const double gu = ((h1 - h0) * e2v - (h2 - h0) * e1v) / det;
-  const double gv = ((h2 - h0) * e1u - (h1 - h0) * e2u) / det;
+  const double gu = ((h1 - h0) * e2v - (h2 - h0) * e1v) * det;  // 1 / det == det
+  const double gv = ((h2 - h0) * e1u - (h1 - h0) * e2u) * det;
   return {h0, double(t.di[0]), double(t.dj[0]), gu, gv};
 }
 
@@ -52,10 +52,15 @@ inline V unit(const V& v) noexcept {
   return v / std::sqrt(glm::dot(v, v));
 }
 
-/// Unit upward face normal of lattice triangle `t` of cell (i, j).
-inline glm::vec3 face_normal(const Heightfield& hf, std::uint32_t i, std::uint32_t j,
-                             const CellTriangle& t) noexcept {
-  return glm::vec3(unit(cell_triangle_cross(hf, i, j, t)));
+/// Unit upward face normal of lattice triangle `t` of cell (i, j): (-dh/dx, 1, -dh/dz)
+/// normalised, from the triangle's plane. `inv_sx`, `inv_sz` are 1 / spacing. A flat triangle
+/// gives exactly (0, 1, 0).
+inline glm::vec3 face_normal(const Heightfield& hf, double inv_sx, double inv_sz, std::uint32_t i,
+                             std::uint32_t j, const CellTriangle& t) noexcept {
+  const CellPlane p = cell_plane(hf, i, j, t);
+  const double nx = -p.gu * inv_sx, nz = -p.gv * inv_sz;
+  const double inv_len = 1.0 / std::sqrt(nx * nx + 1.0 + nz * nz);
+  return {float(nx * inv_len), float(inv_len), float(nz * inv_len)};
 }
 
 /// Triangle `which` (0 or 1, as CellTriangle::which) of cell (i, j), located through
@@ -95,6 +100,11 @@ class RayHierarchy {
   /// Number of levels (level 0 = leaf blocks).
   std::size_t levels() const noexcept { return levels_.size(); }
 
+  /// A ray "touches" the surface where its height above it is at most this (metres): about a
+  /// million units of double rounding of the field's largest local height, far below anything
+  /// physical (1e-9 * (1 + max |local height|)).
+  double touch_tolerance() const noexcept { return touch_; }
+
  private:
   struct Range {
     float min, max;  ///< local heights (relative to the heightfield offset), metres
@@ -109,6 +119,8 @@ class RayHierarchy {
                 double ta, double tb, RayHit& hit) const noexcept;
 
   std::vector<Level> levels_;
+  double inv_sx_ = 1, inv_sz_ = 1;  // 1 / spacing
+  double touch_ = 1e-9;
 };
 
 }  // namespace ridgeline

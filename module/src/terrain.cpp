@@ -64,7 +64,7 @@ std::optional<double> Terrain::height(double x, double z) const noexcept {
 std::optional<glm::vec3> Terrain::face_normal(double x, double z) const noexcept {
   Located p;
   if (!locate(heightfield_, inv_spacing_x_, inv_spacing_z_, x, z, p)) return std::nullopt;
-  return detail::face_normal(heightfield_, p.i, p.j, p.tri);
+  return detail::face_normal(heightfield_, inv_spacing_x_, inv_spacing_z_, p.i, p.j, p.tri);
 }
 
 std::optional<glm::vec3> Terrain::smooth_normal(double x, double z) const noexcept {
@@ -81,7 +81,8 @@ std::optional<HeightNormal> Terrain::height_normal(double x, double z) const noe
   if (!locate(heightfield_, inv_spacing_x_, inv_spacing_z_, x, z, p)) return std::nullopt;
   HeightNormal s;
   s.height = heightfield_.height_offset() + double(local_height(heightfield_, p));
-  s.face_normal = detail::face_normal(heightfield_, p.i, p.j, p.tri);
+  s.face_normal =
+      detail::face_normal(heightfield_, inv_spacing_x_, inv_spacing_z_, p.i, p.j, p.tri);
   s.material = heightfield_.material(p.i, p.j);
   return s;
 }
@@ -91,7 +92,8 @@ std::optional<SurfaceSample> Terrain::sample(double x, double z) const noexcept 
   if (!locate(heightfield_, inv_spacing_x_, inv_spacing_z_, x, z, p)) return std::nullopt;
   SurfaceSample s;
   s.height = heightfield_.height_offset() + double(local_height(heightfield_, p));
-  s.face_normal = detail::face_normal(heightfield_, p.i, p.j, p.tri);
+  s.face_normal =
+      detail::face_normal(heightfield_, inv_spacing_x_, inv_spacing_z_, p.i, p.j, p.tri);
   glm::vec3 n(0.0f);
   for (int k = 0; k < 3; ++k)
     n += p.tri.w[k] * detail::vertex_normal(heightfield_, p.i + p.tri.di[k], p.j + p.tri.dj[k]);
