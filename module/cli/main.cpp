@@ -7,6 +7,24 @@
 #include "cli_util.h"
 #include "commands.h"
 
+// OpenImageIO 2.4's PNG reader leaks one error string per truncated file: its read callback
+// calls geterror() and then png_error() longjmps over the string's destructor. Not ours to fix;
+// suppressed so the sanitizer build still catches every other leak.
+#if defined(__SANITIZE_ADDRESS__)
+#define RIDGELINE_LSAN_SUPPRESSIONS 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define RIDGELINE_LSAN_SUPPRESSIONS 1
+#endif
+#endif
+#ifdef RIDGELINE_LSAN_SUPPRESSIONS
+extern "C" const char* __lsan_default_suppressions() {
+  // Matched on geterror (where the string is allocated): OIIO is built without frame pointers, so
+  // the fast unwinder often stops there before reaching PngReadCallback.
+  return "leak:PNGInput::PngReadCallback\nleak:ImageInput::geterror\n";
+}
+#endif
+
 int main(int argc, char** argv) {
   using namespace ridgeline::cli;
   CLI::App app{"ridge: the Ridgeline terrain tool (heightmap info, queries, profiles, benchmarks)",
@@ -16,9 +34,11 @@ int main(int argc, char** argv) {
   commands.push_back(add_info_command(app));
   commands.push_back(add_query_command(app));
   commands.push_back(add_profile_command(app));
+  commands.push_back(add_mesh_command(app));
   auto* bench = app.add_subcommand("bench", "Benchmarks that print JSON");
   bench->require_subcommand(1);
   commands.push_back(add_bench_queries_command(*bench));
+  commands.push_back(add_bench_lod_command(*bench));
 
   try {
     app.parse(argc, argv);
