@@ -18,6 +18,10 @@ Command add_info_command(CLI::App& parent);
 Command add_query_command(CLI::App& parent);
 /// `ridge profile --from X,Z --to X,Z --steps N`: a text profile with an ASCII plot.
 Command add_profile_command(CLI::App& parent);
+/// `ridge mesh`: converge a ROAM mesh for one view, write it as .glb (cmd_roam.cpp).
+Command add_mesh_command(CLI::App& parent);
+/// `ridge bench lod`: per-frame ROAM cost and error along a camera path (cmd_roam.cpp).
+Command add_bench_lod_command(CLI::App& bench);
 /// `ridge bench queries`: query speed (JSON), measured by bench_queries.h.
 Command add_bench_queries_command(CLI::App& bench);
 

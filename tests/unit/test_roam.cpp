@@ -489,3 +489,28 @@ TEST(Landscape, ConstantTimeGeometryMatchesThePathWalk) {
           << "root " << root << " heap " << h;
     }
 }
+
+TEST(Roam, MeasuredErrorAgreesWithTheBoundsAndTheThreshold) {
+  auto l = make_landscape(257, 5);
+  auto view = RoamView::create(l, {.threshold = 2.0}).value();
+  const Camera c = camera_at({20, 120, 30}, {300, 60, 260});
+  ASSERT_TRUE(view->update(c));
+  const auto e = view->measure_error(c);
+  EXPECT_GT(e.vertices, 10000u);
+  EXPECT_GT(e.max_m, 0.0);
+  EXPECT_LE(e.rms_m, e.max_m);
+  // Converged: the measured screen error at each vertex is at most the threshold, since each
+  // vertex is at least as far as its leaf's bounding box and under its leaf's bound.
+  EXPECT_LE(e.max_px, 2.0 * (1 + 1e-6));
+  // A stratified sample sees fewer vertices and no larger error.
+  const auto s = view->measure_error(c, 4);
+  EXPECT_LT(s.vertices, e.vertices / 8);
+  EXPECT_LE(s.max_m, e.max_m);
+  // World-metre mode: every vertex, error within the tolerance.
+  auto w = RoamView::create(l, {.metric = ErrorMetric::kWorldMetres, .threshold = 3.0}).value();
+  ASSERT_TRUE(w->update(Camera{}));
+  const auto we = w->measure_error(Camera{});
+  EXPECT_EQ(we.vertices, 257u * 257u);
+  EXPECT_LE(we.max_m, 3.0);
+  EXPECT_GT(we.max_m, 1.0);
+}

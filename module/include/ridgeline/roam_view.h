@@ -135,6 +135,17 @@ class RoamView {
   /// 64-bit hash of the leaf set (for determinism checks).
   std::uint64_t mesh_hash() const;
 
+  /// Measured error of the mesh (SPEC.md): |mesh height - surface height| at the lattice vertices
+  /// inside `camera`'s frustum (every vertex with ErrorMetric::kWorldMetres), taking every
+  /// `stride`-th vertex along each axis (1 = all; a fixed stratified sample otherwise), and the
+  /// same error projected to pixels at each vertex's own distance.
+  struct MeasuredError {
+    double max_m = 0, rms_m = 0;     ///< metres
+    double max_px = 0, p99_px = 0;   ///< pixels (0 with ErrorMetric::kWorldMetres)
+    std::uint64_t vertices = 0;      ///< vertices measured
+  };
+  MeasuredError measure_error(const Camera& camera, std::uint32_t stride = 1) const;
+
   /// Checks the mesh's structural invariants (neighbour links symmetric, every leaf edge shared
   /// with exactly one other leaf or on the landscape border, no T-junctions). Returns an empty
   /// string when they hold, else a description of the first violation. O(triangles).

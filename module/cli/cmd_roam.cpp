@@ -1,0 +1,336 @@
+// `ridge mesh` (converge a ROAM mesh for one view and export it as .glb) and `ridge bench lod`
+// (run a camera path and report per-frame cost and error as JSON).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+
+#include "cli_util.h"
+#include "commands.h"
+#include "ridgeline/camera_path.h"
+#include "ridgeline/gltf_export.h"
+#include "ridgeline/roam_view.h"
+#include "terrain_args.h"
+
+namespace ridgeline::cli {
+
+namespace {
+
+// Flags shared by mesh and bench lod: the landscape and the LOD settings.
+struct LodArgs {
+  TerrainArgs terrain;
+  std::string patch_exponent = "6", threshold, triangles, tolerance, budget_ms, mode = "coherent",
+              slack;
+  std::string json_path;
+
+  void add_to(CLI::App& app, bool with_tolerance) {
+    terrain.add_to(app);
+    auto* g = app.add_option_group("Level of detail");
+    g->add_option("--patch-exponent", patch_exponent,
+                  "Patches of 2^K cells per side, K in 2..10 (default 6: 65 x 65 samples)")
+        ->type_name("K");
+    g->add_option("--threshold", threshold, "Detail threshold in screen pixels")->type_name("PX");
+    g->add_option("--triangles", triangles,
+                  "Hard cap on leaf triangles (alone: the best mesh of at most N triangles)")
+        ->type_name("N");
+    if (with_tolerance)
+      g->add_option("--tolerance", tolerance,
+                    "View-independent mode: every triangle within METRES of the samples under it; "
+                    "whole terrain, no culling")
+          ->type_name("METRES");
+    g->add_option("--budget-ms", budget_ms, "Time budget per update, milliseconds")
+        ->type_name("MS");
+    g->add_option("--mode", mode, "coherent (split/merge queues) or rebuild (split only, Turner)")
+        ->type_name("MODE");
+    g->add_option("--slack", slack, "Priority window as a fraction of distance (default 0.05)")
+        ->type_name("F");
+    app.add_option("--json", json_path, "Write the JSON to FILE instead of standard output")
+        ->type_name("FILE");
+  }
+
+  Result<RoamSettings> settings() const {
+    RoamSettings s;
+    if (!threshold.empty() + !triangles.empty() + !tolerance.empty() == 0)
+      return Error{"give --threshold PX, --triangles N or --tolerance METRES"};
+    if (!tolerance.empty() && !threshold.empty())
+      return Error{
+          "--tolerance (metres, view independent) and --threshold (pixels) exclude "
+          "each other"};
+    if (!threshold.empty()) {
+      auto t = parse_finite(threshold, "--threshold");
+      if (!t) return t.error();
+      if (*t < 0) return Error{"--threshold must be >= 0"};
+      s.threshold = *t;
+    } else if (!tolerance.empty()) {
+      auto t = parse_finite(tolerance, "--tolerance");
+      if (!t) return t.error();
+      if (*t < 0) return Error{"--tolerance must be >= 0"};
+      s.threshold = *t;
+      s.metric = ErrorMetric::kWorldMetres;
+    } else {
+      s.threshold = 0.0;  // only the triangle cap limits refinement
+    }
+    if (!triangles.empty()) {
+      auto n = parse_count(triangles, "--triangles", 1, 0xffffffffu);
+      if (!n) return n.error();
+      s.max_triangles = static_cast<std::uint32_t>(*n);
+    }
+    if (!budget_ms.empty()) {
+      auto b = parse_finite(budget_ms, "--budget-ms");
+      if (!b) return b.error();
+      if (*b < 0) return Error{"--budget-ms must be >= 0"};
+      s.budget_ms = *b;
+    }
+    if (!slack.empty()) {
+      auto f = parse_finite(slack, "--slack");
+      if (!f) return f.error();
+      s.slack = *f;
+    }
+    if (mode == "coherent")
+      s.mode = RoamMode::kCoherent;
+    else if (mode == "rebuild")
+      s.mode = RoamMode::kRebuild;
+    else
+      return Error{"--mode '" + mode + "': need coherent or rebuild"};
+    return s;
+  }
+
+  Result<std::unique_ptr<RoamView>> view(double* bounds_ms, std::size_t* bound_bytes) const {
+    auto s = settings();
+    if (!s) return s.error();
+    auto k = parse_count(patch_exponent, "--patch-exponent", 2, 10);
+    if (!k) return k.error();
+    auto t = terrain.load_terrain();
+    if (!t) return t.error();
+    auto l = Landscape::create(*t, {.patch_exponent = static_cast<std::uint32_t>(*k)});
+    if (!l) return l.error();
+    *bounds_ms = (*l)->build_ms();
+    *bound_bytes = (*l)->bound_bytes();
+    return RoamView::create(*l, *s);
+  }
+};
+
+nlohmann::ordered_json stats_json(const RoamStats& s) {
+  const char* stop = s.stop == StopReason::kConverged        ? "converged"
+                     : s.stop == StopReason::kTriangleBudget ? "triangles"
+                                                             : "time";
+  return {{"triangles", s.triangles},
+          {"splits", s.splits},
+          {"forced_splits", s.forced_splits},
+          {"merges", s.merges},
+          {"priority_updates", s.priority_updates},
+          {"update_ms", s.update_ms},
+          {"stopped_by", stop},
+          {"rebuilt", s.rebuilt},
+          {"max_remaining_error", s.max_remaining_error},
+          {"memory_bytes", s.memory_bytes}};
+}
+
+// ---- ridge mesh ---------------------------------------------------------------------------
+
+struct MeshArgs {
+  LodArgs lod;
+  std::string eye, target, up = "0,1,0", fov = "60", viewport = "1280,720", far = "50000", out;
+  bool include_padding = false;
+};
+
+int run_mesh(const MeshArgs& a) {
+  Camera c;
+  const bool tolerance = !a.lod.tolerance.empty();
+  if (!tolerance || !a.eye.empty()) {
+    if (a.eye.empty() || a.target.empty())
+      return report_error("give --eye X,Y,Z and --target X,Y,Z (or --tolerance alone)");
+    auto e = parse_finite_list(a.eye, "--eye", 3, 3);
+    if (!e) return report_error(e.error().message);
+    auto t = parse_finite_list(a.target, "--target", 3, 3);
+    if (!t) return report_error(t.error().message);
+    auto u = parse_finite_list(a.up, "--up", 3, 3);
+    if (!u) return report_error(u.error().message);
+    auto f = parse_finite(a.fov, "--fov-y");
+    if (!f) return report_error(f.error().message);
+    auto vp = parse_finite_list(a.viewport, "--viewport", 2, 2);
+    if (!vp) return report_error(vp.error().message);
+    auto fa = parse_finite(a.far, "--far");
+    if (!fa) return report_error(fa.error().message);
+    c.eye = {(*e)[0], (*e)[1], (*e)[2]};
+    c.target = {(*t)[0], (*t)[1], (*t)[2]};
+    c.up = {(*u)[0], (*u)[1], (*u)[2]};
+    c.fov_y_deg = *f;
+    if ((*vp)[0] < 1 || (*vp)[1] < 1 || (*vp)[0] > 65536 || (*vp)[1] > 65536)
+      return report_error("--viewport: need W,H in 1 .. 65536");
+    c.viewport = {int((*vp)[0]), int((*vp)[1])};
+    c.far_m = *fa;
+    if (auto s = validate_camera(c); !s) return report_error(s.message());
+  }
+  if (a.out.empty()) return report_error("give --out FILE.glb");
+  double bounds_ms = 0;
+  std::size_t bound_bytes = 0;
+  auto view = a.lod.view(&bounds_ms, &bound_bytes);
+  if (!view) return report_error(view.error().message);
+  auto st = (*view)->converge(c);
+  if (!st) return report_error(st.error().message);
+  const auto err = (*view)->measure_error(c);
+  io::GltfExportOptions go;
+  go.include_padding = a.include_padding;
+  if (auto s = io::write_glb(**view, a.out, go); !s) return report_error(s.message());
+  const Landscape& l = (*view)->landscape();
+  nlohmann::ordered_json j = stats_json(*st);
+  j["out"] = a.out;
+  j["patches"] = l.patch_count();
+  j["bounds_build_ms"] = bounds_ms;
+  j["bounds_bytes_per_sample"] =
+      double(bound_bytes) /
+      double(std::uint64_t{l.terrain().heightfield().width()} * l.terrain().heightfield().height());
+  j["measured_max_error_m"] = err.max_m;
+  j["measured_rms_error_m"] = err.rms_m;
+  j["measured_max_error_px"] = err.max_px;
+  j["measured_vertices"] = err.vertices;
+  if (auto s = write_json(j, a.lod.json_path); !s) return report_error(s.message());
+  return 0;
+}
+
+// ---- ridge bench lod ----------------------------------------------------------------------
+
+struct BenchLodArgs {
+  LodArgs lod;
+  std::string path, error_every = "1", error_stride = "1", warmup = "0", repeat = "1";
+};
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t k = std::min(v.size() - 1, static_cast<std::size_t>(q * double(v.size())));
+  return v[k];
+}
+
+int run_bench_lod(const BenchLodArgs& a) {
+  if (a.path.empty()) return report_error("give --path PATH.json");
+  auto frames = io::load_camera_path(a.path);
+  if (!frames) return report_error(frames.error().message);
+  auto every = parse_count(a.error_every, "--error-every", 0, 1000000);
+  if (!every) return report_error(every.error().message);
+  auto stride = parse_count(a.error_stride, "--error-stride", 1, 1024);
+  if (!stride) return report_error(stride.error().message);
+  auto warmup = parse_count(a.warmup, "--warmup", 0, 10000000);
+  if (!warmup) return report_error(warmup.error().message);
+  auto repeat = parse_count(a.repeat, "--repeat", 1, 1000);
+  if (!repeat) return report_error(repeat.error().message);
+  double bounds_ms = 0;
+  std::size_t bound_bytes = 0;
+  auto view = a.lod.view(&bounds_ms, &bound_bytes);
+  if (!view) return report_error(view.error().message);
+  RoamView& v = **view;
+
+  // Warm-up frames (the first frames of the path, not reported), then the path `repeat` times.
+  for (std::uint64_t k = 0; k < *warmup; ++k)
+    if (auto st = v.update((*frames)[k % frames->size()].camera); !st)
+      return report_error(st.error().message);
+  nlohmann::ordered_json out_frames = nlohmann::ordered_json::array();
+  std::vector<double> ms, tris, changes, max_err, rms_err, px_err;
+  std::uint32_t time_stops = 0, rebuilds = 0;
+  for (std::uint64_t rep = 0; rep < *repeat; ++rep) {
+    for (std::size_t k = 0; k < frames->size(); ++k) {
+      const Camera& c = (*frames)[k].camera;
+      auto st = v.update(c);
+      if (!st) return report_error(st.error().message);
+      (void)v.take_dirty_patches();
+      nlohmann::ordered_json f = {
+          {"update_ms", st->update_ms},
+          {"triangles", st->triangles},
+          {"splits", st->splits + st->forced_splits},
+          {"merges", st->merges},
+          {"priority_updates", st->priority_updates},
+          {"rebuilt", st->rebuilt},
+          {"stopped_by", st->stop == StopReason::kConverged        ? "converged"
+                         : st->stop == StopReason::kTriangleBudget ? "triangles"
+                                                                   : "time"}};
+      if (*every > 0 && k % *every == 0) {
+        const auto e = v.measure_error(c, static_cast<std::uint32_t>(*stride));
+        f["max_error"] = e.max_m;
+        f["rms_error"] = e.rms_m;
+        f["max_screen_error_px"] = e.max_px;
+        f["p99_screen_error_px"] = e.p99_px;
+        max_err.push_back(e.max_m);
+        rms_err.push_back(e.rms_m);
+        px_err.push_back(e.max_px);
+      }
+      f["max_remaining_error_px"] = st->max_remaining_error;
+      out_frames.push_back(f);
+      ms.push_back(st->update_ms);
+      tris.push_back(st->triangles);
+      changes.push_back(st->splits + st->forced_splits + st->merges);
+      time_stops += st->stop == StopReason::kTimeBudget;
+      rebuilds += st->rebuilt;
+    }
+  }
+  const RoamSettings s = v.settings();
+  nlohmann::ordered_json summary = {
+      {"frames", ms.size()},
+      {"mode", s.mode == RoamMode::kCoherent ? "coherent" : "rebuild"},
+      {"threshold", s.threshold},
+      {"max_triangles", s.max_triangles},
+      {"budget_ms", s.budget_ms},
+      {"update_ms_median", percentile(ms, 0.5)},
+      {"update_ms_p99", percentile(ms, 0.99)},
+      {"update_ms_max", percentile(ms, 1.0)},
+      {"triangles_median", percentile(tris, 0.5)},
+      {"triangles_p99", percentile(tris, 0.99)},
+      {"changes_per_frame_median", percentile(changes, 0.5)},
+      {"max_error_median", percentile(max_err, 0.5)},
+      {"max_error_max", percentile(max_err, 1.0)},
+      {"rms_error_median", percentile(rms_err, 0.5)},
+      {"max_screen_error_px_median", percentile(px_err, 0.5)},
+      {"time_budget_stops", time_stops},
+      {"rebuilds", rebuilds},
+      {"bounds_build_ms", bounds_ms},
+      {"bounds_bytes", bound_bytes},
+      {"error_every", *every},
+      {"error_stride", *stride},
+  };
+  if (s.budget_ms > 0) summary["time_budget_met"] = percentile(ms, 0.99) <= 1.1 * s.budget_ms + 0.1;
+  nlohmann::ordered_json j = {{"summary", summary}, {"frames", out_frames}};
+  if (auto st = write_json(j, a.lod.json_path); !st) return report_error(st.message());
+  return 0;
+}
+
+}  // namespace
+
+Command add_mesh_command(CLI::App& parent) {
+  auto* app = parent.add_subcommand(
+      "mesh", "Converge the ROAM mesh for one view and write it as glTF 2.0 binary (.glb)");
+  auto a = std::make_shared<MeshArgs>();
+  a->lod.add_to(*app, true);
+  auto* g = app->add_option_group("Camera");
+  g->add_option("--eye", a->eye, "Eye position")->type_name("X,Y,Z");
+  g->add_option("--target", a->target, "Point looked at")->type_name("X,Y,Z");
+  g->add_option("--up", a->up, "Up vector (default 0,1,0)")->type_name("X,Y,Z");
+  g->add_option("--fov-y", a->fov, "Vertical field of view, degrees (default 60)")
+      ->type_name("DEG");
+  g->add_option("--viewport", a->viewport, "Viewport in pixels (default 1280,720)")
+      ->type_name("W,H");
+  g->add_option("--far", a->far, "Far plane, metres (default 50000)")->type_name("M");
+  app->add_option("--out", a->out, "Output .glb file")->type_name("FILE.glb");
+  app->add_flag("--include-padding", a->include_padding,
+                "Also write triangles over the edge padding of the last patches");
+  return {app, [a] { return run_mesh(*a); }};
+}
+
+Command add_bench_lod_command(CLI::App& bench) {
+  auto* app = bench.add_subcommand(
+      "lod", "Run a camera path: per-frame update ms, triangles, splits, merges and error (JSON)");
+  auto a = std::make_shared<BenchLodArgs>();
+  a->lod.add_to(*app, false);
+  app->add_option("--path", a->path, "Camera path (SPEC.md PATH.json)")->type_name("PATH.json");
+  app->add_option("--error-every", a->error_every,
+                  "Measure the mesh error every K-th frame (default 1; 0 = never)")
+      ->type_name("K");
+  app->add_option("--error-stride", a->error_stride,
+                  "Measure every S-th lattice vertex along each axis (default 1 = all)")
+      ->type_name("S");
+  app->add_option("--warmup", a->warmup, "Unreported frames before the run (default 0)")
+      ->type_name("N");
+  app->add_option("--repeat", a->repeat, "Run the path N times (default 1)")->type_name("N");
+  return {app, [a] { return run_bench_lod(*a); }};
+}
+
+}  // namespace ridgeline::cli
