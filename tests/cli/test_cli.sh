@@ -211,6 +211,11 @@ run profile --default-terrain --from 0,0 --to 1; expect "profile bad --to" 1 "--
 run bench queries --heightmap "$PNG" --points 2000 --repetitions 1 --seed 3
 expect "bench queries" 0
 contains "bench JSON names the terrain" '"terrain"'
+for key in height_ns height_normal_ns vertical_ray_ns slanted_ray_ns; do
+  v=$(json_num "$key")
+  if [ -n "$v" ] && awk -v v="$v" 'BEGIN { exit !(v > 0) }'; then ok; else bad "bench $key > 0: '$v'"; fi
+done
+contains "bench JSON gives the point count" '"points": 2000'
 run bench queries --heightmap "$PNG" --points 2000 --repetitions 1 --json "$T/bench.json"
 expect "bench queries --json" 0
 grep -q '"terrain"' "$T/bench.json" && ok || bad "bench --json file"
