@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <glm/geometric.hpp>
 #include <random>
 #include <vector>
@@ -21,14 +22,28 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-// Runs `body` once and returns nanoseconds per item.
-template <class F>
-double ns_per(std::size_t items, F&& body) {
-  const auto t0 = Clock::now();
-  body();
-  const auto t1 = Clock::now();
-  return std::chrono::duration<double, std::nano>(t1 - t0).count() / double(items);
+// CPU time of the calling thread, nanoseconds: unlike wall time it does not count the time the
+// thread waits for a core, which on a shared 2-core machine can dominate.
+double thread_cpu_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) * 1e9 + double(ts.tv_nsec);
 }
+
+// Wall and thread-CPU nanoseconds per item of one run of a timed loop.
+struct Timing {
+  std::vector<double> wall, cpu;
+  template <class F>
+  void run(std::size_t items, F&& body) {
+    const double c0 = thread_cpu_ns();
+    const auto t0 = Clock::now();
+    body();
+    const auto t1 = Clock::now();
+    const double c1 = thread_cpu_ns();
+    wall.push_back(std::chrono::duration<double, std::nano>(t1 - t0).count() / double(items));
+    cpu.push_back((c1 - c0) / double(items));
+  }
+};
 
 struct Ray {
   glm::dvec3 origin, direction;
@@ -72,43 +87,43 @@ nlohmann::json bench_queries(const Terrain& terrain, const BenchQueriesOptions& 
     r.max_distance = glm::length(r.direction);
   }
 
-  std::vector<double> t_height, t_height_normal, t_sample, t_vertical, t_slanted;
+  Timing t_height, t_height_normal, t_sample, t_vertical, t_slanted;
   std::size_t hits_height = 0, hits_height_normal = 0, hits_sample = 0, hits_vertical = 0,
               hits_slanted = 0;
   double checksum = 0;
   for (int rep = 0; rep < reps; ++rep) {
     std::size_t hits = 0;
     double sum = 0;
-    t_height.push_back(ns_per(n, [&] {
+    t_height.run(n, [&] {
       for (const auto& p : points)
         if (auto h = terrain.height(p.x, p.y)) sum += *h, ++hits;
-    }));
+    });
     hits_height = hits;
     hits = 0;
-    t_height_normal.push_back(ns_per(n, [&] {
+    t_height_normal.run(n, [&] {
       for (const auto& p : points)
         if (auto s = terrain.height_normal(p.x, p.y)) sum += s->height + s->face_normal.x, ++hits;
-    }));
+    });
     hits_height_normal = hits;
     hits = 0;
-    t_sample.push_back(ns_per(n, [&] {
+    t_sample.run(n, [&] {
       for (const auto& p : points)
         if (auto s = terrain.sample(p.x, p.y)) sum += s->height + s->smooth_normal.x, ++hits;
-    }));
+    });
     hits_sample = hits;
     hits = 0;
-    t_vertical.push_back(ns_per(n, [&] {
+    t_vertical.run(n, [&] {
       for (const auto& r : vertical)
         if (auto h = terrain.raycast(r.origin, r.direction, r.max_distance))
           sum += h->distance, ++hits;
-    }));
+    });
     hits_vertical = hits;
     hits = 0;
-    t_slanted.push_back(ns_per(n, [&] {
+    t_slanted.run(n, [&] {
       for (const auto& r : slanted)
         if (auto h = terrain.raycast(r.origin, r.direction, r.max_distance))
           sum += h->distance, ++hits;
-    }));
+    });
     hits_slanted = hits;
     checksum += sum;
   }
@@ -117,11 +132,16 @@ nlohmann::json bench_queries(const Terrain& terrain, const BenchQueriesOptions& 
   const std::size_t height_bytes = hf.local_heights().size() * sizeof(float);
   const std::size_t hierarchy_bytes = terrain.ray_hierarchy_bytes();
   nlohmann::json j;
-  j["height_ns"] = median(t_height);
-  j["height_normal_ns"] = median(t_height_normal);
-  j["sample_ns"] = median(t_sample);
-  j["vertical_ray_ns"] = median(t_vertical);
-  j["slanted_ray_ns"] = median(t_slanted);
+  j["height_ns"] = median(t_height.wall);
+  j["height_normal_ns"] = median(t_height_normal.wall);
+  j["sample_ns"] = median(t_sample.wall);
+  j["vertical_ray_ns"] = median(t_vertical.wall);
+  j["slanted_ray_ns"] = median(t_slanted.wall);
+  j["thread_cpu"] = {{"height_ns", median(t_height.cpu)},
+                     {"height_normal_ns", median(t_height_normal.cpu)},
+                     {"sample_ns", median(t_sample.cpu)},
+                     {"vertical_ray_ns", median(t_vertical.cpu)},
+                     {"slanted_ray_ns", median(t_slanted.cpu)}};
   j["bytes_per_sample"] = double(height_bytes + hierarchy_bytes) / samples;
   j["height_bytes"] = height_bytes;
   j["ray_hierarchy_bytes"] = hierarchy_bytes;
@@ -139,7 +159,9 @@ nlohmann::json bench_queries(const Terrain& terrain, const BenchQueriesOptions& 
                {"slanted_ray", hits_slanted}};
   j["checksum"] = checksum;
   j["notes"] =
-      "ns per query, median over repetitions; height_normal = height + face normal + material "
+      "ns per query, median over repetitions of wall time (thread_cpu: of the thread's CPU time, "
+      "which leaves out time spent waiting for a core); height_normal = height + face normal + "
+      "material "
       "(Terrain::height_normal); sample = height + face and smooth normals + material; "
       "bytes_per_sample = (float heights + ray hierarchy) / samples";
   return j;

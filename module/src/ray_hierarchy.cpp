@@ -106,13 +106,13 @@ std::size_t RayHierarchy::memory_bytes() const noexcept {
 
 namespace {
 
-// Fills a hit on triangle `tri` of cell (i, j) at distance t.
+// Fills a hit at distance t on the triangle with plane `plane` in cell (i, j).
 void fill_hit(const Heightfield& hf, double inv_sx, double inv_sz, const glm::dvec3& origin,
-              const glm::dvec3& dir, std::uint32_t i, std::uint32_t j, const CellTriangle& tri,
-              double t, bool started_below, RayHit& hit) noexcept {
+              const glm::dvec3& dir, std::uint32_t i, std::uint32_t j,
+              const detail::CellPlane& plane, double t, bool started_below, RayHit& hit) noexcept {
   hit.distance = t;
   hit.point = t == 0.0 ? origin : origin + dir * t;
-  hit.normal = detail::face_normal(hf, inv_sx, inv_sz, i, j, tri);
+  hit.normal = detail::plane_normal(plane, inv_sx, inv_sz);
   hit.material = hf.material(i, j);
   hit.started_below = started_below;
 }
@@ -184,7 +184,7 @@ bool RayHierarchy::leaf_hit(const Heightfield& hf, const Ray& r, std::uint32_t b
           if (fb > touch_) continue;
           th = fb <= 0 ? std::clamp(pa + (pb - pa) * (fa / (fa - fb)), pa, pb) : pb;
         }
-        fill_hit(hf, inv_sx_, inv_sz_, r.origin, r.dir, i, j, tri, th, false, hit);
+        fill_hit(hf, inv_sx_, inv_sz_, r.origin, r.dir, i, j, plane, th, false, hit);
         return true;
       }
     }
@@ -209,8 +209,8 @@ std::optional<RayHit> RayHierarchy::raycast(const Heightfield& hf, const glm::dv
     if (!std::isfinite(origin[a]) || !std::isfinite(direction[a])) return std::nullopt;
   // Normalise without overflow: scale by the largest component first.
   const double m = std::max({std::abs(direction.x), std::abs(direction.y), std::abs(direction.z)});
-  if (!(m > 0.0)) return std::nullopt;                     // zero direction
-  glm::dvec3 d(0.0, direction.y > 0.0 ? 1.0 : -1.0, 0.0);  // vertical: nothing to compute
+  if (!(m > 0.0)) return std::nullopt;  // zero direction
+  glm::dvec3 d(0.0, direction.y > 0.0 ? 1.0 : -1.0, 0.0);
   if (direction.x != 0.0 || direction.z != 0.0) {
     d = direction / m;
     d /= std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
@@ -228,18 +228,36 @@ std::optional<RayHit> RayHierarchy::raycast(const Heightfield& hf, const glm::dv
   r.du = d.x * inv_sx_;
   r.dv = d.z * inv_sz_;
   r.dy = d.y;
-  r.inv_du = r.du != 0.0 ? 1.0 / r.du : 0.0;
-  r.inv_dv = r.dv != 0.0 ? 1.0 / r.dv : 0.0;
+  const double umax = hf.width() - 1.0, vmax = hf.height() - 1.0;
+  RayHit hit;
+
+  if (r.du == 0.0 && r.dv == 0.0) {
+    // Vertical: only the surface under the origin can be hit.
+    if (!(r.u0 >= 0.0 && r.u0 <= umax && r.v0 >= 0.0 && r.v0 <= vmax)) return std::nullopt;
+    const auto i = std::min(static_cast<std::uint32_t>(r.u0), hf.width() - 2);
+    const auto j = std::min(static_cast<std::uint32_t>(r.v0), hf.height() - 2);
+    const double fu = r.u0 - i, fv = r.v0 - j;
+    const CellTriangle tri = locate_in_cell(i, j, static_cast<float>(fu), static_cast<float>(fv));
+    const detail::CellPlane plane = detail::cell_plane(hf, i, j, tri);
+    const double f = r.y0 - plane.at(fu, fv);  // height above the surface
+    if (f <= touch_) {
+      fill_hit(hf, inv_sx_, inv_sz_, origin, d, i, j, plane, 0.0, f < 0.0, hit);
+      return hit;
+    }
+    if (r.dy > 0.0 || f > max_distance) return std::nullopt;
+    fill_hit(hf, inv_sx_, inv_sz_, origin, d, i, j, plane, f, false, hit);
+    return hit;
+  }
 
   // The part of the ray above the footprint (exact bounds: the footprint is the terrain).
-  const double umax = hf.width() - 1.0, vmax = hf.height() - 1.0;
+  r.inv_du = r.du != 0.0 ? 1.0 / r.du : 0.0;
+  r.inv_dv = r.dv != 0.0 ? 1.0 / r.dv : 0.0;
   r.t_enter = 0.0;
   r.t_exit = max_distance;
   if (!clip_axis(r.u0, r.du, r.inv_du, 0.0, umax, r.t_enter, r.t_exit)) return std::nullopt;
   if (!clip_axis(r.v0, r.dv, r.inv_dv, 0.0, vmax, r.t_enter, r.t_exit)) return std::nullopt;
 
   // Where the ray starts over the terrain: at or below the surface there, it hits there.
-  RayHit hit;
   {
     const double t = r.t_enter;
     const double u = std::clamp(r.u0 + r.du * t, 0.0, umax);
@@ -248,18 +266,10 @@ std::optional<RayHit> RayHierarchy::raycast(const Heightfield& hf, const glm::dv
     const auto j = std::min(static_cast<std::uint32_t>(v), hf.height() - 2);
     const double fu = u - i, fv = v - j;
     const CellTriangle tri = locate_in_cell(i, j, static_cast<float>(fu), static_cast<float>(fv));
-    const double h = detail::cell_plane(hf, i, j, tri).at(fu, fv);
-    const double f = (r.y0 + r.dy * t) - h;
+    const detail::CellPlane plane = detail::cell_plane(hf, i, j, tri);
+    const double f = (r.y0 + r.dy * t) - plane.at(fu, fv);
     if (f <= touch_) {
-      fill_hit(hf, inv_sx_, inv_sz_, origin, d, i, j, tri, t, t == 0.0 && f < 0.0, hit);
-      return hit;
-    }
-    if (r.du == 0.0 && r.dv == 0.0) {
-      // Vertical: the surface under the origin is the only candidate.
-      if (r.dy >= 0.0) return std::nullopt;
-      const double th = f / -r.dy;
-      if (th > r.t_exit) return std::nullopt;
-      fill_hit(hf, inv_sx_, inv_sz_, origin, d, i, j, tri, th, false, hit);
+      fill_hit(hf, inv_sx_, inv_sz_, origin, d, i, j, plane, t, t == 0.0 && f < 0.0, hit);
       return hit;
     }
   }
@@ -279,7 +289,8 @@ std::optional<RayHit> RayHierarchy::raycast(const Heightfield& hf, const glm::dv
     const Level& level = levels_[l];
     const double size = double(std::int64_t{1} << (l + kLeafShift));
     const double ua = double(x) * size, va = double(z) * size;
-    const double ub = std::min(ua + size, umax), vb = std::min(va + size, vmax);
+    // The far edges of the last nodes may lie past the footprint: t_exit stops the ray first.
+    const double ub = ua + size, vb = va + size;
     const double tnu = r.du > 0 ? (ub - r.u0) * r.inv_du : r.du < 0 ? (ua - r.u0) * r.inv_du : kInf;
     const double tnv = r.dv > 0 ? (vb - r.v0) * r.inv_dv : r.dv < 0 ? (va - r.v0) * r.inv_dv : kInf;
     const double t_out = std::max(t, std::min(std::min(tnu, tnv), r.t_exit));

@@ -52,15 +52,18 @@ inline V unit(const V& v) noexcept {
   return v / std::sqrt(glm::dot(v, v));
 }
 
-/// Unit upward face normal of lattice triangle `t` of cell (i, j): (-dh/dx, 1, -dh/dz)
-/// normalised, from the triangle's plane. `inv_sx`, `inv_sz` are 1 / spacing. A flat triangle
-/// gives exactly (0, 1, 0).
-inline glm::vec3 face_normal(const Heightfield& hf, double inv_sx, double inv_sz, std::uint32_t i,
-                             std::uint32_t j, const CellTriangle& t) noexcept {
-  const CellPlane p = cell_plane(hf, i, j, t);
+/// Unit upward normal of a triangle's plane: (-dh/dx, 1, -dh/dz) normalised. `inv_sx`, `inv_sz`
+/// are 1 / spacing. A flat triangle gives exactly (0, 1, 0).
+inline glm::vec3 plane_normal(const CellPlane& p, double inv_sx, double inv_sz) noexcept {
   const double nx = -p.gu * inv_sx, nz = -p.gv * inv_sz;
   const double inv_len = 1.0 / std::sqrt(nx * nx + 1.0 + nz * nz);
   return {float(nx * inv_len), float(inv_len), float(nz * inv_len)};
+}
+
+/// Unit upward face normal of lattice triangle `t` of cell (i, j).
+inline glm::vec3 face_normal(const Heightfield& hf, double inv_sx, double inv_sz, std::uint32_t i,
+                             std::uint32_t j, const CellTriangle& t) noexcept {
+  return plane_normal(cell_plane(hf, i, j, t), inv_sx, inv_sz);
 }
 
 /// Triangle `which` (0 or 1, as CellTriangle::which) of cell (i, j), located through

@@ -98,17 +98,33 @@ class Terrain {
                std::span<std::uint8_t> valid) const noexcept;
 
   /// First intersection of the ray origin + t * normalize(direction), 0 <= t <= max_distance,
-  /// with the surface. Empty when it misses, leaves the terrain first, direction is zero, or any
-  /// input is non-finite. A ray starting below the surface (inside the solid under it) reports a
-  /// hit at distance 0 with started_below = true. A ray that only touches the surface (grazes it
-  /// at a point or runs along it) counts as a hit at the first touching point.
+  /// with the surface: the smallest such t at which the ray is over the footprint and at or below
+  /// the surface. max_distance may be +infinity.
+  /// - Starting below the surface (inside the solid under it): a hit at distance 0 with
+  ///   started_below = true, point = origin, the normal of the triangle under the origin.
+  /// - Starting outside the footprint: the ray is clipped to it; if it enters below the surface
+  ///   level it hits at the entry point (the side of the solid), started_below = false.
+  /// - Touching counts: a ray that grazes the surface at a point, runs along it, starts exactly
+  ///   on it, or passes within the touch tolerance of it (1e-9 * (1 + the largest |height -
+  ///   height_offset|) metres: rounding, not geometry) hits at the first touching point.
+  /// - Vertical rays, rays exactly along cell edges or diagonals and rays through vertices are
+  ///   ordinary rays; they take the same answers as above (tested against a brute-force reference).
+  /// - Empty when the ray misses, leaves the footprint before meeting the surface (nothing beyond
+  ///   the edge is hit), direction is zero, max_distance <= 0 or NaN, or any origin or direction
+  ///   component is non-finite. Direction need not be normalised; its length is irrelevant.
+  /// Cost: the ray descends a min/max pyramid, so a long ray costs about the number of pyramid
+  /// nodes it crosses at the level where it clears the terrain, not the number of cells.
   std::optional<RayHit> raycast(const glm::dvec3& origin, const glm::dvec3& direction,
                                 double max_distance) const noexcept;
 
-  /// Appends to `out` every full-detail triangle whose xz footprint overlaps the box's xz range and
-  /// whose height range overlaps [box.min.y, box.max.y]: what a physics mid-phase asks for.
+  /// Appends to `out` every full-detail triangle whose xz footprint overlaps the box's xz range
+  /// (closed: touching counts; exact triangle/rectangle test, not bounding boxes) and whose
+  /// height range (min..max of its corners) overlaps [box.min.y, box.max.y]: what a physics
+  /// mid-phase asks for. Triangles are in world coordinates, counter-clockwise seen from above
+  /// (locate_in_cell's corner order), with their cell's material; padding is never returned.
   /// Returns the number appended. `max_triangles` caps the work (0 = no cap); when the cap is
-  /// hit the result is truncated and the return value equals the cap.
+  /// hit the result is truncated and the return value equals the cap. A box with a non-finite
+  /// coordinate or min > max on any axis appends nothing and returns 0.
   std::size_t triangles_in_box(const Box& box, std::vector<SurfaceTriangle>& out,
                                std::size_t max_triangles = 0) const;
 
