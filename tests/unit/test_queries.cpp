@@ -207,10 +207,7 @@ struct Reference {
       for (int i = i0; i <= std::min(cw - 1, i0 + 2); ++i)
         for (int w = 0; w < 2; ++w) {
           const RefTri t = tri(i, j, w);
-          double a, b;
-          // A zero-length "ray" at (x, z): inside when the clip leaves [0, 0] non-empty.
-          RefTri wide = t;
-          (void)wide;
+          // Inside when on the inner side of all three edges, widened by `slack`.
           bool inside = true;
           for (int e = 0; e < 3 && inside; ++e) {
             const glm::dvec3 p = t.p[e], q = t.p[(e + 1) % 3], r = t.p[(e + 2) % 3];
@@ -219,8 +216,6 @@ struct Reference {
             n /= glm::length(n);
             inside = n.x * (x - p.x) + n.y * (z - p.z) >= -slack;
           }
-          (void)a;
-          (void)b;
           if (inside) out.push_back(glm::normalize(up_normal(t)));
         }
     return out;
