@@ -58,7 +58,8 @@ RayHierarchy::RayHierarchy(const Heightfield& hf)
   Level leaf;
   leaf.nx = (cells_x + kLeafCells - 1) >> kLeafShift;
   leaf.nz = (cells_z + kLeafCells - 1) >> kLeafShift;
-  leaf.nodes.resize(std::size_t{leaf.nx} * leaf.nz);
+  leaf.max.resize(std::size_t{leaf.nx} * leaf.nz);
+  leaf.min.resize(leaf.max.size());
   for (std::uint32_t bz = 0; bz < leaf.nz; ++bz) {
     const std::uint32_t j0 = bz << kLeafShift, j1 = std::min(j0 + kLeafCells, cells_z);
     for (std::uint32_t bx = 0; bx < leaf.nx; ++bx) {
@@ -71,7 +72,8 @@ RayHierarchy::RayHierarchy(const Heightfield& hf)
           hi = std::max(hi, h);
         }
       }
-      leaf.nodes[bx + std::size_t{bz} * leaf.nx] = {lo, hi};
+      leaf.min[leaf.index(bx, bz)] = lo;
+      leaf.max[leaf.index(bx, bz)] = hi;
     }
   }
   levels_.push_back(std::move(leaf));
@@ -80,18 +82,19 @@ RayHierarchy::RayHierarchy(const Heightfield& hf)
     Level up;
     up.nx = (below.nx + 1) / 2;
     up.nz = (below.nz + 1) / 2;
-    up.nodes.resize(std::size_t{up.nx} * up.nz);
+    up.max.resize(std::size_t{up.nx} * up.nz);
+    up.min.resize(up.max.size());
     for (std::uint32_t z = 0; z < up.nz; ++z) {
       for (std::uint32_t x = 0; x < up.nx; ++x) {
-        Range r = below.nodes[2 * x + std::size_t{2 * z} * below.nx];
+        float lo = below.min[below.index(2 * x, 2 * z)], hi = below.max[below.index(2 * x, 2 * z)];
         for (std::uint32_t c = 1; c < 4; ++c) {
           const std::uint32_t cx = 2 * x + (c & 1), cz = 2 * z + (c >> 1);
           if (cx >= below.nx || cz >= below.nz) continue;
-          const Range& k = below.nodes[cx + std::size_t{cz} * below.nx];
-          r.min = std::min(r.min, k.min);
-          r.max = std::max(r.max, k.max);
+          lo = std::min(lo, below.min[below.index(cx, cz)]);
+          hi = std::max(hi, below.max[below.index(cx, cz)]);
         }
-        up.nodes[x + std::size_t{z} * up.nx] = r;
+        up.min[up.index(x, z)] = lo;
+        up.max[up.index(x, z)] = hi;
       }
     }
     levels_.push_back(std::move(up));
@@ -100,7 +103,7 @@ RayHierarchy::RayHierarchy(const Heightfield& hf)
 
 std::size_t RayHierarchy::memory_bytes() const noexcept {
   std::size_t bytes = levels_.capacity() * sizeof(Level);
-  for (const Level& l : levels_) bytes += l.nodes.capacity() * sizeof(Range);
+  for (const Level& l : levels_) bytes += (l.max.capacity() + l.min.capacity()) * sizeof(float);
   return bytes;
 }
 
@@ -294,7 +297,7 @@ std::optional<RayHit> RayHierarchy::raycast(const Heightfield& hf, const glm::dv
     const double tnu = r.du > 0 ? (ub - r.u0) * r.inv_du : r.du < 0 ? (ua - r.u0) * r.inv_du : kInf;
     const double tnv = r.dv > 0 ? (vb - r.v0) * r.inv_dv : r.dv < 0 ? (va - r.v0) * r.inv_dv : kInf;
     const double t_out = std::max(t, std::min(std::min(tnu, tnv), r.t_exit));
-    const float node_max = level.nodes[std::size_t(x) + std::size_t(z) * level.nx].max;
+    const float node_max = level.max[level.index(x, z)];
     const double ylow = r.y0 + r.dy * (r.dy < 0 ? t_out : t);
     if (ylow <= double(node_max) + touch_) {
       if (l > 0) {
@@ -357,8 +360,8 @@ std::size_t RayHierarchy::triangles_in_box(const Heightfield& hf, const Box& box
   std::size_t added = 0;
   for (std::int64_t bz = j0 >> kLeafShift; bz <= (j1 >> kLeafShift); ++bz) {
     for (std::int64_t bx = i0 >> kLeafShift; bx <= (i1 >> kLeafShift); ++bx) {
-      const Range& range = leaf.nodes[std::size_t(bx) + std::size_t(bz) * leaf.nx];
-      if (double(range.max) < ylo || double(range.min) > yhi) continue;
+      const std::size_t block = leaf.index(bx, bz);
+      if (double(leaf.max[block]) < ylo || double(leaf.min[block]) > yhi) continue;
       const std::int64_t ci_end = std::min(i1, ((bx + 1) << kLeafShift) - 1);
       const std::int64_t cj_end = std::min(j1, ((bz + 1) << kLeafShift) - 1);
       for (std::int64_t cj = std::max(j0, bz << kLeafShift); cj <= cj_end; ++cj) {
