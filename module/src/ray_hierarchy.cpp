@@ -284,9 +284,22 @@ std::optional<RayHit> RayHierarchy::raycast(const Heightfield& hf, const glm::dv
   // one axis at a time, so every node the ray touches is visited (through a corner, the side node
   // gets an empty interval) and the walk always advances.
   const int top = static_cast<int>(levels_.size()) - 1;
-  int l = top;
-  std::int64_t x = 0, z = 0;
   double t = r.t_enter;
+  // Start at the lowest level whose nodes are at least as long as the ray's footprint (fewer
+  // descents for short rays); the walk climbs from there if the ray crosses into another node.
+  int l = top;
+  const double cells = (r.t_exit - t) * std::max(std::abs(r.du), std::abs(r.dv));
+  while (l > 0 && double(std::int64_t{kLeafCells} << (l - 1)) >= cells) --l;
+  std::int64_t x = 0, z = 0;
+  if (l < top) {
+    const int shift = l + static_cast<int>(kLeafShift);
+    x = std::clamp<std::int64_t>(
+        static_cast<std::int64_t>(std::clamp(r.u0 + r.du * t, 0.0, umax)) >> shift, 0,
+        levels_[l].nx - 1);
+    z = std::clamp<std::int64_t>(
+        static_cast<std::int64_t>(std::clamp(r.v0 + r.dv * t, 0.0, vmax)) >> shift, 0,
+        levels_[l].nz - 1);
+  }
   const int step_u = r.du > 0 ? 1 : -1, step_v = r.dv > 0 ? 1 : -1;
   for (;;) {
     const Level& level = levels_[l];
