@@ -32,6 +32,8 @@ namespace {
 
 constexpr std::uint32_t kNone = 0xffffffffu;
 constexpr float kInf = std::numeric_limits<float>::infinity();
+// How much of the way to the threshold crossing a priority window spans (see priority()).
+constexpr double kWindowFraction = 0.5;
 
 struct Node {
   std::uint32_t parent = kNone;
@@ -42,6 +44,9 @@ struct Node {
   std::uint32_t heap = 1;
   std::uint32_t stamp = 0;      // generation of the node's newest expiry records
   std::int32_t ax = 0, az = 0;  // apex in global lattice coordinates (geometry in O(1))
+  // Cached at creation so a priority reads no height or bound arrays (cache misses dominated):
+  float bound = 0;              // nested error bound, metres
+  float ylo = 0, yhi = 0;       // bounding box y range relative to the height offset, metres
 };
 
 struct HeapEntry {
@@ -263,6 +268,7 @@ struct RoamView::Impl {
   ErrorMetric metric = ErrorMetric::kScreenPixels;
   double slack = 0.05;
   double threshold = 2.0;  // used only to size priority windows
+  double height_offset = land.terrain().heightfield().height_offset();
   bool reset_pending = true;
 
   // Output.
@@ -336,6 +342,8 @@ struct RoamView::Impl {
         r0.az = static_cast<std::int32_t>(t0.az);
         r1.ax = static_cast<std::int32_t>(t1.ax);
         r1.az = static_cast<std::int32_t>(t1.az);
+        cache_box(2 * p);
+        cache_box(2 * p + 1);
         r0.base = 2 * p + 1;
         r1.base = 2 * p;
         // root 0: apex (P, 0), left edge z = 0 (towards -z), right edge x = P (towards +x)
@@ -357,19 +365,15 @@ struct RoamView::Impl {
   float priority(std::uint32_t n, Validity& v) {
     ++st.priority_updates;
     const Node& nd = nodes[n];
-    const float b = land.bound(nd.root, nd.heap);
+    const float b = nd.bound;
     v = Validity{};
     if (metric == ErrorMetric::kWorldMetres || b == 0.0f) return b;
     const LatticeTriangle t = land.triangle_at(nd.ax, nd.az, nd.root, nd.heap);
     const std::int64_t i0 = std::min({t.ax, t.lx, t.rx}), i1 = std::max({t.ax, t.lx, t.rx});
     const std::int64_t j0 = std::min({t.az, t.lz, t.rz}), j1 = std::max({t.az, t.lz, t.rz});
-    const float ha = land.lattice_height(t.ax, t.az), hl = land.lattice_height(t.lx, t.lz),
-                hr = land.lattice_height(t.rx, t.rz);
-    const double off = land.terrain().heightfield().height_offset();
-    const glm::dvec3 lo(land.world_x(i0), off + double(std::min({ha, hl, hr})) - b,
-                        land.world_z(j0));
-    const glm::dvec3 hi(land.world_x(i1), off + double(std::max({ha, hl, hr})) + b,
-                        land.world_z(j1));
+    const double off = height_offset;
+    const glm::dvec3 lo(land.world_x(i0), off + double(nd.ylo), land.world_z(j0));
+    const glm::dvec3 hi(land.world_x(i1), off + double(nd.yhi), land.world_z(j1));
     const glm::dvec3 e = cam.eye;
     const glm::dvec3 nearest = glm::clamp(e, lo, hi);
     const double d = glm::length(nearest - e);
@@ -400,7 +404,7 @@ struct RoamView::Impl {
     // below the threshold if the node was below it (and above if above), so decisions only ever
     // err on the side of more detail.
     double window = r;
-    if (threshold > 0.0) window = std::max(window, 0.5 * std::abs(d - double(b) * K / threshold));
+    if (threshold > 0.0) window = std::max(window, kWindowFraction * std::abs(d - double(b) * K / threshold));
     v.distance = window;
     const double dd = d - window;
     if (dd <= 0.0) return kInf;
@@ -497,6 +501,18 @@ struct RoamView::Impl {
     }
   }
 
+  // Caches a node's bound and bounding-box height range (the surface under the triangle lies
+  // within [lowest corner - bound, highest corner + bound]).
+  void cache_box(std::uint32_t n) {
+    Node& nd = nodes[n];
+    nd.bound = land.bound(nd.root, nd.heap);
+    const LatticeTriangle t = land.triangle_at(nd.ax, nd.az, nd.root, nd.heap);
+    const float ha = land.lattice_height(t.ax, t.az), hl = land.lattice_height(t.lx, t.lz),
+                hr = land.lattice_height(t.rx, t.rz);
+    nd.ylo = std::min({ha, hl, hr}) - nd.bound;
+    nd.yhi = std::max({ha, hl, hr}) + nd.bound;
+  }
+
   void make_children(std::uint32_t n) {
     const std::uint32_t c = alloc_pair();
     Node& p = nodes[n];
@@ -512,6 +528,8 @@ struct RoamView::Impl {
     c0.ax = c1.ax = static_cast<std::int32_t>((t.lx + t.rx) / 2);
     c0.az = c1.az = static_cast<std::int32_t>((t.lz + t.rz) / 2);
     p.child = c;
+    cache_box(c);
+    cache_box(c + 1);
   }
 
   void split_leaf(std::uint32_t t, bool forced) {
