@@ -514,3 +514,47 @@ TEST(Roam, MeasuredErrorAgreesWithTheBoundsAndTheThreshold) {
   EXPECT_LE(we.max_m, 3.0);
   EXPECT_GT(we.max_m, 1.0);
 }
+
+TEST(Roam, TimeBudgetStopsTheUpdateAndTheRestContinuesNextUpdate) {
+  auto l = make_landscape(257, 5);
+  // A budget far below what converging takes: the first check (after 16 operations) stops it.
+  auto view = RoamView::create(l, {.threshold = 1.0, .budget_ms = 1e-6}).value();
+  const Camera c = camera_at({20, 120, 30}, {300, 60, 260});
+  auto st = view->update(c);
+  ASSERT_TRUE(st);
+  EXPECT_EQ(st->stop, StopReason::kTimeBudget);
+  EXPECT_GT(st->max_remaining_error, 1.0);
+  EXPECT_EQ(check_crack_free(*view), "");
+  // Lift the budget: the same camera converges from where it stopped, without a rebuild.
+  RoamSettings s = view->settings();
+  s.budget_ms = 0;
+  ASSERT_TRUE(view->set_settings(s));
+  st = view->update(c);
+  ASSERT_TRUE(st);
+  EXPECT_EQ(st->stop, StopReason::kConverged);
+  EXPECT_FALSE(st->rebuilt);
+  expect_converged(*view, c, 1.0);
+}
+
+TEST(Roam, ThresholdChangesNeedNoRecomputation) {
+  auto l = make_landscape(257, 5);
+  auto view = RoamView::create(l, {.threshold = 4.0}).value();
+  const Camera c = camera_at({20, 120, 30}, {300, 60, 260});
+  auto coarse = view->update(c);
+  ASSERT_TRUE(coarse);
+  RoamSettings s = view->settings();
+  s.threshold = 1.0;
+  ASSERT_TRUE(view->set_settings(s));
+  auto fine = view->update(c);
+  ASSERT_TRUE(fine);
+  EXPECT_GT(fine->triangles, coarse->triangles);
+  EXPECT_EQ(fine->expired, 0u);  // the camera did not move: no key expired
+  EXPECT_FALSE(fine->rebuilt);
+  expect_converged(*view, c, 1.0);
+  s.threshold = 4.0;
+  ASSERT_TRUE(view->set_settings(s));
+  auto back = view->update(c);
+  ASSERT_TRUE(back);
+  EXPECT_GT(back->merges, 0u);
+  EXPECT_EQ(back->triangles, coarse->triangles);  // the same unique mesh for the same keys
+}

@@ -1,0 +1,60 @@
+#!/usr/bin/env bash
+# Regenerates the benchmark figures quoted in docs/benchmarks.md: query speed and ROAM cost and
+# error along camera paths, on the 1025 x 1025 value-noise field the peer figures were measured on
+# (written by ../shared/tools/make-noise-field when present) and on the built-in default terrain.
+# Usage: scripts/bench.sh [OUT_DIR]   (default docs/benchmarks; per-frame JSON goes to build/bench)
+set -euo pipefail
+source "$(dirname "$0")/lib/common.sh"
+cd "$RIDGELINE_ROOT"
+out=${1:-docs/benchmarks}
+work=build/bench
+mkdir -p "$out" "$work"
+ensure_packages "${RIDGELINE_PACKAGES[@]}" python3
+configure_and_build build/release -DCMAKE_BUILD_TYPE=Release > /dev/null
+ridge=build/release/module/ridge
+
+noise=()
+gen=$RIDGELINE_ROOT/../shared/tools/make-noise-field
+if [ -f "$work/noise1025.png" ] || { [ -x "$gen" ] && "$gen" "$work" > /dev/null; }; then
+  noise=(--heightmap "$work/noise1025.png" --spacing 1 --height-scale 0.005)
+fi
+
+echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)" | tee "$out/machine.txt"
+
+# Queries.
+"$ridge" bench queries --default-terrain --json "$out/queries_default.json"
+[ ${#noise[@]} -gt 0 ] && "$ridge" bench queries "${noise[@]}" --json "$out/queries_noise1025.json"
+
+# ROAM along paths. Error measured every 10th frame on every vertex in view.
+lod() {  # NAME ARGS...
+  local name=$1; shift
+  "$ridge" bench lod "$@" --error-every 10 --json "$work/$name.json"
+  python3 - "$work/$name.json" "$name" >> "$work/summaries.jsonl" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))["summary"]
+s["name"] = sys.argv[2]
+print(json.dumps(s))
+PY
+}
+rm -f "$work/summaries.jsonl"
+if [ ${#noise[@]} -gt 0 ]; then
+  path=$work/noise1025_circle.json
+  for t in 0.5 1 2 4 8; do
+    for mode in coherent rebuild; do
+      lod "noise_${mode}_t$t" "${noise[@]}" --path "$path" --threshold "$t" --mode "$mode" --warmup 60
+    done
+  done
+  for n in 5250 53000; do
+    lod "noise_coherent_n$n" "${noise[@]}" --path "$path" --triangles "$n" --warmup 60
+  done
+fi
+for p in flyover drive fast_yaw zoom down fast_pass; do
+  lod "default_${p}_t2" --default-terrain --path "tests/data/paths/$p.json" --threshold 2
+done
+lod "default_fast_yaw_t1_budget1ms" --default-terrain --path tests/data/paths/fast_yaw.json \
+  --threshold 1 --budget-ms 1
+python3 - "$work/summaries.jsonl" > "$out/lod_summary.json" <<'PY'
+import json, sys
+print(json.dumps([json.loads(l) for l in open(sys.argv[1])], indent=1))
+PY
+echo "wrote $out/queries_*.json, $out/lod_summary.json (per-frame JSON in $work)"
