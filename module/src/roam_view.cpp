@@ -34,6 +34,8 @@ constexpr std::uint32_t kNone = 0xffffffffu;
 constexpr float kInf = std::numeric_limits<float>::infinity();
 // How much of the way to the threshold crossing a priority window spans (see priority()).
 constexpr double kWindowFraction = 0.5;
+// Smallest rotation (radians) before a visible node's key is reconsidered for leaving the view.
+constexpr double kMinAngleWindow = 0.03;
 
 struct Node {
   std::uint32_t parent = kNone;
@@ -42,11 +44,15 @@ struct Node {
   std::uint32_t qslot = kNone;  // position in the split heap (leaf) or merge heap (internal)
   std::uint32_t root = 0;
   std::uint32_t heap = 1;
-  std::uint32_t stamp = 0;      // generation of the node's newest expiry records
+  // When the node's key must be recomputed: eye odometer (metres) and accumulated rotation
+  // (radians), rounded down to float; infinity when it never expires that way. An expiry record
+  // whose key rounds to a different value is stale.
+  float due_d = std::numeric_limits<float>::infinity();
+  float due_a = std::numeric_limits<float>::infinity();
   std::int32_t ax = 0, az = 0;  // apex in global lattice coordinates (geometry in O(1))
   // Cached at creation so a priority reads no height or bound arrays (cache misses dominated):
-  float bound = 0;              // nested error bound, metres
-  float ylo = 0, yhi = 0;       // bounding box y range relative to the height offset, metres
+  float bound = 0;         // nested error bound, metres
+  float ylo = 0, yhi = 0;  // bounding box y range relative to the height offset, metres
 };
 
 struct HeapEntry {
@@ -64,7 +70,7 @@ class IndexedHeap {
   std::size_t size() const { return a_.size(); }
   const HeapEntry& top() const { return a_.front(); }
   void clear() {
-    for (auto& e : a_) (*nodes_)[e.node].qslot = kNone;
+    for (auto& e : a_) leave(e.node);
     a_.clear();
   }
   void push(std::uint32_t node, float key) {
@@ -75,7 +81,7 @@ class IndexedHeap {
   void remove(std::uint32_t node) {
     const std::uint32_t i = (*nodes_)[node].qslot;
     if (i == kNone) return;
-    (*nodes_)[node].qslot = kNone;
+    leave(node);
     const std::size_t last = a_.size() - 1;
     if (i != last) {
       a_[i] = a_[last];
@@ -96,6 +102,13 @@ class IndexedHeap {
 
  private:
   static bool before(float a, float b) { return kMax ? a > b : a < b; }
+  // A node leaving its queue forgets its expiry: its records turn stale, and when it is queued
+  // again it gets new ones.
+  void leave(std::uint32_t node) {
+    Node& n = (*nodes_)[node];
+    n.qslot = kNone;
+    n.due_d = n.due_a = std::numeric_limits<float>::infinity();
+  }
   bool up(std::size_t i) {
     bool moved = false;
     while (i > 0) {
@@ -131,7 +144,6 @@ class IndexedHeap {
 struct Expiry {
   double key;
   std::uint32_t node;
-  std::uint32_t stamp;
   bool operator>(const Expiry& o) const { return key > o.key; }
 };
 
@@ -147,17 +159,18 @@ class ExpiryWheel {
     overflow_ = {};
     size_ = 0;
     cursor_ = bucket(now);
+    sweep_pos_ = 0;
   }
   std::size_t size() const { return size_; }
-  void push(double key, std::uint32_t node, std::uint32_t stamp) {
+  void push(double key, std::uint32_t node) {
     const std::uint64_t b = bucket(key);
     ++size_;
     if (b < cursor_ + kBuckets)
-      ring_[std::max(b, cursor_) % kBuckets].push_back({key, node, stamp});
+      ring_[std::max(b, cursor_) % kBuckets].push_back({key, node});
     else
-      overflow_.push({key, node, stamp});
+      overflow_.push({key, node});
   }
-  // Calls fn(node, stamp) for every record with key <= now; stops early when fn returns false.
+  // Calls fn(node, key) for every record with key <= now; stops early when fn returns false.
   template <class Fn>
   bool drain(double now, Fn&& fn) {
     const std::uint64_t target = bucket(now);
@@ -168,8 +181,10 @@ class ExpiryWheel {
       for (std::size_t k = 0; k < v.size(); ++k) {
         if (v[k].key <= now) {
           --size_;
-          if (!fn(v[k].node, v[k].stamp)) {
-            // Abandoned: the caller rebuilds and clears the wheel.
+          if (!fn(v[k].node, v[k].key)) {
+            // Stopped: keep the records not yet looked at, drop the ones consumed.
+            v.erase(v.begin() + static_cast<std::ptrdiff_t>(keep),
+                    v.begin() + static_cast<std::ptrdiff_t>(k + 1));
             return false;
           }
         } else {
@@ -193,7 +208,11 @@ class ExpiryWheel {
       for (std::size_t k = 0; k < v.size(); ++k) {
         if (v[k].key <= now) {
           --size_;
-          if (!fn(v[k].node, v[k].stamp)) return false;
+          if (!fn(v[k].node, v[k].key)) {
+            v.erase(v.begin() + static_cast<std::ptrdiff_t>(keep),
+                    v.begin() + static_cast<std::ptrdiff_t>(k + 1));
+            return false;
+          }
         } else {
           v[keep++] = v[k];
         }
@@ -202,6 +221,49 @@ class ExpiryWheel {
     }
     return true;
   }
+  // Drops the records for which live(node, key) is false (stale ones), in O(records).
+  template <class Live>
+  void compact(Live&& live) {
+    size_ = 0;
+    for (auto& v : ring_) {
+      std::size_t keep = 0;
+      for (const Expiry& e : v)
+        if (live(e.node, e.key)) v[keep++] = e;
+      v.resize(keep);
+      size_ += keep;
+    }
+    std::vector<Expiry> rest;
+    while (!overflow_.empty()) {
+      if (live(overflow_.top().node, overflow_.top().key)) rest.push_back(overflow_.top());
+      overflow_.pop();
+    }
+    for (const Expiry& e : rest) overflow_.push(e);
+    size_ += rest.size();
+  }
+
+  // Drops stale records, looking at no more than `budget` records per call, round robin over the
+  // ring: spreads the clean-up over updates so that no single update pays for it.
+  template <class Live>
+  void compact_some(Live&& live, std::size_t budget) {
+    for (std::size_t visited = 0; budget > 0 && visited <= kBuckets; ++visited) {
+      std::vector<Expiry>& v = ring_[sweep_bucket_ % kBuckets];
+      sweep_pos_ = std::min(sweep_pos_, v.size());  // the bucket may have shrunk since
+      const std::size_t end = std::min(v.size(), sweep_pos_ + budget);
+      std::size_t w = sweep_pos_;
+      for (std::size_t k = sweep_pos_; k < end; ++k)
+        if (live(v[k].node, v[k].key)) v[w++] = v[k];
+      v.erase(v.begin() + static_cast<std::ptrdiff_t>(w),
+              v.begin() + static_cast<std::ptrdiff_t>(end));
+      size_ -= end - w;
+      budget -= end - sweep_pos_;
+      sweep_pos_ = w;
+      if (sweep_pos_ >= v.size()) {
+        ++sweep_bucket_;
+        sweep_pos_ = 0;
+      }
+    }
+  }
+
   std::size_t memory_bytes() const {
     std::size_t b = ring_.capacity() * sizeof(std::vector<Expiry>);
     for (const auto& v : ring_) b += v.capacity() * sizeof(Expiry);
@@ -218,6 +280,8 @@ class ExpiryWheel {
   std::priority_queue<Expiry, std::vector<Expiry>, std::greater<Expiry>> overflow_;
   std::size_t size_ = 0;
   std::uint64_t cursor_ = 0;
+  std::uint64_t sweep_bucket_ = 0;
+  std::size_t sweep_pos_ = 0;
 };
 
 struct Validity {
@@ -267,7 +331,8 @@ struct RoamView::Impl {
   // Settings snapshot used by priorities.
   ErrorMetric metric = ErrorMetric::kScreenPixels;
   double slack = 0.05;
-  double threshold = 2.0;  // used only to size priority windows
+  double threshold = 2.0;        // used only to size priority windows
+  double keyed_threshold = 0.0;  // threshold of the previous update
   double height_offset = land.terrain().heightfield().height_offset();
   bool reset_pending = true;
 
@@ -279,8 +344,11 @@ struct RoamView::Impl {
   std::vector<std::uint64_t> mesh_built_version;
   std::vector<std::uint32_t> scratch_index;
 
-  // Per-update counters.
+  // Per-update counters and the time budget.
   RoamStats st;
+  bool has_deadline = false;
+  std::chrono::steady_clock::time_point deadline;
+  std::uint32_t time_checks = 0;
   std::uint32_t triangles = 0;
 
   // ---- structure ---------------------------------------------------------------------------
@@ -386,36 +454,69 @@ struct RoamView::Impl {
     // Side planes. The box is outside a plane by margin m (metres) when its most inward corner
     // is m behind it; the classification holds while translation + rotation * reach < m.
     const glm::dvec3 c = 0.5 * (lo + hi) - e, he = 0.5 * (hi - lo);
-    double margin = 0.0;
+    double margin = 0.0, inside = std::numeric_limits<double>::infinity();
     for (const glm::dvec3& pn : planes) {
       const double s_max =
           glm::dot(pn, c) + std::abs(pn.x) * he.x + std::abs(pn.y) * he.y + std::abs(pn.z) * he.z;
       margin = std::max(margin, -s_max);
+      inside = std::min(inside, s_max);
     }
+    const double reach = std::max(glm::length(c) + glm::length(he), 1e-9);
     if (margin > r && margin > 0.0) {
-      const double reach = glm::length(c) + glm::length(he);
       v.distance = 0.5 * margin;
-      v.angle = 0.5 * margin / std::max(reach, 1e-9);
+      v.angle = 0.5 * margin / reach;
       return 0.0f;
     }
+    // Counting a node as visible is always conservative, but one that has turned out of view
+    // should be merged: recompute it once the view may have turned far enough to lose it.
+    v.angle = std::max(inside / reach, kMinAngleWindow);
     // Window: at least slack * d; wider when the node is far from the threshold either way
     // (half the way to the distance at which its priority would equal the threshold), so nodes
     // that are clearly fine or clearly too coarse are not recomputed every frame. The key stays
     // below the threshold if the node was below it (and above if above), so decisions only ever
     // err on the side of more detail.
     double window = r;
-    if (threshold > 0.0) window = std::max(window, kWindowFraction * std::abs(d - double(b) * K / threshold));
+    if (threshold > 0.0)
+      window = std::max(window, kWindowFraction * std::abs(d - double(b) * K / threshold));
     v.distance = window;
     const double dd = d - window;
     if (dd <= 0.0) return kInf;
     return static_cast<float>(double(b) * K / dd);
   }
 
+  // Largest float not above x: due times round down, so a key is recomputed early, never late.
+  static float floor_float(double x) {
+    float f = static_cast<float>(x);
+    if (double(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
+    return f;
+  }
+
+  // Schedules the recomputation of n's key. A record already due no later is kept (the node is
+  // then recomputed early, which is safe); otherwise a new record replaces it, and the old one
+  // turns stale.
   void push_records(std::uint32_t n, const Validity& v) {
     Node& nd = nodes[n];
-    ++nd.stamp;
-    if (std::isfinite(v.distance)) by_distance.push(odometer + v.distance, n, nd.stamp);
-    if (std::isfinite(v.angle)) by_angle.push(angometer + v.angle, n, nd.stamp);
+    if (std::isfinite(v.distance)) {
+      const float due = floor_float(odometer + v.distance);
+      if (!(nd.due_d <= due)) {
+        nd.due_d = due;
+        by_distance.push(due, n);
+      }
+    }
+    if (std::isfinite(v.angle)) {
+      const float due = floor_float(angometer + v.angle);
+      if (!(nd.due_a <= due)) {
+        nd.due_a = due;
+        by_angle.push(due, n);
+      }
+    }
+  }
+
+  bool live_distance(std::uint32_t n, double key) const {
+    return nodes[n].qslot != kNone && float(key) == nodes[n].due_d;
+  }
+  bool live_angle(std::uint32_t n, double key) const {
+    return nodes[n].qslot != kNone && float(key) == nodes[n].due_a;
   }
 
   void push_split(std::uint32_t n) {
@@ -600,8 +701,6 @@ struct RoamView::Impl {
       replace_link(nodes[c1].base, c1, n);
       split.remove(c0);
       split.remove(c1);
-      nodes[c0].stamp++;  // invalidate any expiry records of the freed nodes
-      nodes[c1].stamp++;
       nodes[n].child = kNone;
       free_pairs.push_back(c0);
       mark_dirty(n);
@@ -639,28 +738,69 @@ struct RoamView::Impl {
     return all;
   }
 
-  void recompute_all() {
+  // Makes every queued key due now (a projection change, or too many stale expiry records). The
+  // keys are recomputed by refresh_expired(), within the time budget: what does not fit waits
+  // for the next update, and the mesh keeps its shape meanwhile.
+  void mark_all_due() {
     by_distance.clear(odometer);
     by_angle.clear(angometer);
-    std::vector<std::uint32_t> queued;
-    queued.reserve(split.size() + merge.size());
-    for (const auto& e : split.entries()) queued.push_back(e.node);
-    for (const auto& e : merge.entries()) queued.push_back(e.node);
-    for (std::uint32_t n : queued) requeue(n);
+    auto due = [&](std::uint32_t n) {
+      nodes[n].due_a = std::numeric_limits<float>::infinity();
+      nodes[n].due_d = floor_float(odometer);
+      by_distance.push(nodes[n].due_d, n);
+    };
+    for (const auto& e : split.entries()) due(e.node);
+    for (const auto& e : merge.entries()) due(e.node);
   }
 
-  // Recomputes expired keys. Returns false when so many expired that rebuilding is cheaper.
-  bool refresh_expired(std::size_t rebuild_above) {
+  void mark_merges_due() {
+    for (const auto& e : merge.entries()) {
+      Node& nd = nodes[e.node];
+      nd.due_d = floor_float(odometer);
+      by_distance.push(nd.due_d, e.node);
+    }
+  }
+
+  // Time budget: true once the update's deadline has passed (the clock is read every 4th call:
+  // a call is one split, merge or key recomputation, about a microsecond).
+  bool out_of_time() {
+    if (!has_deadline || (++time_checks & 3) != 0) return false;
+    return std::chrono::steady_clock::now() >= deadline;
+  }
+
+  enum class Refresh { kDone, kRebuild, kOutOfTime };
+
+  // Recomputes expired keys. Stops with kRebuild when more than `rebuild_above` expired (then
+  // rebuilding costs less), with kOutOfTime when the time budget ran out (the rest stays due).
+  Refresh refresh_expired(std::size_t rebuild_above) {
     std::size_t done = 0;
-    auto visit = [&](std::uint32_t node, std::uint32_t stamp) {
+    Refresh why = Refresh::kDone;
+    auto visit = [&](std::uint32_t node, bool angular, double key) {
       ++st.expiry_records;
-      const Node& nd = nodes[node];
-      if (nd.stamp != stamp || nd.qslot == kNone) return true;  // stale record
+      if (angular ? !live_angle(node, key) : !live_distance(node, key)) return true;  // stale
+      if (out_of_time()) {
+        // Still due: look at it first next update.
+        Node& nd = nodes[node];
+        nd.due_d = floor_float(odometer);
+        by_distance.push(nd.due_d, node);
+        why = Refresh::kOutOfTime;
+        return false;
+      }
       ++st.expired;
+      // Only the clock that fired is spent; the other record stays valid and is kept when it is
+      // due no later than the new key's window (push_records).
+      (angular ? nodes[node].due_a : nodes[node].due_d) = std::numeric_limits<float>::infinity();
       requeue(node);
-      return ++done <= rebuild_above;
+      if (++done > rebuild_above) {
+        why = Refresh::kRebuild;
+        return false;
+      }
+      return true;
     };
-    return by_angle.drain(angometer, visit) && by_distance.drain(odometer, visit);
+    auto visit_angle = [&](std::uint32_t node, double key) { return visit(node, true, key); };
+    auto visit_distance = [&](std::uint32_t node, double key) { return visit(node, false, key); };
+    if (by_angle.drain(angometer, visit_angle)) by_distance.drain(odometer, visit_distance);
+    return why;
   }
 };
 
@@ -738,23 +878,45 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   };
 
+  m.has_deadline = budget > 0.0;
+  m.deadline = t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                        std::chrono::duration<double, std::milli>(budget));
   bool all = false;
   if (settings_.metric == ErrorMetric::kScreenPixels) all = m.set_camera(camera);
   if (m.reset_pending || settings_.mode == RoamMode::kRebuild) {
     m.reset_pending = false;
     m.reset_to_roots();
-  } else if (all) {
-    m.recompute_all();
   } else if (settings_.metric == ErrorMetric::kScreenPixels) {
+    const std::size_t queued = m.split.size() + m.merge.size();
+    // Stale records piling up (nodes re-keyed, split or merged before their records came due)
+    // are dropped; a projection change makes every key due.
+    auto live_d = [&](std::uint32_t n, double key) { return m.live_distance(n, key); };
+    auto live_a = [&](std::uint32_t n, double key) { return m.live_angle(n, key); };
+    if (m.by_distance.size() + m.by_angle.size() > 8 * queued + 65536) {
+      m.by_distance.compact(live_d);  // rare: the round-robin sweep below fell behind
+      m.by_angle.compact(live_a);
+    } else {
+      m.by_distance.compact_some(live_d, 4096);
+      m.by_angle.compact_some(live_a, 4096);
+    }
+    const bool everything = all;
+    if (everything) {
+      m.mark_all_due();
+    } else if (threshold > m.keyed_threshold * 1.01) {
+      // Merge keys were windowed for a lower threshold and may sit above the new one although
+      // the diamond now qualifies: recompute them (within the time budget).
+      m.mark_merges_due();
+    }
     // Coherence loses when most keys expire at once (a teleport, a snap turn): rebuilding
     // top-down then costs less than requeueing everything and merging most of the mesh away.
-    const std::size_t queued = m.split.size() + m.merge.size();
-    if (!m.refresh_expired(std::max<std::size_t>(2048, queued / 2))) {
-      m.reset_to_roots();
-    } else if (m.by_distance.size() + m.by_angle.size() > 2 * queued + 8192) {
-      m.recompute_all();  // stale records piled up: start the wheels afresh
-    }
+    // Not after a projection change (a zoom): the mesh keeps its shape while keys catch up.
+    const auto r = m.refresh_expired(everything ? std::numeric_limits<std::size_t>::max()
+                                                : std::max<std::size_t>(2048, queued / 2));
+    if (r == Impl::Refresh::kRebuild) m.reset_to_roots();
+    if (r == Impl::Refresh::kOutOfTime) m.st.stop = StopReason::kTimeBudget;
   }
+
+  m.keyed_threshold = threshold;
 
   // Greedy split/merge (D97 section 5): split the worst leaf while it exceeds the threshold,
   // merge the best diamond while it is within it; under a triangle cap, trade merges of
@@ -763,7 +925,7 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
   for (;;) {
     // A safety net against a trade cycle under a triangle cap; never reached in practice.
     if (++ops > 16ull * (m.triangles + 4096)) break;
-    if (budget > 0.0 && (ops & 15) == 0 && elapsed_ms() >= budget) {
+    if (m.st.stop == StopReason::kTimeBudget || m.out_of_time()) {
       m.st.stop = StopReason::kTimeBudget;
       break;
     }
