@@ -177,22 +177,8 @@ class ExpiryWheel {
     const std::uint64_t last = std::min(target, cursor_ + kBuckets - 1);
     for (std::uint64_t b = cursor_; b <= last; ++b) {
       std::vector<Expiry>& v = ring_[b % kBuckets];
-      std::size_t keep = 0;
-      for (std::size_t k = 0; k < v.size(); ++k) {
-        if (v[k].key <= now) {
-          --size_;
-          if (!fn(v[k].node, v[k].key)) {
-            // Stopped: keep the records not yet looked at, drop the ones consumed.
-            v.erase(v.begin() + static_cast<std::ptrdiff_t>(keep),
-                    v.begin() + static_cast<std::ptrdiff_t>(k + 1));
-            return false;
-          }
-        } else {
-          v[keep++] = v[k];
-        }
-      }
-      v.resize(keep);
-      if (keep == 0 && v.capacity() > 256) std::vector<Expiry>().swap(v);  // bound idle memory
+      if (!drain_bucket(v, now, fn)) return false;
+      if (v.empty() && v.capacity() > 256) std::vector<Expiry>().swap(v);  // bound idle memory
     }
     cursor_ = std::max(cursor_, target > cursor_ + kBuckets - 1 ? target : last);
     // Records whose buckets the ring now reaches come in from the overflow heap.
@@ -202,25 +188,10 @@ class ExpiryWheel {
       ring_[std::max(bucket(e.key), cursor_) % kBuckets].push_back(e);
     }
     // A jump past the horizon (teleport) may leave due records in the ring's current bucket.
-    if (target >= cursor_) {
-      std::vector<Expiry>& v = ring_[cursor_ % kBuckets];
-      std::size_t keep = 0;
-      for (std::size_t k = 0; k < v.size(); ++k) {
-        if (v[k].key <= now) {
-          --size_;
-          if (!fn(v[k].node, v[k].key)) {
-            v.erase(v.begin() + static_cast<std::ptrdiff_t>(keep),
-                    v.begin() + static_cast<std::ptrdiff_t>(k + 1));
-            return false;
-          }
-        } else {
-          v[keep++] = v[k];
-        }
-      }
-      v.resize(keep);
-    }
+    if (target >= cursor_) return drain_bucket(ring_[cursor_ % kBuckets], now, fn);
     return true;
   }
+
   // Drops the records for which live(node, key) is false (stale ones), in O(records).
   template <class Live>
   void compact(Live&& live) {
@@ -272,6 +243,26 @@ class ExpiryWheel {
 
  private:
   static constexpr std::uint64_t kBuckets = 2048;
+  // Consumes the due records of one bucket, keeping the others in order; on an early stop keeps
+  // the records not yet looked at and drops the ones consumed.
+  template <class Fn>
+  bool drain_bucket(std::vector<Expiry>& v, double now, Fn&& fn) {
+    std::size_t keep = 0;
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      if (v[k].key <= now) {
+        --size_;
+        if (!fn(v[k].node, v[k].key)) {
+          v.erase(v.begin() + static_cast<std::ptrdiff_t>(keep),
+                  v.begin() + static_cast<std::ptrdiff_t>(k + 1));
+          return false;
+        }
+      } else {
+        v[keep++] = v[k];
+      }
+    }
+    v.resize(keep);
+    return true;
+  }
   std::uint64_t bucket(double key) const {
     return key <= 0.0 ? 0 : static_cast<std::uint64_t>(key / width_);
   }
