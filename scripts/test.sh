@@ -11,7 +11,7 @@ STAGES=${STAGES:-"release asan"}
 JOBS=$(nproc)
 total0=$SECONDS
 
-stage "packages" ensure_packages "${RIDGELINE_PACKAGES[@]}" clang-14 || exit 1
+stage "packages" ensure_packages "${RIDGELINE_PACKAGES[@]}" clang-14 libclang-rt-14-dev || exit 1
 
 # Khronos' glTF-Validator for the .glb export test, when npm is there (the test skips otherwise).
 install_gltf_validator() {
