@@ -98,6 +98,7 @@ class IndexedHeap {
     if (!up(i)) down(i);
   }
   const std::vector<HeapEntry>& entries() const { return a_; }
+  float key_of(std::uint32_t node) const { return a_[(*nodes_)[node].qslot].key; }
   std::size_t memory_bytes() const { return a_.capacity() * sizeof(HeapEntry); }
 
  private:
@@ -633,6 +634,16 @@ struct RoamView::Impl {
     else
       ++st.splits;
     const std::uint32_t b = nodes[t].base;
+    // The leaves' keys become the new diamond's key (the same function, max over both nodes),
+    // with the earlier of their expiries: no recomputation.
+    float key = split.key_of(t);
+    Validity v = due_validity(t);
+    if (b != kNone) {
+      key = std::max(key, split.key_of(b));
+      const Validity vb = due_validity(b);
+      v.distance = std::min(v.distance, vb.distance);
+      v.angle = std::min(v.angle, vb.angle);
+    }
     split.remove(t);
     make_children(t);
     const std::uint32_t t0 = nodes[t].child, t1 = t0 + 1;
@@ -675,9 +686,21 @@ struct RoamView::Impl {
       push_split(b0);
       push_split(b1);
     }
-    refresh_merge(t);
+    {
+      const std::uint32_t rep = rep_of(t);
+      merge.push(rep, key);
+      push_records(rep, v);
+    }
     if (nodes[t].parent != kNone) refresh_merge(nodes[t].parent);
     if (b != kNone && nodes[b].parent != kNone) refresh_merge(nodes[b].parent);
+  }
+
+  // The remaining validity of a queued node's key, from its due times.
+  Validity due_validity(std::uint32_t n) const {
+    Validity v;
+    v.distance = std::max(0.0, double(nodes[n].due_d) - odometer);
+    v.angle = std::max(0.0, double(nodes[n].due_a) - angometer);
+    return v;
   }
 
   void merge_diamond(std::uint32_t rep) {
