@@ -28,6 +28,7 @@ ensure_packages() {
 # configure_and_build BUILD_DIR [cmake args...]
 configure_and_build() {
   local dir=$1; shift
+  mkdir -p "$dir"
   cmake -S "$RIDGELINE_ROOT" -B "$dir" -G Ninja "$@" > "$dir.configure.log" 2>&1 || {
     cat "$dir.configure.log"; return 1; }
   cmake --build "$dir" -j "$(nproc)"
