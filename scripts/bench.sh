@@ -57,4 +57,5 @@ python3 - "$work/summaries.jsonl" > "$out/lod_summary.json" <<'PY'
 import json, sys
 print(json.dumps([json.loads(l) for l in open(sys.argv[1])], indent=1))
 PY
-echo "wrote $out/queries_*.json, $out/lod_summary.json (per-frame JSON in $work)"
+python3 docs/benchmarks/tables.py "$out" > "$out/tables.md"
+echo "wrote $out/queries_*.json, $out/lod_summary.json, $out/tables.md (per-frame JSON in $work)"

@@ -226,7 +226,7 @@ int run_bench_lod(const BenchLodArgs& a) {
     if (auto st = v.update((*frames)[k % frames->size()].camera); !st)
       return report_error(st.error().message);
   nlohmann::ordered_json out_frames = nlohmann::ordered_json::array();
-  std::vector<double> ms, tris, changes, max_err, rms_err, px_err;
+  std::vector<double> ms, tris, changes, max_err, rms_err, px_err, mem;
   std::uint32_t time_stops = 0, rebuilds = 0;
   for (std::uint64_t rep = 0; rep < *repeat; ++rep) {
     for (std::size_t k = 0; k < frames->size(); ++k) {
@@ -259,6 +259,7 @@ int run_bench_lod(const BenchLodArgs& a) {
       ms.push_back(st->update_ms);
       tris.push_back(st->triangles);
       changes.push_back(st->splits + st->forced_splits + st->merges);
+      mem.push_back(double(st->memory_bytes));
       time_stops += st->stop == StopReason::kTimeBudget;
       rebuilds += st->rebuilt;
     }
@@ -276,6 +277,8 @@ int run_bench_lod(const BenchLodArgs& a) {
       {"triangles_median", percentile(tris, 0.5)},
       {"triangles_p99", percentile(tris, 0.99)},
       {"changes_per_frame_median", percentile(changes, 0.5)},
+      {"view_memory_bytes_median", percentile(mem, 0.5)},
+      {"view_bytes_per_triangle", percentile(mem, 0.5) / std::max(1.0, percentile(tris, 0.5))},
       {"max_error_median", percentile(max_err, 0.5)},
       {"max_error_max", percentile(max_err, 1.0)},
       {"rms_error_median", percentile(rms_err, 0.5)},

@@ -179,7 +179,7 @@ class ExpiryWheel {
     for (std::uint64_t b = cursor_; b <= last; ++b) {
       std::vector<Expiry>& v = ring_[b % kBuckets];
       if (!drain_bucket(v, now, fn)) return false;
-      if (v.empty() && v.capacity() > 256) std::vector<Expiry>().swap(v);  // bound idle memory
+      trim(v);
     }
     cursor_ = std::max(cursor_, target > cursor_ + kBuckets - 1 ? target : last);
     // Records whose buckets the ring now reaches come in from the overflow heap.
@@ -230,6 +230,7 @@ class ExpiryWheel {
       budget -= end - sweep_pos_;
       sweep_pos_ = w;
       if (sweep_pos_ >= v.size()) {
+        trim(v);
         ++sweep_bucket_;
         sweep_pos_ = 0;
       }
@@ -244,6 +245,11 @@ class ExpiryWheel {
 
  private:
   static constexpr std::uint64_t kBuckets = 2048;
+  // Gives back a bucket's spare capacity once it is mostly empty, so memory follows the records
+  // held rather than the largest burst a bucket ever saw.
+  static void trim(std::vector<Expiry>& v) {
+    if (v.capacity() > 64 && v.capacity() > 4 * v.size()) std::vector<Expiry>(v).swap(v);
+  }
   // Consumes the due records of one bucket, keeping the others in order; on an early stop keeps
   // the records not yet looked at and drops the ones consumed.
   template <class Fn>
