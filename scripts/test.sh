@@ -33,6 +33,9 @@ asan() {
   configure_and_build build/asan -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DCMAKE_CXX_COMPILER=clang++-14 -DRIDGELINE_SANITIZE=address,undefined \
     -DRIDGELINE_BUILD_BENCHMARKS=OFF || return 1
+  # Readable sanitizer stacks where llvm-symbolizer is installed (suppressions do not need it).
+  local sym=/usr/lib/llvm-14/bin/llvm-symbolizer
+  [ -x "$sym" ] && export ASAN_SYMBOLIZER_PATH=$sym
   (cd build/asan && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
      UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 ctest --output-on-failure -j "$JOBS")
 }
