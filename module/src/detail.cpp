@@ -122,47 +122,64 @@ struct DetailKernel {
     RIDGELINE_ASSERT(level >= 1 && level <= f.params_.levels);
     const std::int64_t amp = f.amp_[level], amp_prev = f.amp_[level - 1];
     const std::uint64_t seed = level_seed(f, level);
-    auto P = [&](std::int64_t k, std::int64_t m) -> std::int64_t {
-      return par[(m - pj0) * pstride + (k - pi0)];
-    };
+    const std::int64_t mask = (std::int64_t{1} << level) - 1, up = 12 - level;
+    const std::int64_t sw = f.shape_w_, w1 = f.shape_w_ - 1, h1 = f.shape_h_ - 1;
     for (std::int64_t r = 0; r < ch; ++r) {
       const std::int64_t j = cj0 + r, m = j >> 1;
       const bool jodd = (j & 1) != 0;
       std::int32_t* row = out + r * ostride;
+      // Parent rows m - 1 .. m + 2, indexed by the parent column minus pi0.
+      const std::int32_t* pr[4];
+      for (int d = 0; d < 4; ++d) {
+        const std::int64_t rr = std::max(m - 1 + d, pj0);  // rows outside are never read
+        pr[d] = par + (rr - pj0) * pstride;
+      }
+      const std::int32_t* p0 = pr[1];  // row m
+      // Shape along this row: the same four products as shape_q15, summed in another order
+      // (exact in int64, so the same value).
+      const std::int64_t tv = (j & mask) << up, wv = (tv * tv * (3 * 4096 - 2 * tv)) >> 24;
+      const std::uint16_t* s0 = f.shape_.data() + clamp64(j >> level, 0, h1) * sw;
+      const std::uint16_t* s1 = f.shape_.data() + clamp64((j >> level) + 1, 0, h1) * sw;
+      auto new_sample = [&](std::int64_t i, std::int64_t lin2, std::int64_t corr) {
+        const std::int64_t tu = (i & mask) << up, wu = (tu * tu * (3 * 4096 - 2 * tu)) >> 24;
+        const std::int64_t k0 = clamp64(i >> level, 0, w1), k1 = clamp64((i >> level) + 1, 0, w1);
+        const std::int64_t c0 = std::int64_t{s0[k0]} * (4096 - wv) + std::int64_t{s1[k0]} * wv;
+        const std::int64_t c1 = std::int64_t{s0[k1]} * (4096 - wv) + std::int64_t{s1[k1]} * wv;
+        const std::int64_t s = (c0 * (4096 - wu) + c1 * wu) >> 24;
+        const std::int64_t q = (amp * s) >> 15, q_prev = (amp_prev * s) >> 15;
+        return static_cast<std::int32_t>((lin2 >> 1) + clamp64(corr, -q_prev, q_prev) +
+                                         ((noise(seed, i, j) * q) >> 15));
+      };
+      if (!jodd) {
+        for (std::int64_t c = 0; c < cw; ++c) {
+          const std::int64_t i = ci0 + c, x = (i >> 1) - pi0;
+          if ((i & 1) == 0) {  // a parent sample keeps its value
+            row[c] = p0[x];
+            continue;
+          }
+          // Edge midpoint along x: linear + (4-point cubic - linear), floor.
+          const std::int64_t a = p0[x - 1], b = p0[x], cc = p0[x + 1], d = p0[x + 2];
+          row[c] = new_sample(i, b + cc, (b + cc - a - d) >> 4);
+        }
+        continue;
+      }
       for (std::int64_t c = 0; c < cw; ++c) {
-        const std::int64_t i = ci0 + c, k = i >> 1;
-        const bool iodd = (i & 1) != 0;
-        if (!iodd && !jodd) {  // a parent sample keeps its value
-          row[c] = static_cast<std::int32_t>(P(k, m));
+        const std::int64_t i = ci0 + c, k = i >> 1, x = k - pi0;
+        if ((i & 1) == 0) {  // edge midpoint along z
+          const std::int64_t a = pr[0][x], b = pr[1][x], cc = pr[2][x], d = pr[3][x];
+          row[c] = new_sample(i, b + cc, (b + cc - a - d) >> 4);
           continue;
         }
-        std::int64_t lin2, corr;  // lin2: twice the linear interpolation
-        if (iodd && !jodd) {
-          const std::int64_t a = P(k - 1, m), b = P(k, m), cc = P(k + 1, m), d = P(k + 2, m);
-          lin2 = b + cc;
-          corr = (b + cc - a - d) >> 4;  // (4-point cubic - linear), floor
-        } else if (!iodd) {
-          const std::int64_t a = P(k, m - 1), b = P(k, m), cc = P(k, m + 1), d = P(k, m + 2);
-          lin2 = b + cc;
-          corr = (b + cc - a - d) >> 4;
-        } else {
-          // Cell centre: the linear interpolation is the midpoint of the parent cell's diagonal.
-          lin2 =
-              cell_has_main_diagonal(k, m) ? P(k, m) + P(k + 1, m + 1) : P(k + 1, m) + P(k, m + 1);
-          std::int64_t s256 = 0;
-          static constexpr std::int64_t w[4] = {-1, 9, 9, -1};
-          for (int dm = 0; dm < 4; ++dm) {
-            const std::int64_t rr = m - 1 + dm;
-            const std::int64_t h16 = 9 * (P(k, rr) + P(k + 1, rr)) - P(k - 1, rr) - P(k + 2, rr);
-            s256 += w[dm] * h16;
-          }
-          corr = (s256 - 128 * lin2) >> 8;
-        }
-        const std::int64_t s = shape_q15(f, level, i, j);
-        const std::int64_t q = (amp * s) >> 15, q_prev = (amp_prev * s) >> 15;
-        const std::int64_t v =
-            (lin2 >> 1) + clamp64(corr, -q_prev, q_prev) + ((noise(seed, i, j) * q) >> 15);
-        row[c] = static_cast<std::int32_t>(v);
+        // Cell centre: the linear interpolation is the midpoint of the parent cell's diagonal;
+        // the cubic one the tensor product of the 4-point weights (-1, 9, 9, -1) / 16.
+        const std::int64_t lin2 = cell_has_main_diagonal(k, m)
+                                      ? std::int64_t{pr[1][x]} + pr[2][x + 1]
+                                      : std::int64_t{pr[1][x + 1]} + pr[2][x];
+        std::int64_t h16[4];
+        for (int d = 0; d < 4; ++d)
+          h16[d] = 9 * (std::int64_t{pr[d][x]} + pr[d][x + 1]) - pr[d][x - 1] - pr[d][x + 2];
+        const std::int64_t s256 = 9 * (h16[1] + h16[2]) - h16[0] - h16[3];
+        row[c] = new_sample(i, lin2, (s256 - 128 * lin2) >> 8);
       }
     }
   }
