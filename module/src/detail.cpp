@@ -345,8 +345,8 @@ Result<std::shared_ptr<const DetailField>> DetailField::create(
 std::int32_t DetailField::detail_raw(std::uint32_t level, std::int64_t i,
                                      std::int64_t j) const noexcept {
   RIDGELINE_ASSERT(level <= params_.levels);
-  if (level == 0) return 0;
-  // A 1 x 1 window never needs more than 4 x 4 parents and 6 x 6 further up (docs/detail.md).
+  if (level == 0 || level > params_.levels) return 0;  // the fallback after the assert
+  // A 1 x 1 window never needs more than 4 x 4 parents and 7 x 7 further up (docs/detail.md).
   std::array<std::int32_t, 64> a, b;
   std::int32_t out = 0;
   DetailKernel::eval_window(*this, level, i, j, 1, 1, &out, 1, a.data(), b.data(), a.size());
@@ -358,7 +358,8 @@ void DetailField::detail_window(std::uint32_t level, std::int64_t i0, std::int64
                                 std::span<std::int32_t> out) const {
   RIDGELINE_ASSERT(level <= params_.levels);
   RIDGELINE_ASSERT(out.size() >= std::size_t{w} * h);
-  if (w == 0 || h == 0) return;
+  if (w == 0 || h == 0 || out.size() < std::size_t{w} * h) return;
+  if (level > params_.levels) level = 0;  // the fallback after the assert: zeros
   // The largest window is the one at level 0 or near the top; size scratch for the worst.
   std::int64_t lo_i = i0, hi_i = i0 + w - 1, lo_j = j0, hi_j = j0 + h - 1;
   std::size_t cap = std::size_t{w} * h;
@@ -404,6 +405,7 @@ std::optional<double> DetailField::height(std::uint32_t level, std::int64_t i,
 
 double DetailField::shape(std::uint32_t level, std::int64_t i, std::int64_t j) const noexcept {
   RIDGELINE_ASSERT(level <= kMaxDetailLevels);
+  level = std::min(level, kMaxDetailLevels);
   return double(DetailKernel::shape_q15(*this, level, i, j)) / 32768.0;
 }
 
@@ -418,6 +420,9 @@ std::shared_ptr<const DetailTile> DetailField::make_tile(const DetailTileKey& ke
   RIDGELINE_ASSERT(key.level >= 1 && key.level <= params_.levels);
   RIDGELINE_ASSERT((key.level == 1) == (parent == nullptr));
   RIDGELINE_ASSERT(parent == nullptr || parent->key() == key.parent());
+  if (key.level < 1 || key.level > params_.levels || (key.level == 1) != (parent == nullptr) ||
+      (parent && !(parent->key() == key.parent())))
+    return nullptr;  // the fallback after the asserts
   std::shared_ptr<DetailTile> tile(new DetailTile());
   tile->key_ = key;
   tile->samples_.resize(tile_samples());
@@ -495,9 +500,18 @@ double DetailField::contribution_bound(std::uint32_t from_level) const noexcept 
 
 // ---- DetailSnapshot, DetailCache ----------------------------------------------------------------
 
+std::ptrdiff_t DetailSnapshot::find_index(const DetailTileKey& key) const noexcept {
+  if (index_.empty()) return -1;
+  const std::size_t mask = index_.size() - 1;
+  for (std::size_t h = DetailTileKeyHash{}(key)&mask;; h = (h + 1) & mask) {
+    const std::int32_t e = index_[h];
+    if (e < 0 || tiles_[std::size_t(e)]->key() == key) return e;
+  }
+}
+
 const DetailTile* DetailSnapshot::find(const DetailTileKey& key) const noexcept {
-  const auto it = tiles_.find(key);
-  return it == tiles_.end() ? nullptr : it->second.get();
+  const std::ptrdiff_t e = find_index(key);
+  return e < 0 ? nullptr : tiles_[std::size_t(e)].get();
 }
 
 struct DetailCache::State {
@@ -597,7 +611,16 @@ struct DetailCache::State {
   std::shared_ptr<const DetailSnapshot> make_snapshot() const {
     auto snap = std::make_shared<DetailSnapshot>();
     snap->tiles_.reserve(resident.size());
-    for (const auto& [key, entry] : resident) snap->tiles_.emplace(key, entry.tile);
+    std::size_t size = 16;
+    while (size < 2 * resident.size()) size *= 2;
+    snap->index_.assign(size, -1);
+    const DetailTileKeyHash hash;
+    for (const auto& [key, entry] : resident) {
+      std::size_t h = hash(key) & (size - 1);
+      while (snap->index_[h] >= 0) h = (h + 1) & (size - 1);
+      snap->index_[h] = static_cast<std::int32_t>(snap->tiles_.size());
+      snap->tiles_.push_back(entry.tile);
+    }
     return snap;
   }
 
@@ -673,6 +696,7 @@ DetailCache::~DetailCache() {
 
 bool DetailCache::request(const DetailTileKey& key, bool urgent) {
   RIDGELINE_ASSERT(key.level >= 1 && key.level <= field_->levels());
+  if (key.level < 1 || key.level > field_->levels()) return false;  // fallback after the assert
   State& s = *state_;
   std::unique_lock<std::mutex> lock(s.mu);
   if (auto it = s.resident.find(key); it != s.resident.end()) {
@@ -742,8 +766,8 @@ std::shared_ptr<const DetailSnapshot> DetailCache::snapshot() const {
 
 std::shared_ptr<const DetailTile> DetailCache::try_get(const DetailTileKey& key) const {
   const std::shared_ptr<const DetailSnapshot> snap = snapshot_.load();
-  const auto it = snap->tiles_.find(key);
-  return it == snap->tiles_.end() ? nullptr : it->second;
+  const std::ptrdiff_t e = snap->find_index(key);
+  return e < 0 ? nullptr : snap->tiles_[std::size_t(e)];
 }
 
 bool DetailCache::wait_idle(double timeout_seconds) {

@@ -11,7 +11,6 @@
 #include <memory>
 #include <optional>
 #include <span>
-#include <unordered_map>
 #include <vector>
 
 #include "ridgeline/result.h"
@@ -134,8 +133,9 @@ class DetailField {
 
   /// Detail at level-`level` lattice sample (i, j) in units of kDetailUnit, evaluated directly
   /// (no cache, no allocation): reproduces the tile recurrence bit for bit. level <= levels()
-  /// (asserted); level 0 gives 0. Any (i, j) is valid (outside the terrain the shape field
-  /// repeats its edge); |i|, |j| < 2^40. Cost: about 60 samples per level.
+  /// (asserted; 0 is returned past it); level 0 gives 0. Any (i, j) is valid (outside the
+  /// terrain the shape field repeats its edge); |i|, |j| < 2^40. Cost: at most 7 x 7 samples
+  /// per level (about 3 us at level 8, 6 us at level 12 on the CI machine).
   std::int32_t detail_raw(std::uint32_t level, std::int64_t i, std::int64_t j) const noexcept;
   /// The same in metres.
   double detail(std::uint32_t level, std::int64_t i, std::int64_t j) const noexcept {
@@ -143,7 +143,8 @@ class DetailField {
   }
   /// Detail of a w x h window of level-`level` samples starting at (i0, j0), row-major into
   /// `out` (out.size() >= w * h), evaluated directly; identical to detail_raw per sample and
-  /// cheaper than calling it w * h times.
+  /// cheaper than calling it w * h times. Allocates scratch of about (w/2 + 4) * (h/2 + 4)
+  /// samples. level > levels() (asserted) gives zeros; a short `out` is left untouched.
   void detail_window(std::uint32_t level, std::int64_t i0, std::int64_t j0, std::uint32_t w,
                      std::uint32_t h, std::span<std::int32_t> out) const;
 
@@ -157,7 +158,8 @@ class DetailField {
 
   /// Generates a tile from its parent tile (the recurrence). `parent` must be the tile
   /// key.parent() for level >= 2 and null for level 1 (whose parent is the zero base detail);
-  /// asserted. 1 <= key.level <= levels(). Thread-safe; allocates one tile.
+  /// asserted (null is returned past the asserts). 1 <= key.level <= levels(). Thread-safe;
+  /// allocates one tile (72,948 bytes).
   std::shared_ptr<const DetailTile> make_tile(const DetailTileKey& key,
                                               const DetailTile* parent) const;
   /// Generates a tile and every ancestor it needs, synchronously (tools and tests).
@@ -234,15 +236,21 @@ class DetailSnapshot {
 
  private:
   friend class DetailCache;
-  std::unordered_map<DetailTileKey, std::shared_ptr<const DetailTile>, DetailTileKeyHash> tiles_;
+  std::ptrdiff_t find_index(const DetailTileKey& key) const noexcept;
+  // Flat arrays (cheap to build once per update): the tiles, and an open-addressing index of
+  // them (power-of-two size, linear probing, -1 for empty).
+  std::vector<std::shared_ptr<const DetailTile>> tiles_;
+  std::vector<std::int32_t> index_;
 };
 
 /// Tiles generated on demand, cached with LRU eviction under a byte budget.
 ///
 /// Threading contract:
 /// - request(), update() and stats() may be called from any threads; they serialise on one
-///   internal mutex held for O(1) work per request (O(tiles integrated + evicted) per update),
-///   never during generation. The renderer never waits for generation.
+///   internal mutex held for O(1) work per request and, per update(), for the tiles integrated
+///   and evicted plus, when anything changed, a copy of the resident table into the new
+///   snapshot (O(resident tiles)); never during generation. The renderer never waits for
+///   generation.
 /// - snapshot() may be called from any thread (one atomic shared_ptr load); lookups in the
 ///   snapshot take no lock at all. try_get() is a snapshot() plus a lookup: in a hot loop take
 ///   the snapshot once.
@@ -259,7 +267,7 @@ class DetailCache {
   /// True when the tile is resident (and marks it used this frame for the LRU). Otherwise
   /// queues it (once; `urgent` puts it first) and returns false without waiting, except in
   /// synchronous mode where it generates it and returns true. key.level must be 1..levels()
-  /// (asserted).
+  /// (asserted; false past the assert).
   bool request(const DetailTileKey& key, bool urgent = false);
   /// Starts a frame: integrates generated tiles (at most `max_integrations`, 0 = all), evicts the
   /// least recently used tiles until the bytes are within budget, publishes a new snapshot.
