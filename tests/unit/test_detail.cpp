@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <mutex>
 #include <random>
 #include <thread>
@@ -231,6 +232,29 @@ TEST(Detail, DeterministicAcrossRunsAndThreadCounts) {
   EXPECT_EQ(one, 0xf0219510bdd0082full);
   // Another seed gives another surface.
   EXPECT_NE(one, hash_rows(*make_field(6, 12346), -40, 216));
+
+  // Heights (base + detail, doubles) over a region: one thread against three, bit for bit.
+  auto height_hash = [&](std::int64_t j0, std::int64_t j1) {
+    std::uint64_t h = 0xcbf29ce484222325ull;
+    for (std::int64_t j = j0; j < j1; ++j)
+      for (std::int64_t i = 1000; i < 1300; ++i) {
+        const double v = f->height(6, i, j).value_or(-1.0);
+        std::uint64_t bits;
+        std::memcpy(&bits, &v, sizeof bits);
+        h = fnv(fnv(h, std::int32_t(bits)), std::int32_t(bits >> 32));
+      }
+    return h;
+  };
+  const std::uint64_t serial = height_hash(2000, 2090);
+  std::uint64_t parts3[3];
+  std::vector<std::thread> hthreads;
+  for (int t = 0; t < 3; ++t)
+    hthreads.emplace_back([&, t] { parts3[t] = height_hash(2000 + 30 * t, 2030 + 30 * t); });
+  for (auto& t : hthreads) t.join();
+  std::uint64_t again[3] = {height_hash(2000, 2030), height_hash(2030, 2060),
+                            height_hash(2060, 2090)};
+  for (int t = 0; t < 3; ++t) EXPECT_EQ(parts3[t], again[t]);
+  EXPECT_EQ(serial, height_hash(2000, 2090));
 }
 
 // Brute force: the largest |D_L(v) - P(v)| over the finest samples of a rectangle, P the
