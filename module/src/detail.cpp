@@ -521,6 +521,11 @@ struct DetailCache::State {
   std::function<void(std::function<void()>)> executor;
 
   mutable std::mutex mu;
+  // The published snapshot has its own lock, held only to copy or swap the pointer, so readers
+  // never wait behind request() or update(). (std::atomic<std::shared_ptr> would do the same
+  // with libstdc++'s internal spin bit, which ThreadSanitizer cannot see.)
+  mutable std::mutex snapshot_mu;
+  std::shared_ptr<const DetailSnapshot> snapshot;
   std::condition_variable work_cv, idle_cv;
   bool stop = false;
   std::vector<std::thread> workers;
@@ -539,6 +544,14 @@ struct DetailCache::State {
   DetailCacheStats stats;
   std::chrono::steady_clock::time_point window_start = std::chrono::steady_clock::now();
   std::uint64_t window_generated = 0;
+
+  // Swaps in a new snapshot; the old one is released outside snapshot_mu.
+  void publish(std::shared_ptr<const DetailSnapshot> next) {
+    {
+      std::lock_guard<std::mutex> lock(snapshot_mu);
+      snapshot.swap(next);
+    }
+  }
 
   void touch(Entry& e) { lru.splice(lru.begin(), lru, e.lru); }
 
@@ -680,7 +693,7 @@ Result<std::unique_ptr<DetailCache>> DetailCache::create(std::shared_ptr<const D
     }
   }
   cache->state_ = std::move(s);
-  cache->snapshot_.store(std::make_shared<const DetailSnapshot>());
+  cache->state_->snapshot = std::make_shared<const DetailSnapshot>();
   return cache;
 }
 
@@ -711,7 +724,7 @@ bool DetailCache::request(const DetailTileKey& key, bool urgent) {
     for (auto& tile : s.generate(lock, keys, std::move(parent))) s.insert_resident(tile);
     if (auto it = s.resident.find(key); it != s.resident.end()) s.touch(it->second);
     s.evict_to_budget();
-    snapshot_.store(s.make_snapshot());
+    s.publish(s.make_snapshot());
     return true;
   }
   if (s.pending.count(key)) return false;
@@ -757,15 +770,16 @@ void DetailCache::update(std::size_t max_integrations) {
     s.window_start = now;
     s.window_generated = s.stats.generated;
   }
-  if (changed) snapshot_.store(s.make_snapshot());
+  if (changed) s.publish(s.make_snapshot());
 }
 
 std::shared_ptr<const DetailSnapshot> DetailCache::snapshot() const {
-  return snapshot_.load();
+  std::lock_guard<std::mutex> lock(state_->snapshot_mu);
+  return state_->snapshot;
 }
 
 std::shared_ptr<const DetailTile> DetailCache::try_get(const DetailTileKey& key) const {
-  const std::shared_ptr<const DetailSnapshot> snap = snapshot_.load();
+  const std::shared_ptr<const DetailSnapshot> snap = snapshot();
   const std::ptrdiff_t e = snap->find_index(key);
   return e < 0 ? nullptr : snap->tiles_[std::size_t(e)];
 }

@@ -4,7 +4,6 @@
 // the queries do not use it yet (docs/detail.md, "Not integrated yet").
 #pragma once
 
-#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -251,9 +250,11 @@ class DetailSnapshot {
 ///   and evicted plus, when anything changed, a copy of the resident table into the new
 ///   snapshot (O(resident tiles)); never during generation. The renderer never waits for
 ///   generation.
-/// - snapshot() may be called from any thread (one atomic shared_ptr load); lookups in the
-///   snapshot take no lock at all. try_get() is a snapshot() plus a lookup: in a hot loop take
-///   the snapshot once.
+/// - snapshot() may be called from any thread: a shared_ptr copy under a lock of its own, held
+///   for that copy only (never behind request(), update() or generation). Lookups in a snapshot
+///   take no lock and write no shared memory, so queries on many threads share one snapshot
+///   per frame or batch without contention. try_get() is a snapshot() plus a lookup: fine for
+///   a one-off, but in a query loop take the snapshot once.
 /// - Tiles become visible to snapshot()/try_get() only at update() (the owner calls it once per
 ///   frame), except in synchronous mode where request() publishes at once.
 class DetailCache {
@@ -288,7 +289,6 @@ class DetailCache {
   DetailCache() = default;
   std::shared_ptr<const DetailField> field_;
   std::shared_ptr<State> state_;
-  std::atomic<std::shared_ptr<const DetailSnapshot>> snapshot_;
 };
 
 }  // namespace ridgeline
