@@ -317,11 +317,12 @@ Result<std::shared_ptr<const DetailField>> DetailField::create(
         params.flat_shape + (params.steep_shape - params.flat_shape) * (t * t * (3 - 2 * t));
     f->shape_[s] = static_cast<std::uint16_t>(clamp64(std::llround(shape * 32768.0), 0, 32768));
   }
-  // Max pyramid for the bound: level p holds the max over blocks of 2^p x 2^p samples.
-  f->shape_max_.push_back(f->shape_);
+  // Max pyramid for the bound: level p >= 1 (shape_max_[p - 1]) holds the max over blocks of
+  // 2^p x 2^p samples; level 0 is the field itself.
   std::int64_t pw = W, ph = H;
   while (pw > 1 || ph > 1) {
-    const std::vector<std::uint16_t>& src = f->shape_max_.back();
+    const std::vector<std::uint16_t>& src =
+        f->shape_max_.empty() ? f->shape_ : f->shape_max_.back();
     const std::int64_t nw = (pw + 1) / 2, nh = (ph + 1) / 2;
     std::vector<std::uint16_t> dst(std::size_t(nw * nh));
     for (std::int64_t j = 0; j < nh; ++j)
@@ -475,12 +476,13 @@ double DetailField::contribution_bound(std::uint32_t from_level, std::uint32_t l
   std::int64_t a0 = clamp64((i0 >> level) - 1, 0, w1), a1 = clamp64((i1 >> level) + 2, 0, w1);
   std::int64_t b0 = clamp64((j0 >> level) - 1, 0, h1), b1 = clamp64((j1 >> level) + 2, 0, h1);
   std::size_t p = 0;
-  while (p + 1 < shape_max_.size() && ((a1 >> p) - (a0 >> p) > 1 || (b1 >> p) - (b0 >> p) > 1)) ++p;
-  const std::int64_t pw = std::max<std::int64_t>(1, ((shape_w_ - 1) >> p) + 1);
+  while (p < shape_max_.size() && ((a1 >> p) - (a0 >> p) > 1 || (b1 >> p) - (b0 >> p) > 1)) ++p;
+  const std::vector<std::uint16_t>& blocks = p == 0 ? shape_ : shape_max_[p - 1];
+  const std::int64_t pw = ((shape_w_ - 1) >> p) + 1;
   std::uint16_t smax = 0;
   for (std::int64_t bj = b0 >> p; bj <= (b1 >> p); ++bj)
     for (std::int64_t bi = a0 >> p; bi <= (a1 >> p); ++bi)
-      smax = std::max(smax, shape_max_[p][std::size_t(bi + bj * pw)]);
+      smax = std::max(smax, blocks[std::size_t(bi + bj * pw)]);
   std::int64_t amps = 0, rounding = 0;
   for (std::uint32_t m = std::max(from_level, 1u); m <= params_.levels; ++m) {
     amps += amp_[m] + amp_[m - 1];

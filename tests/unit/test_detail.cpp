@@ -310,6 +310,33 @@ TEST(Detail, AmplitudeBoundHoldsAgainstBruteForce) {
   }
 }
 
+TEST(Detail, RegionalBoundUsesTheLargestShapeInReach) {
+  // From the finest level only, the bound is (a_L + a_{L-1}) * max shape + 1 unit: recover the
+  // max shape it used and compare with a brute-force scan of the stored samples in reach.
+  auto f = make_field(5);
+  const double unit = kDetailUnit;
+  double all = 0;
+  for (int j = 0; j < 65; ++j)
+    for (int i = 0; i < 65; ++i) all = std::max(all, f->shape(0, i, j));
+  const double per_shape = (f->contribution_bound(5) - unit) / all;
+  std::mt19937_64 rng(9);
+  std::uniform_int_distribution<std::int64_t> pos(-5, 70), len(0, 40);
+  for (int n = 0; n < 500; ++n) {
+    const std::int64_t i0 = pos(rng), j0 = pos(rng), i1 = i0 + len(rng), j1 = j0 + len(rng);
+    double want = 0;
+    for (std::int64_t j = std::max<std::int64_t>(j0 - 1, 0);
+         j <= std::min<std::int64_t>(j1 + 2, 64); ++j)
+      for (std::int64_t i = std::max<std::int64_t>(i0 - 1, 0);
+           i <= std::min<std::int64_t>(i1 + 2, 64); ++i)
+        want = std::max(want, f->shape(0, i, j));
+    if (i0 - 1 > 64 || j0 - 1 > 64)
+      want = f->shape(0, std::min<std::int64_t>(i0, 64), std::min<std::int64_t>(j0, 64));
+    const double got = (f->contribution_bound(5, 0, i0, j0, i1, j1) - unit) / per_shape;
+    // The pyramid may take a few more samples (whole blocks), never fewer.
+    ASSERT_GE(got, want - 1e-9) << i0 << "," << j0 << " .. " << i1 << "," << j1;
+  }
+}
+
 TEST(Detail, ShapeFieldIsSmoothAndFollowsSlope) {
   auto f = make_field(8);
   // Flat plain: flat_shape; inside the hills somewhere: steep_shape.
