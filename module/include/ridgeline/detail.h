@@ -118,7 +118,8 @@ class DetailTile {
 /// diagonal rule) plus a smoothing correction (4-point cubic minus linear, clamped to the
 /// previous octave's amplitude) plus that level's octave: a hashed value in [-1, 1] times
 /// amplitude * gain^(l-1) * shape(x, z). All of it is integer arithmetic on fixed-point values,
-/// so it is bit for bit the same on every platform, compiler and thread.
+/// so it is bit for bit the same on every platform, compiler and thread (the shape field is
+/// computed once at create() in double with correctly rounded operations only, then quantised).
 class DetailField {
  public:
   /// Validates `params` and derives the shape field from the terrain's slopes (once, at the base
@@ -204,9 +205,9 @@ struct DetailCacheDesc {
   /// Worker threads of the cache's own pool, 0..64. 0 means synchronous: request() generates
   /// the tile (and its missing ancestors) before returning. Ignored when `executor` is set.
   std::uint32_t worker_threads = 2;
-  /// Optional job system of the embedding engine: called (from request(), under no lock the
-  /// caller can see) with a job to run once on any thread. The job is self-contained and safe to
-  /// run after the cache is destroyed (it then does nothing).
+  /// Optional job system of the embedding engine: called from request(), after the cache's lock
+  /// is released, with a job to run once on any thread (it may also run it inline). The job is
+  /// self-contained and safe to run after the cache is destroyed (it then does nothing).
   std::function<void(std::function<void()>)> executor;
 };
 
