@@ -3,15 +3,18 @@
 // recomputation (section 6). The split-only rebuild mode is Turner 2000.
 //
 // Lazy priorities. A queued node's key is the LARGEST priority it can take while the eye stays
-// within r = slack * d of the point where it was computed (d: distance to the node's bounding
-// box): bound * K / (d - r). Both queues are keyed by this upper bound and decisions compare it
-// with the threshold, so split and merge use one function (no oscillation) and every triangle
-// left unsplit truly meets the threshold for any eye position in its window. The key is
-// recomputed when the eye has travelled r (an odometer, so it is conservative for any path).
-// A node classified outside the frustum gets priority 0 (it is merged back towards its root),
-// which stays valid while translation and rotation cannot bring it inside: it carries a second,
-// angular expiry. Nodes near the frustum border count as inside (conservative). A change of
-// field of view, viewport or far plane recomputes every key.
+// within a window w of the point where it was computed (d: distance to the node's bounding box):
+// bound * K / (d - w), w = max(slack * d, half the way to where the priority would equal the
+// threshold). Both queues are keyed by this upper bound and decisions compare it with the
+// threshold, so split and merge use one function (no oscillation) and every triangle left
+// unsplit truly meets the threshold for any eye position in its window. The key is recomputed
+// when the eye's odometer has advanced by w (conservative for any path). A node classified
+// outside the frustum gets priority 0 (it is merged back towards its root), valid while
+// translation and rotation cannot bring it inside: it carries an angular expiry too. Nodes near
+// the frustum border count as inside (conservative); visible nodes are re-checked once the view
+// may have turned enough to lose them. A change of field of view, viewport or far plane makes
+// every key due, a threshold rise makes the merge keys due (their windows were sized for the
+// lower threshold); due keys are recomputed within the time budget, the rest next update.
 #include "ridgeline/roam_view.h"
 
 #include <algorithm>
