@@ -58,6 +58,8 @@ struct Node {
   float ylo = 0, yhi = 0;  // bounding box y range relative to the height offset, metres
 };
 
+static_assert(sizeof(Node) == 60, "docs/architecture.md and docs/roam.md quote the node size");
+
 struct HeapEntry {
   float key;
   std::uint32_t node;
