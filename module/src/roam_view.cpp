@@ -37,8 +37,8 @@ constexpr std::uint32_t kNone = 0xffffffffu;
 constexpr float kInf = std::numeric_limits<float>::infinity();
 // How much of the way to the threshold crossing a priority window spans (see priority()).
 constexpr double kWindowFraction = 0.5;
-// Smallest rotation (radians) before a visible node's key is reconsidered for leaving the view.
-constexpr double kMinAngleWindow = 0.03;
+// Deepest level the hierarchical culling pass tracks (see refresh_culling()).
+constexpr std::uint32_t kCullDepth = 4;
 
 struct Node {
   std::uint32_t parent = kNone;
@@ -54,11 +54,12 @@ struct Node {
   float due_a = std::numeric_limits<float>::infinity();
   std::int32_t ax = 0, az = 0;  // apex in global lattice coordinates (geometry in O(1))
   // Cached at creation so a priority reads no height or bound arrays (cache misses dominated):
-  float bound = 0;         // nested error bound, metres
-  float ylo = 0, yhi = 0;  // bounding box y range relative to the height offset, metres
+  float bound = 0;           // nested error bound, metres
+  float ylo = 0, yhi = 0;    // bounding box y range relative to the height offset, metres
+  std::uint8_t visible = 1;  // in view at the last culling pass (levels <= kCullDepth)
 };
 
-static_assert(sizeof(Node) == 60, "docs/architecture.md and docs/roam.md quote the node size");
+static_assert(sizeof(Node) == 64, "docs/architecture.md and docs/roam.md quote the node size");
 
 struct HeapEntry {
   float key;
@@ -470,9 +471,9 @@ struct RoamView::Impl {
       v.angle = 0.5 * margin / reach;
       return 0.0f;
     }
-    // Counting a node as visible is always conservative, but one that has turned out of view
-    // should be merged: recompute it once the view may have turned far enough to lose it.
-    v.angle = std::max(inside / reach, kMinAngleWindow);
+    // Counting a node as visible is always conservative; nodes that turn out of view are
+    // re-keyed when an ancestor leaves the view (refresh_culling()).
+    (void)inside;
     // Window: at least slack * d; wider when the node is far from the threshold either way
     // (half the way to the distance at which its priority would equal the threshold), so nodes
     // that are clearly fine or clearly too coarse are not recomputed every frame. The key stays
@@ -615,6 +616,8 @@ struct RoamView::Impl {
                 hr = land.lattice_height(t.rx, t.rz);
     nd.ylo = std::min({ha, hl, hr}) - nd.bound;
     nd.yhi = std::max({ha, hl, hr}) + nd.bound;
+    // The culling pass tracks the upper levels; a new node starts with its current visibility.
+    if (have_camera && level(n) <= kCullDepth) nd.visible = classify_node(n) != Cull::kOut;
   }
 
   void make_children(std::uint32_t n) {
@@ -778,6 +781,74 @@ struct RoamView::Impl {
     for (const auto& e : merge.entries()) due(e.node);
   }
 
+  enum class Cull : std::uint8_t { kOut, kPartial, kIn };
+
+  // Classifies the box [lo, hi] (world) against the frustum's side planes and far distance.
+  Cull classify_box(const glm::dvec3& lo, const glm::dvec3& hi) const {
+    const glm::dvec3 c = 0.5 * (lo + hi) - cam.eye, he = 0.5 * (hi - lo);
+    if (glm::length(glm::clamp(cam.eye, lo, hi) - cam.eye) > cam.far_m) return Cull::kOut;
+    bool all_in = true;
+    for (const glm::dvec3& pn : planes) {
+      const double mid = glm::dot(pn, c);
+      const double ext = std::abs(pn.x) * he.x + std::abs(pn.y) * he.y + std::abs(pn.z) * he.z;
+      if (mid + ext < 0.0) return Cull::kOut;
+      if (mid - ext < 0.0) all_in = false;
+    }
+    return all_in ? Cull::kIn : Cull::kPartial;
+  }
+
+  Cull classify_node(std::uint32_t n) const {
+    const Node& nd = nodes[n];
+    const LatticeTriangle t = land.triangle_at(nd.ax, nd.az, nd.root, nd.heap);
+    const glm::dvec3 lo(land.world_x(std::min({t.ax, t.lx, t.rx})), height_offset + double(nd.ylo),
+                        land.world_z(std::min({t.az, t.lz, t.rz})));
+    const glm::dvec3 hi(land.world_x(std::max({t.ax, t.lx, t.rx})), height_offset + double(nd.yhi),
+                        land.world_z(std::max({t.az, t.lz, t.rz})));
+    return classify_box(lo, hi);
+  }
+
+  // Makes every queued key in n's subtree due.
+  void rekey_subtree(std::uint32_t n, std::vector<std::uint32_t>& stack) {
+    stack.push_back(n);
+    while (!stack.empty()) {
+      const std::uint32_t x = stack.back();
+      stack.pop_back();
+      Node& nd = nodes[x];
+      if (nd.qslot != kNone) {
+        nd.due_d = floor_float(odometer);
+        by_distance.push(nd.due_d, x);
+      }
+      if (nd.child != kNone) {
+        stack.push_back(nd.child);
+        stack.push_back(nd.child + 1);
+      }
+    }
+  }
+
+  // Hierarchical culling (D97's IN / OUT / PARTIAL flags) over the upper levels of the trees:
+  // nodes wholly in or out of view end the descent, so the cost follows the frustum's border.
+  // A node that left the view has every queued key below it made due, so what turned out of
+  // view is merged back (keys computed as visible stay conservative but would keep the detail).
+  void refresh_culling(bool rekey = true) {
+    std::vector<std::uint32_t> stack, sub;
+    for (std::uint32_t r = 0; r < land.root_count(); ++r) {
+      stack.push_back(r);
+      while (!stack.empty()) {
+        const std::uint32_t n = stack.back();
+        stack.pop_back();
+        Node& nd = nodes[n];
+        const Cull c = classify_node(n);
+        const bool was = nd.visible != 0, now = c != Cull::kOut;
+        nd.visible = now;
+        if (was && !now && rekey) rekey_subtree(n, sub);
+        if (c == Cull::kPartial && nd.child != kNone && level(n) < kCullDepth) {
+          stack.push_back(nd.child);
+          stack.push_back(nd.child + 1);
+        }
+      }
+    }
+  }
+
   void mark_merges_due() {
     for (const auto& e : merge.entries()) {
       Node& nd = nodes[e.node];
@@ -911,6 +982,7 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
   if (m.reset_pending || settings_.mode == RoamMode::kRebuild) {
     m.reset_pending = false;
     m.reset_to_roots();
+    if (settings_.metric == ErrorMetric::kScreenPixels) m.refresh_culling(false);
   } else if (settings_.metric == ErrorMetric::kScreenPixels) {
     const std::size_t queued = m.split.size() + m.merge.size();
     // Stale records piling up (nodes re-keyed, split or merged before their records came due)
@@ -924,6 +996,7 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
       m.by_distance.compact_some(live_d, 4096);
       m.by_angle.compact_some(live_a, 4096);
     }
+    m.refresh_culling();
     const bool everything = all;
     if (everything) {
       m.mark_all_due();
