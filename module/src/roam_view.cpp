@@ -458,22 +458,20 @@ struct RoamView::Impl {
     // Side planes. The box is outside a plane by margin m (metres) when its most inward corner
     // is m behind it; the classification holds while translation + rotation * reach < m.
     const glm::dvec3 c = 0.5 * (lo + hi) - e, he = 0.5 * (hi - lo);
-    double margin = 0.0, inside = std::numeric_limits<double>::infinity();
+    double margin = 0.0;
     for (const glm::dvec3& pn : planes) {
       const double s_max =
           glm::dot(pn, c) + std::abs(pn.x) * he.x + std::abs(pn.y) * he.y + std::abs(pn.z) * he.z;
       margin = std::max(margin, -s_max);
-      inside = std::min(inside, s_max);
     }
-    const double reach = std::max(glm::length(c) + glm::length(he), 1e-9);
     if (margin > r && margin > 0.0) {
+      const double reach = std::max(glm::length(c) + glm::length(he), 1e-9);
       v.distance = 0.5 * margin;
       v.angle = 0.5 * margin / reach;
       return 0.0f;
     }
     // Counting a node as visible is always conservative; nodes that turn out of view are
     // re-keyed when an ancestor leaves the view (refresh_culling()).
-    (void)inside;
     // Window: at least slack * d; wider when the node is far from the threshold either way
     // (half the way to the distance at which its priority would equal the threshold), so nodes
     // that are clearly fine or clearly too coarse are not recomputed every frame. The key stays
