@@ -548,7 +548,8 @@ TEST(Roam, ThresholdChangesNeedNoRecomputation) {
   auto fine = view->update(c);
   ASSERT_TRUE(fine);
   EXPECT_GT(fine->triangles, coarse->triangles);
-  EXPECT_EQ(fine->expired, 0u);  // the camera did not move: no key expired (keys hold any threshold)
+  EXPECT_EQ(fine->expired,
+            0u);  // the camera did not move: no key expired (keys hold any threshold)
   EXPECT_FALSE(fine->rebuilt);
   expect_converged(*view, c, 1.0);
   s.threshold = 4.0;
@@ -559,4 +560,28 @@ TEST(Roam, ThresholdChangesNeedNoRecomputation) {
   // Back to (nearly) the coarse mesh: keys are windowed per threshold, so not bit for bit.
   EXPECT_NEAR(double(back->triangles), double(coarse->triangles), 0.05 * coarse->triangles);
   expect_converged(*view, c, 4.0);
+}
+
+TEST(Roam, DetailThatTurnsOutOfViewIsMergedBack) {
+  auto l = make_landscape(257, 5);
+  auto view = RoamView::create(l, {.threshold = 1.0}).value();
+  const glm::dvec3 eye(256, 140, 256);
+  auto look = [&](double yaw) {
+    return camera_at(eye, eye + glm::dvec3(std::cos(yaw), -0.5, std::sin(yaw)), 50.0);
+  };
+  // Turn on the spot by 180 degrees in 5-degree steps (no translation: only rotation moves keys).
+  RoamStats st{};
+  for (int k = 0; k <= 36; ++k) {
+    auto r = view->update(look(k * M_PI / 36));
+    ASSERT_TRUE(r);
+    st = *r;
+  }
+  EXPECT_EQ(check_crack_free(*view), "");
+  expect_converged(*view, look(M_PI), 1.0);
+  // A fresh view for the final camera: the turned view must not carry much more detail.
+  auto fresh = RoamView::create(l, {.threshold = 1.0}).value();
+  auto f = fresh->update(look(M_PI));
+  ASSERT_TRUE(f);
+  EXPECT_LT(double(st.triangles), 1.25 * double(f->triangles))
+      << "turned view " << st.triangles << " vs fresh " << f->triangles;
 }
