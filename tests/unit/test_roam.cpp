@@ -11,6 +11,7 @@
 #include <optional>
 #include <random>
 #include <set>
+#include <thread>
 #include <tuple>
 
 #include "ridgeline/roam_view.h"
@@ -584,4 +585,24 @@ TEST(Roam, DetailThatTurnsOutOfViewIsMergedBack) {
   ASSERT_TRUE(f);
   EXPECT_LT(double(st.triangles), 1.25 * double(f->triangles))
       << "turned view " << st.triangles << " vs fresh " << f->triangles;
+}
+
+TEST(Roam, ViewsUpdateOnDifferentThreadsOverOneLandscape) {
+  auto l = make_landscape(257, 5);
+  auto run = [&](glm::dvec3 eye, std::uint64_t* hash) {
+    auto view = RoamView::create(l, {.threshold = 2.0}).value();
+    for (int k = 0; k < 40; ++k) {
+      eye += glm::dvec3(3, 0, 2);
+      ASSERT_TRUE(view->update(camera_at(eye, eye + glm::dvec3(50, -20, 40))));
+    }
+    *hash = view->mesh_hash();
+  };
+  std::uint64_t a1 = 0, b1 = 0, a2 = 0, b2 = 0;
+  run({10, 150, 10}, &a1);  // reference, one thread
+  run({400, 150, 60}, &b1);
+  std::thread ta(run, glm::dvec3(10, 150, 10), &a2), tb(run, glm::dvec3(400, 150, 60), &b2);
+  ta.join();
+  tb.join();
+  EXPECT_EQ(a1, a2);
+  EXPECT_EQ(b1, b2);
 }
