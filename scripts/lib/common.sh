@@ -7,7 +7,7 @@ RIDGELINE_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 RIDGELINE_PACKAGES=(
   g++ cmake ninja-build pkg-config git ca-certificates
   libglm-dev libopenimageio-dev libtinygltf-dev nlohmann-json3-dev libcli11-dev
-  libgtest-dev libbenchmark-dev
+  libgtest-dev libbenchmark-dev liblua5.4-dev lua5.4
 )
 
 # Installs the given Debian packages that are missing, through sudo when not root.

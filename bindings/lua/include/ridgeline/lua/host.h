@@ -1,0 +1,83 @@
+// Host: runs game scripts in a (by default sandboxed) Lua 5.4 state with the ridgeline module.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "ridgeline/result.h"
+
+struct lua_State;
+
+namespace ridgeline::lua {
+
+/// What a Host allows its scripts. Defaults are the game-script sandbox.
+struct HostOptions {
+  /// Sandbox (default): the globals hold only base (without dofile, loadfile, and load refuses
+  /// binary chunks), string (without dump), table, math, utf8, coroutine and `ridgeline`; no io,
+  /// os, package, debug, require. The string metatable is protected. When false, every standard
+  /// library is opened (trusted tools).
+  bool sandbox = true;
+  /// Lua VM instructions one host call (run, call) may execute, counted by a hook every 1000
+  /// instructions; 0 = no limit. Exceeding it ends the call with an error and a traceback.
+  std::uint64_t instruction_limit = 100'000'000;
+  /// Bytes the Lua state may hold (owned states only; 0 = no limit). Above it the next hook
+  /// check ends the call with an error and a traceback; a single allocation that would pass the
+  /// limit plus a headroom of max(1 MiB, limit / 8) is refused (Lua's "not enough memory").
+  /// C++ terrain data is not counted here: `max_samples` bounds it.
+  std::size_t memory_limit = std::size_t{64} << 20;
+  /// Folder sandboxed scripts may read from (ridgeline.load); empty: no file access. Paths given
+  /// by scripts are relative to it, without `..`, never absolute. Unused without the sandbox.
+  std::string data_root;
+  /// Largest heightmap a script may load, samples.
+  std::uint64_t max_samples = std::uint64_t{1} << 24;
+};
+
+/// Owns or borrows a lua_State and runs chunks and callbacks under a traceback message handler.
+/// A failing script returns a Status whose message holds the error and the traceback; the host
+/// and its state stay usable.
+///
+/// Threading: a Host and its lua_State are used by one thread at a time.
+class Host {
+ public:
+  /// Creates a new state (with the counting allocator) and opens the libraries per `options`.
+  static Result<std::unique_ptr<Host>> create(const HostOptions& options = {});
+  /// Uses an engine's state: installs the hook and, with options.sandbox, replaces the globals of
+  /// `L` with the sandbox. The memory limit does not apply (the engine owns the allocator).
+  /// `L` must outlive the Host; the Host does not close it.
+  static Result<std::unique_ptr<Host>> attach(lua_State* L, const HostOptions& options = {});
+  ~Host();
+  Host(const Host&) = delete;
+  Host& operator=(const Host&) = delete;
+
+  lua_State* state() const noexcept { return L_; }
+
+  /// Compiles `source` (text only) as chunk `name` and runs it. Errors carry a traceback.
+  Status run(std::string_view source, std::string_view name);
+  /// Reads a file with the host's own (unconfined) file access and runs it as text.
+  Status run_file(const std::string& path);
+  /// Calls the function below `nargs` arguments on top of the stack (like lua_pcall) under the
+  /// message handler and the limits, leaving `nresults` results (LUA_MULTRET allowed) on
+  /// success and nothing on failure.
+  Status call(int nargs, int nresults);
+  /// Calls global function `name` with no arguments and no results (a game callback).
+  Status call_global(const char* name);
+
+  /// Bytes held by an owned state (0 for an attached one).
+  std::size_t memory_used() const noexcept;
+  /// Instructions counted during the last call (in steps of 1000).
+  std::uint64_t last_instructions() const noexcept;
+
+  struct Limits;  // hook and allocator state (host.cpp)
+
+ private:
+  Host() = default;
+  Status setup(const HostOptions& options);
+  lua_State* L_ = nullptr;
+  bool owned_ = false;
+  std::unique_ptr<Limits> limits_;
+};
+
+}  // namespace ridgeline::lua

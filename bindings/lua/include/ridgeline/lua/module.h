@@ -1,0 +1,45 @@
+// The `ridgeline` Lua module: what `require "ridgeline"` returns, and the limits it enforces.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+struct lua_State;
+
+namespace ridgeline::lua {
+
+/// Points one call of terrain:heights() accepts (the hook never fires inside a C function, so
+/// every bound call that can do unbounded work has its own cap).
+inline constexpr std::size_t kMaxBatchPoints = 65536;
+/// Wheel offsets one call of terrain:contacts() accepts.
+inline constexpr std::size_t kMaxContacts = 64;
+/// Upper bound on the leaf triangles of one view (view:set_budget{triangles=} is clamped to it,
+/// and 0 means this cap).
+inline constexpr std::uint32_t kMaxViewTriangles = 4'000'000;
+/// Default triangle budget of a new view.
+inline constexpr std::uint32_t kDefaultViewTriangles = 500'000;
+
+/// How the module treats file names and sizes. Plain data; copied into the Lua state when the
+/// module is opened, so it may be destroyed afterwards.
+struct ModuleConfig {
+  /// When true, file names given by scripts must be relative, free of `..` and absolute parts,
+  /// and resolve inside `root` (symbolic links included). When false (the stock interpreter),
+  /// any path the process can read is accepted.
+  bool confine_paths = false;
+  /// Folder granted to scripts (used only with confine_paths; empty: no file access at all).
+  const char* root = "";
+  /// Largest heightmap ridgeline.load accepts, in samples (checked before allocating).
+  std::uint64_t max_samples = std::uint64_t{1} << 26;
+};
+
+/// Pushes a new `ridgeline` module table on the stack of `L` (the bound types' metatables are
+/// registered on first use). May raise a Lua error (memory); call it from a protected context
+/// or from luaopen_*. Returns 1.
+int open_module(lua_State* L, const ModuleConfig& config);
+
+}  // namespace ridgeline::lua
+
+extern "C" {
+/// Entry point of ridgeline.so for `require "ridgeline"`: unconfined paths, default caps.
+int luaopen_ridgeline(lua_State* L);
+}

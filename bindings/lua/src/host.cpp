@@ -1,0 +1,375 @@
+// Host: a sandboxed Lua 5.4 state for game scripts, after lua.c (message handler, protected
+// calls) with an instruction budget (count hook) and a memory cap (counting allocator).
+#include "ridgeline/lua/host.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <lua.hpp>
+#include <sstream>
+
+#include "lua_util.h"
+#include "ridgeline/lua/module.h"
+
+namespace ridgeline::lua {
+
+struct Host::Limits {
+  std::uint64_t instruction_limit = 0;
+  std::uint64_t instructions = 0;  // counted in the current call
+  std::size_t memory_limit = 0;    // 0: none
+  std::size_t hard_limit = 0;      // refused above this (memory_limit + headroom)
+  std::size_t used = 0;            // bytes held by the owned state
+  bool active = false;             // limits apply (off while the host sets the state up)
+  bool handling = false;           // inside the message handler: let it finish
+  std::uint64_t failed_request = 0;
+  lua_State* main = nullptr;  // the thread the host calls on
+};
+
+namespace {
+
+constexpr int kHookStep = 1000;
+char kLimitsKey;   // registry key (light userdata address) of the Limits
+char kSandboxKey;  // registry key of the sandbox environment table
+
+void* limited_alloc(void* ud, void* ptr, std::size_t osize, std::size_t nsize) {
+  auto* lim = static_cast<Host::Limits*>(ud);
+  const std::size_t old = ptr != nullptr ? osize : 0;
+  if (nsize == 0) {
+    std::free(ptr);
+    lim->used -= old;
+    return nullptr;
+  }
+  if (lim->active && lim->memory_limit != 0 && nsize > old &&
+      lim->used - old + nsize > lim->hard_limit) {
+    lim->failed_request = nsize;
+    return nullptr;  // Lua raises "not enough memory" (after an emergency collection)
+  }
+  void* p = std::realloc(ptr, nsize);
+  if (p != nullptr) lim->used = lim->used - old + nsize;
+  return p;
+}
+
+Host::Limits* limits_of(lua_State* L) {
+  lua_rawgetp(L, LUA_REGISTRYINDEX, &kLimitsKey);
+  auto* lim = static_cast<Host::Limits*>(lua_touserdata(L, -1));
+  lua_pop(L, 1);
+  return lim;
+}
+
+// Once a limit is exceeded the hook fires on every instruction of the running thread and of the
+// host's main thread, so that a script cannot keep going by catching the error with pcall (at a
+// 1000-instruction period the check would keep landing inside the pcall'ed loop).
+void count_hook(lua_State* L, lua_Debug*) {
+  Host::Limits* lim = limits_of(L);
+  if (lim == nullptr || !lim->active || lim->handling) return;
+  const int step = lua_gethookcount(L);
+  lim->instructions += static_cast<std::uint64_t>(step);
+  const bool over_instructions =
+      lim->instruction_limit != 0 && lim->instructions > lim->instruction_limit;
+  const bool over_memory = lim->memory_limit != 0 && lim->used > lim->memory_limit;
+  if (!over_instructions && !over_memory) {
+    if (step != kHookStep) lua_sethook(L, count_hook, LUA_MASKCOUNT, kHookStep);
+    return;
+  }
+  lua_sethook(L, count_hook, LUA_MASKCOUNT, 1);
+  if (lim->main != nullptr && lim->main != L) lua_sethook(lim->main, count_hook, LUA_MASKCOUNT, 1);
+  if (over_instructions)
+    luaL_error(L, "instruction limit exceeded (%I instructions per call)",
+               static_cast<lua_Integer>(lim->instruction_limit));
+  luaL_error(L, "memory limit exceeded (%I bytes in use, limit %I)",
+             static_cast<lua_Integer>(lim->used), static_cast<lua_Integer>(lim->memory_limit));
+}
+
+// Adds a traceback to the error (lua.c's msghandler).
+int message_handler(lua_State* L) {
+  Host::Limits* lim = limits_of(L);
+  if (lim != nullptr) lim->handling = true;
+  const char* msg = lua_tostring(L, 1);
+  if (msg == nullptr) {
+    if (luaL_callmeta(L, 1, "__tostring") && lua_type(L, -1) == LUA_TSTRING) return 1;
+    msg = lua_pushfstring(L, "(error object is a %s value)", luaL_typename(L, 1));
+  }
+  luaL_traceback(L, L, msg, 1);
+  return 1;
+}
+
+// load(chunk [, name [, mode [, env]]]): text chunks only; the default environment is the
+// sandbox, never the state's real globals.
+int safe_load(lua_State* L) {
+  lua_settop(L, 4);
+  lua_pushvalue(L, lua_upvalueindex(1));  // the original load
+  lua_pushvalue(L, 1);
+  lua_pushvalue(L, 2);
+  lua_pushliteral(L, "t");
+  if (lua_isnil(L, 4))
+    lua_rawgetp(L, LUA_REGISTRYINDEX, &kSandboxKey);
+  else
+    lua_pushvalue(L, 4);
+  lua_call(L, 4, LUA_MULTRET);
+  return lua_gettop(L) - 4;
+}
+
+// setmetatable refusing __gc: finalizers run with hooks disabled, so a looping __gc would escape
+// the instruction budget.
+int safe_setmetatable(lua_State* L) {
+  if (lua_type(L, 2) == LUA_TTABLE && lua_getfield(L, 2, "__gc") != LUA_TNIL)
+    luaL_argerror(L, 2, "__gc metamethods are not allowed in the sandbox");
+  lua_settop(L, 2);
+  lua_pushvalue(L, lua_upvalueindex(1));
+  lua_insert(L, 1);
+  lua_call(L, 2, 1);
+  return 1;
+}
+
+// collectgarbage limited to options that cannot switch the collector off or retune it.
+int safe_collectgarbage(lua_State* L) {
+  static const char* const kAllowed[] = {"collect", "count", "step", "isrunning", nullptr};
+  luaL_checkoption(L, 1, "collect", kAllowed);
+  lua_pushvalue(L, lua_upvalueindex(1));
+  lua_insert(L, 1);
+  lua_call(L, lua_gettop(L) - 1, LUA_MULTRET);
+  return lua_gettop(L);
+}
+
+struct SetupArgs {
+  const HostOptions* options;
+};
+
+// Opens the libraries and builds the sandbox environment; runs under lua_pcall.
+int setup_state(lua_State* L) {
+  const auto* args = static_cast<const SetupArgs*>(lua_touserdata(L, 1));
+  const HostOptions& o = *args->options;
+  if (!o.sandbox) {
+    luaL_openlibs(L);
+    ModuleConfig config;
+    config.max_samples = o.max_samples;
+    open_module(L, config);
+    lua_setglobal(L, "ridgeline");
+    lua_pushglobaltable(L);
+    lua_rawsetp(L, LUA_REGISTRYINDEX, &kSandboxKey);
+    return 0;
+  }
+  static const luaL_Reg kLibs[] = {{LUA_GNAME, luaopen_base},
+                                   {LUA_STRLIBNAME, luaopen_string},
+                                   {LUA_TABLIBNAME, luaopen_table},
+                                   {LUA_MATHLIBNAME, luaopen_math},
+                                   {LUA_UTF8LIBNAME, luaopen_utf8},
+                                   {LUA_COLIBNAME, luaopen_coroutine},
+                                   {nullptr, nullptr}};
+  lua_newtable(L);  // the sandbox environment
+  const int env = lua_gettop(L);
+  for (const luaL_Reg* lib = kLibs; lib->func != nullptr; ++lib) {
+    luaL_requiref(L, lib->name, lib->func, 0);
+    if (lib == kLibs) {  // base: copy the allowed functions only
+      static const char* const kBase[] = {
+          "assert",   "error",  "ipairs",       "next",     "pairs",  "pcall",    "print",
+          "rawequal", "rawget", "rawlen",       "rawset",   "select", "tonumber", "tostring",
+          "type",     "xpcall", "getmetatable", "_VERSION", nullptr};
+      for (const char* const* n = kBase; *n != nullptr; ++n) {
+        lua_getfield(L, -1, *n);
+        lua_setfield(L, env, *n);
+      }
+      lua_getfield(L, -1, "load");
+      lua_pushcclosure(L, safe_load, 1);
+      lua_setfield(L, env, "load");
+      lua_getfield(L, -1, "setmetatable");
+      lua_pushcclosure(L, safe_setmetatable, 1);
+      lua_setfield(L, env, "setmetatable");
+      lua_getfield(L, -1, "collectgarbage");
+      lua_pushcclosure(L, safe_collectgarbage, 1);
+      lua_setfield(L, env, "collectgarbage");
+    } else {
+      // A copy: scripts that change `string.rep` change their copy, not the string methods.
+      lua_newtable(L);
+      lua_pushnil(L);
+      while (lua_next(L, -3) != 0) {
+        lua_pushvalue(L, -2);
+        lua_insert(L, -2);
+        lua_settable(L, -4);
+      }
+      if (lib->func == luaopen_string) {
+        lua_pushnil(L);
+        lua_setfield(L, -2, "dump");
+      }
+      lua_setfield(L, env, lib->name);
+    }
+    lua_pop(L, 1);
+  }
+  lua_pushvalue(L, env);
+  lua_setfield(L, env, "_G");
+  // Protect the string metatable: getmetatable("") returns this string instead.
+  lua_pushliteral(L, "");
+  if (lua_getmetatable(L, -1)) {
+    lua_pushliteral(L, "string");
+    lua_setfield(L, -2, "__metatable");
+    lua_pop(L, 1);
+  }
+  lua_pop(L, 1);
+  ModuleConfig config;
+  config.confine_paths = true;
+  config.root = o.data_root.c_str();
+  config.max_samples = o.max_samples;
+  open_module(L, config);
+  lua_setfield(L, env, "ridgeline");
+  lua_pushvalue(L, env);
+  lua_rawsetp(L, LUA_REGISTRYINDEX, &kSandboxKey);
+  return 0;
+}
+
+// Looks the global up inside the protected call (the lookup may allocate) and calls it.
+int call_global_protected(lua_State* L) {
+  const char* name = static_cast<const char*>(lua_touserdata(L, 1));
+  lua_rawgetp(L, LUA_REGISTRYINDEX, &kSandboxKey);
+  lua_pushstring(L, name);
+  if (lua_rawget(L, -2) != LUA_TFUNCTION)
+    return luaL_error(L, "global '%s' is not a function", name);
+  lua_call(L, 0, 0);
+  return 0;
+}
+
+std::string top_message(lua_State* L, int rc, const Host::Limits& lim) {
+  const char* m = lua_tostring(L, -1);
+  std::string msg = m != nullptr ? m : "(error object is not a string)";
+  if (rc == LUA_ERRMEM && lim.memory_limit != 0) {
+    char extra[200];
+    std::snprintf(extra, sizeof extra,
+                  " (memory limit exceeded: a request of %llu bytes refused with %llu bytes in "
+                  "use, limit %llu; Lua runs no message handler for memory errors, so there is "
+                  "no traceback)",
+                  static_cast<unsigned long long>(lim.failed_request),
+                  static_cast<unsigned long long>(lim.used),
+                  static_cast<unsigned long long>(lim.memory_limit));
+    msg += extra;
+  }
+  return msg;
+}
+
+}  // namespace
+
+Result<std::unique_ptr<Host>> Host::create(const HostOptions& options) {
+  std::unique_ptr<Host> host(new Host());
+  host->limits_ = std::make_unique<Limits>();
+  host->L_ = lua_newstate(limited_alloc, host->limits_.get());
+  if (host->L_ == nullptr) return Error{"lua: cannot create a state"};
+  host->owned_ = true;
+  Status s = host->setup(options);
+  if (!s) return Error{s.message()};
+  return host;
+}
+
+Result<std::unique_ptr<Host>> Host::attach(lua_State* L, const HostOptions& options) {
+  if (L == nullptr) return Error{"lua: null state"};
+  std::unique_ptr<Host> host(new Host());
+  host->limits_ = std::make_unique<Limits>();
+  host->L_ = L;
+  Status s = host->setup(options);
+  if (!s) return Error{s.message()};
+  return host;
+}
+
+Status Host::setup(const HostOptions& options) {
+  if (options.data_root.size() >= sizeof(detail::ConfigBox::root))
+    return Error{"lua host: data_root is too long"};
+  Limits& lim = *limits_;
+  lim.instruction_limit = options.instruction_limit;
+  lim.memory_limit = owned_ ? options.memory_limit : 0;
+  lim.hard_limit =
+      lim.memory_limit + std::max<std::size_t>(std::size_t{1} << 20, lim.memory_limit / 8);
+  lua_State* L = L_;
+  lim.main = L;
+  lua_pushlightuserdata(L, &lim);  // no allocation: safe outside a protected call
+  lua_rawsetp(L, LUA_REGISTRYINDEX, &kLimitsKey);
+  SetupArgs args{&options};
+  lua_pushcfunction(L, setup_state);
+  lua_pushlightuserdata(L, &args);
+  if (lua_pcall(L, 1, 0, 0) != LUA_OK) {
+    std::string msg = std::string("lua host setup: ") + lua_tostring(L, -1);
+    lua_pop(L, 1);
+    return Error{msg};
+  }
+  lua_sethook(L, count_hook, LUA_MASKCOUNT, kHookStep);
+  lim.active = true;
+  return {};
+}
+
+Host::~Host() {
+  if (L_ == nullptr) return;
+  if (owned_) {
+    limits_->active = false;
+    lua_close(L_);
+  } else {
+    lua_sethook(L_, nullptr, 0, 0);
+    lua_pushnil(L_);
+    lua_rawsetp(L_, LUA_REGISTRYINDEX, &kLimitsKey);
+  }
+}
+
+Status Host::call(int nargs, int nresults) {
+  lua_State* L = L_;
+  const int base = lua_gettop(L) - nargs;
+  if (base < 1) return Error{"lua host: call without a function"};
+  if (!lua_checkstack(L, 2)) return Error{"lua host: stack overflow"};
+  lua_pushcfunction(L, message_handler);
+  lua_insert(L, base);
+  limits_->instructions = 0;
+  limits_->handling = false;
+  lua_sethook(L, count_hook, LUA_MASKCOUNT, kHookStep);
+  const int rc = lua_pcall(L, nargs, nresults, base);
+  limits_->handling = false;
+  lua_remove(L, base);
+  if (rc == LUA_OK) return {};
+  std::string msg = top_message(L, rc, *limits_);
+  lua_pop(L, 1);
+  // Give the next call a clean start when this one ran into the memory cap.
+  if (limits_->memory_limit != 0 && limits_->used > limits_->memory_limit / 2) {
+    limits_->active = false;
+    lua_gc(L, LUA_GCCOLLECT, 0);
+    limits_->active = true;
+  }
+  return Error{msg};
+}
+
+Status Host::run(std::string_view source, std::string_view name) {
+  lua_State* L = L_;
+  char chunkname[256];
+  std::snprintf(chunkname, sizeof chunkname, "=%.*s",
+                static_cast<int>(std::min<std::size_t>(name.size(), 200)), name.data());
+  limits_->instructions = 0;
+  if (!lua_checkstack(L, 4)) return Error{"lua host: stack overflow"};
+  const int rc = luaL_loadbufferx(L, source.data(), source.size(), chunkname, "t");
+  if (rc != LUA_OK) {
+    std::string msg = top_message(L, rc, *limits_);
+    lua_pop(L, 1);
+    return Error{msg};
+  }
+  lua_rawgetp(L, LUA_REGISTRYINDEX, &kSandboxKey);
+  lua_setupvalue(L, -2, 1);  // _ENV of the main chunk
+  return call(0, 0);
+}
+
+Status Host::run_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Error{"cannot open script '" + path + "'"};
+  std::ostringstream text;
+  text << in.rdbuf();
+  return run(text.str(), path);
+}
+
+Status Host::call_global(const char* name) {
+  lua_State* L = L_;
+  if (!lua_checkstack(L, 4)) return Error{"lua host: stack overflow"};
+  lua_pushcfunction(L, call_global_protected);
+  lua_pushlightuserdata(L, const_cast<char*>(name));
+  return call(1, 0);
+}
+
+std::size_t Host::memory_used() const noexcept {
+  return owned_ ? limits_->used : 0;
+}
+std::uint64_t Host::last_instructions() const noexcept {
+  return limits_->instructions;
+}
+
+}  // namespace ridgeline::lua

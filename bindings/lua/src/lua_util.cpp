@@ -1,0 +1,204 @@
+// Argument checking, metatables and path confinement shared by the wrap files.
+#include "lua_util.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <system_error>
+
+namespace ridgeline::lua::detail {
+
+void copy_error(char* err, const char* text) noexcept {
+  std::strncpy(err, text, kErrSize - 1);
+  err[kErrSize - 1] = '\0';
+}
+
+namespace {
+
+const char* non_finite_name(double v) {
+  return std::isnan(v) ? "nan" : (v > 0 ? "inf" : "-inf");
+}
+
+}  // namespace
+
+double check_finite(lua_State* L, int arg) {
+  const double v = luaL_checknumber(L, arg);
+  if (!std::isfinite(v)) {
+    lua_pushfstring(L, "finite number expected, got %s", non_finite_name(v));
+    luaL_argerror(L, arg, lua_tostring(L, -1));
+  }
+  return v;
+}
+
+double opt_finite(lua_State* L, int arg, double def) {
+  return lua_isnoneornil(L, arg) ? def : check_finite(L, arg);
+}
+
+void check_fields(lua_State* L, int arg, const char* const* names) {
+  lua_pushnil(L);
+  while (lua_next(L, arg) != 0) {
+    lua_pop(L, 1);  // value
+    bool known = false;
+    if (lua_type(L, -1) == LUA_TSTRING) {
+      const char* key = lua_tostring(L, -1);
+      for (const char* const* n = names; *n != nullptr && !known; ++n)
+        known = std::strcmp(*n, key) == 0;
+    }
+    if (!known) {
+      lua_pushfstring(L, "unknown field '%s'", luaL_tolstring(L, -1, nullptr));
+      luaL_argerror(L, arg, lua_tostring(L, -1));
+    }
+  }
+}
+
+bool get_number_field(lua_State* L, int arg, const char* name, double* out) {
+  const int type = lua_getfield(L, arg, name);
+  if (type == LUA_TNIL) {
+    lua_pop(L, 1);
+    return false;
+  }
+  int isnum = 0;
+  const double v = lua_tonumberx(L, -1, &isnum);
+  if (type != LUA_TNUMBER) {  // no string coercion in option tables
+    lua_pushfstring(L, "field '%s': number expected, got %s", name, luaL_typename(L, -1));
+    luaL_argerror(L, arg, lua_tostring(L, -1));
+  }
+  if (!std::isfinite(v)) {
+    lua_pushfstring(L, "field '%s': finite number expected, got %s", name, non_finite_name(v));
+    luaL_argerror(L, arg, lua_tostring(L, -1));
+  }
+  lua_pop(L, 1);
+  *out = v;
+  return true;
+}
+
+bool get_vector_field(lua_State* L, int arg, const char* name, int n, double* out) {
+  const int type = lua_getfield(L, arg, name);
+  if (type == LUA_TNIL) {
+    lua_pop(L, 1);
+    return false;
+  }
+  if (type != LUA_TTABLE || lua_rawlen(L, -1) != static_cast<lua_Unsigned>(n)) {
+    lua_pushfstring(L, "field '%s': array of %d numbers expected, got %s", name, n,
+                    luaL_typename(L, -1));
+    luaL_argerror(L, arg, lua_tostring(L, -1));
+  }
+  for (int i = 0; i < n; ++i) {
+    lua_rawgeti(L, -1, i + 1);
+    int isnum = 0;
+    const double v = lua_tonumberx(L, -1, &isnum);
+    isnum = isnum && lua_type(L, -1) == LUA_TNUMBER;
+    if (!isnum || !std::isfinite(v)) {
+      lua_pushfstring(L, "field '%s': entry %d: finite number expected, got %s", name, i + 1,
+                      isnum ? non_finite_name(v) : luaL_typename(L, -1));
+      luaL_argerror(L, arg, lua_tostring(L, -1));
+    }
+    out[i] = v;
+    lua_pop(L, 1);
+  }
+  lua_pop(L, 1);
+  return true;
+}
+
+void* check_self(lua_State* L, const char* tname) {
+  void* p = lua_touserdata(L, 1);
+  if (p != nullptr && lua_getmetatable(L, 1)) {
+    const bool ok = lua_rawequal(L, -1, lua_upvalueindex(1));
+    lua_pop(L, 1);
+    if (ok) return p;
+  }
+  luaL_typeerror(L, 1, tname);
+  return nullptr;
+}
+
+void push_metatable(lua_State* L, const char* tname, const luaL_Reg* methods,
+                    const luaL_Reg* metamethods) {
+  if (luaL_newmetatable(L, tname) == 0) return;  // already registered in this state
+  lua_newtable(L);                               // methods
+  lua_pushvalue(L, -2);
+  luaL_setfuncs(L, methods, 1);
+  lua_setfield(L, -2, "__index");
+  lua_pushvalue(L, -1);
+  luaL_setfuncs(L, metamethods, 1);
+  // Scripts may not read or replace the metatable (getmetatable returns the type name).
+  lua_pushstring(L, tname);
+  lua_setfield(L, -2, "__metatable");
+}
+
+bool resolve_path(const ConfigBox& config, const char* name, char* out, std::size_t size,
+                  char* err) noexcept {
+  namespace fs = std::filesystem;
+  try {
+    if (name[0] == '\0') {
+      copy_error(err, "empty file name");
+      return false;
+    }
+    if (!config.confine_paths) {
+      if (std::strlen(name) + 1 > size) {
+        copy_error(err, "file name too long");
+        return false;
+      }
+      std::strcpy(out, name);
+      return true;
+    }
+    std::string msg = std::string("file '") + name + "': ";
+    if (config.root[0] == '\0') {
+      copy_error(err, (msg + "file access is not granted to scripts").c_str());
+      return false;
+    }
+    const fs::path rel(name);
+    if (rel.is_absolute() || rel.has_root_name() || rel.has_root_directory() || name[0] == '~') {
+      copy_error(err, (msg + "absolute paths are not allowed; give a path relative to the "
+                             "granted folder")
+                          .c_str());
+      return false;
+    }
+    for (const fs::path& part : rel) {
+      if (part == "..") {
+        copy_error(err, (msg + "'..' is not allowed in file names").c_str());
+        return false;
+      }
+    }
+    if (std::strchr(name, '\\') != nullptr) {
+      copy_error(err, (msg + "backslashes are not allowed in file names").c_str());
+      return false;
+    }
+    // Symbolic links may still point outside: compare canonical forms.
+    std::error_code ec;
+    const fs::path root = fs::weakly_canonical(fs::path(config.root), ec);
+    if (ec) {
+      copy_error(err, (msg + "the granted folder is not accessible").c_str());
+      return false;
+    }
+    const fs::path full = fs::weakly_canonical(root / rel, ec);
+    if (ec) {
+      copy_error(err, (msg + "cannot resolve: " + ec.message()).c_str());
+      return false;
+    }
+    const auto [root_end, full_it] =
+        std::mismatch(root.begin(), root.end(), full.begin(), full.end());
+    if (root_end != root.end()) {
+      copy_error(err, (msg + "resolves outside the granted folder").c_str());
+      return false;
+    }
+    const std::string s = full.string();
+    if (s.size() + 1 > size) {
+      copy_error(err, (msg + "file name too long").c_str());
+      return false;
+    }
+    std::strcpy(out, s.c_str());
+    return true;
+  } catch (const std::exception& e) {
+    copy_error(err, e.what());
+    return false;
+  }
+}
+
+void account_memory(lua_State* L, std::size_t bytes) {
+  const int kb = static_cast<int>(std::min<std::size_t>(bytes / 1024, 1 << 20));
+  if (kb > 0) lua_gc(L, LUA_GCSTEP, kb);
+}
+
+}  // namespace ridgeline::lua::detail

@@ -1,0 +1,92 @@
+// Helpers shared by the wrap files. Rules for every lua_CFunction here (the stock interpreter
+// carries the C build of Lua, whose errors longjmp over C++ frames):
+//  - read and check every argument first, into plain data (no object with a destructor);
+//  - do the C++ work in a `noexcept` helper that makes no Lua call, catches std::exception (never
+//    `...`) and reports failure through a char buffer;
+//  - push results only after the helper has returned and its objects are gone.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <lua.hpp>
+#include <memory>
+
+#include "ridgeline/landscape.h"
+#include "ridgeline/lua/module.h"
+#include "ridgeline/roam_view.h"
+#include "ridgeline/terrain.h"
+
+namespace ridgeline::lua::detail {
+
+inline constexpr char kTerrainMeta[] = "ridgeline.terrain";
+inline constexpr char kViewMeta[] = "ridgeline.view";
+inline constexpr char kConfigMeta[] = "ridgeline.config";
+inline constexpr std::size_t kErrSize = 512;
+
+/// Per-module-table settings and caches: a userdata (with __gc) that module functions reach as
+/// upvalue 1.
+struct ConfigBox {
+  bool confine_paths = false;
+  std::uint64_t max_samples = 0;
+  char root[4096] = {};
+  std::shared_ptr<const Terrain> default_terrain;  // built once, shared by default_terrain()
+};
+
+/// A terrain userdata. Released: `terrain` is empty.
+struct TerrainBox {
+  std::shared_ptr<const Terrain> terrain;
+  std::shared_ptr<const Landscape> landscape;  // built on the first new_view
+};
+
+/// A view userdata. Released: `view` is empty.
+struct ViewBox {
+  std::unique_ptr<RoamView> view;
+  Camera camera;
+  RoamStats last;
+  bool has_stats = false;
+};
+
+/// Copies `text` into `err` (kErrSize bytes), truncating.
+void copy_error(char* err, const char* text) noexcept;
+
+/// luaL_checknumber that also refuses NaN and infinities ("finite number expected, got nan").
+double check_finite(lua_State* L, int arg);
+/// Optional finite number: `def` when the argument is none or nil.
+double opt_finite(lua_State* L, int arg, double def);
+
+/// Raises `bad argument #arg (...unknown field 'k'...)` for a key of table `arg` not in `names`
+/// (a null-terminated list): catches typos in option tables.
+void check_fields(lua_State* L, int arg, const char* const* names);
+/// Reads number field `name` of the table at `arg`. Returns false when absent (nil); raises
+/// `bad argument #arg (field 'name': finite number expected, got ...)` otherwise.
+bool get_number_field(lua_State* L, int arg, const char* name, double* out);
+/// Reads field `name` as an array of exactly `n` finite numbers (n <= 4).
+bool get_vector_field(lua_State* L, int arg, const char* name, int n, double* out);
+
+/// Metatable check against upvalue 1 of the running method (fast: no registry lookup). Raises a
+/// type error naming `tname` when argument 1 is not such a userdata.
+void* check_self(lua_State* L, const char* tname);
+
+/// Creates (once) the metatable `tname` with `methods` as __index and the given metamethods;
+/// every method gets the metatable as upvalue 1. Leaves the metatable on the stack.
+void push_metatable(lua_State* L, const char* tname, const luaL_Reg* methods,
+                    const luaL_Reg* metamethods);
+
+/// Pushes a new, empty, released-state terrain userdata with its metatable.
+TerrainBox* push_terrain_box(lua_State* L);
+/// Registers the view metatable (called by new_view).
+ViewBox* push_view_box(lua_State* L);
+
+/// Resolves a script-given file name under the config's rules into `out` (a buffer of `size`
+/// bytes). Returns false with a message in `err` when the name is refused. No Lua calls.
+bool resolve_path(const ConfigBox& config, const char* name, char* out, std::size_t size,
+                  char* err) noexcept;
+
+/// Tells the collector about C++ memory held by a new object (kilobytes), so that dropped
+/// objects are finalized before they pile up.
+void account_memory(lua_State* L, std::size_t bytes);
+
+/// Method tables, for `open_module`.
+int new_view(lua_State* L);  // terrain:new_view, defined in wrap_view.cpp
+
+}  // namespace ridgeline::lua::detail

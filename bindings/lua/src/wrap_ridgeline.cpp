@@ -1,0 +1,179 @@
+// The `ridgeline` module table: loading terrains; the per-module configuration userdata.
+#include <cstring>
+#include <exception>
+#include <new>
+
+#include "lua_util.h"
+#include "ridgeline/io.h"
+
+namespace ridgeline::lua::detail {
+namespace {
+
+ConfigBox* config_of(lua_State* L) {
+  return static_cast<ConfigBox*>(lua_touserdata(L, lua_upvalueindex(1)));
+}
+
+// Plain data read from the option table of ridgeline.load before any C++ object exists.
+struct LoadArgs {
+  const char* heightmap = nullptr;  // kept alive by the option table on the stack
+  double spacing[2] = {1, 1};
+  double origin[2] = {0, 0};
+  double height_scale = 1, height_offset = 0;
+  bool has_nodata = false;
+  double nodata = 0;
+  bool fill_nearest = false;
+};
+
+bool do_load(const ConfigBox& config, const LoadArgs& a, TerrainBox* box, char* err) noexcept {
+  try {
+    char path[4096];
+    if (!resolve_path(config, a.heightmap, path, sizeof path, err)) return false;
+    io::LoadOptions options;
+    HeightfieldDesc& p = options.placement;
+    p.spacing_x = a.spacing[0];
+    p.spacing_z = a.spacing[1];
+    p.origin_x = a.origin[0];
+    p.origin_z = a.origin[1];
+    p.height_scale = a.height_scale;
+    p.height_offset = a.height_offset;
+    if (a.has_nodata) p.nodata = a.nodata;
+    if (a.fill_nearest) p.fill = FillPolicy::kNearest;
+    p.max_samples = config.max_samples;
+    auto hf = io::load_heightmap(path, options);
+    if (!hf) {
+      // Under confinement, name the file as the script gave it, not the host's full path.
+      const std::string& m = hf.error().message;
+      if (config.confine_paths && std::strstr(m.c_str(), path) != nullptr) {
+        std::string msg = m;
+        const auto at = msg.find(path);
+        msg.replace(at, std::strlen(path), a.heightmap);
+        copy_error(err, msg.c_str());
+      } else {
+        copy_error(err, m.c_str());
+      }
+      return false;
+    }
+    box->terrain = Terrain::create(std::move(*hf));
+    return true;
+  } catch (const std::exception& e) {
+    copy_error(err, e.what());
+    return false;
+  }
+}
+
+// ridgeline.load{heightmap=, spacing=, origin=, height_scale=, height_offset=, nodata=, fill=}
+//   -> terrain or nil, message
+int r_load(lua_State* L) {
+  const ConfigBox* config = config_of(L);
+  luaL_checktype(L, 1, LUA_TTABLE);
+  static const char* const kFields[] = {"heightmap",     "spacing", "origin", "height_scale",
+                                        "height_offset", "nodata",  "fill",   nullptr};
+  check_fields(L, 1, kFields);
+  lua_settop(L, 1);
+  LoadArgs a;
+  if (lua_getfield(L, 1, "heightmap") != LUA_TSTRING)
+    luaL_argerror(
+        L, 1,
+        lua_pushfstring(L, "field 'heightmap': string expected, got %s", luaL_typename(L, -1)));
+  a.heightmap = lua_tostring(L, -1);  // stays at index 2 while we work
+  if (std::strlen(a.heightmap) != lua_rawlen(L, -1))
+    luaL_argerror(L, 1, "field 'heightmap': embedded zero in file name");
+  if (lua_getfield(L, 1, "spacing") == LUA_TTABLE) {
+    lua_pop(L, 1);
+    get_vector_field(L, 1, "spacing", 2, a.spacing);
+  } else {
+    lua_pop(L, 1);
+    if (get_number_field(L, 1, "spacing", &a.spacing[0])) a.spacing[1] = a.spacing[0];
+  }
+  get_vector_field(L, 1, "origin", 2, a.origin);
+  get_number_field(L, 1, "height_scale", &a.height_scale);
+  get_number_field(L, 1, "height_offset", &a.height_offset);
+  a.has_nodata = get_number_field(L, 1, "nodata", &a.nodata);
+  const int fill = lua_getfield(L, 1, "fill");
+  if (fill != LUA_TNIL) {
+    const char* f = fill == LUA_TSTRING ? lua_tostring(L, -1) : "";
+    if (std::strcmp(f, "nearest") == 0)
+      a.fill_nearest = true;
+    else if (std::strcmp(f, "refuse") != 0)
+      luaL_argerror(L, 1, "field 'fill': 'refuse' or 'nearest' expected");
+  }
+  lua_pop(L, 1);
+  TerrainBox* box = push_terrain_box(L);
+  char err[kErrSize];
+  if (!do_load(*config, a, box, err)) {
+    lua_pushnil(L);
+    lua_pushstring(L, err);
+    return 2;
+  }
+  account_memory(L, box->terrain->memory_bytes());
+  return 1;
+}
+
+bool make_default(ConfigBox* config, TerrainBox* box, char* err) noexcept {
+  try {
+    if (!config->default_terrain) {
+      auto hf = make_default_heightfield();
+      if (!hf) {
+        copy_error(err, hf.error().message.c_str());
+        return false;
+      }
+      config->default_terrain = Terrain::create(std::move(*hf));
+    }
+    box->terrain = config->default_terrain;
+    return true;
+  } catch (const std::exception& e) {
+    copy_error(err, e.what());
+    return false;
+  }
+}
+
+// ridgeline.default_terrain() -> terrain (the built-in 2048 m terrain; generated once per module
+// table, then shared by every call: cheap after the first).
+int r_default_terrain(lua_State* L) {
+  ConfigBox* config = config_of(L);
+  TerrainBox* box = push_terrain_box(L);
+  char err[kErrSize];
+  if (!make_default(config, box, err)) return luaL_error(L, "default_terrain: %s", err);
+  return 1;
+}
+
+int config_gc(lua_State* L) {
+  auto* c = static_cast<ConfigBox*>(luaL_checkudata(L, 1, kConfigMeta));
+  c->default_terrain.reset();
+  return 0;
+}
+
+const luaL_Reg kFunctions[] = {
+    {"load", r_load}, {"default_terrain", r_default_terrain}, {nullptr, nullptr}};
+
+}  // namespace
+}  // namespace ridgeline::lua::detail
+
+namespace ridgeline::lua {
+
+int open_module(lua_State* L, const ModuleConfig& config) {
+  using namespace detail;
+  lua_createtable(L, 0, 8);
+  void* mem = lua_newuserdatauv(L, sizeof(ConfigBox), 0);
+  auto* box = new (mem) ConfigBox();
+  if (luaL_newmetatable(L, kConfigMeta)) {
+    lua_pushcfunction(L, config_gc);
+    lua_setfield(L, -2, "__gc");
+    lua_pushliteral(L, "ridgeline.config");
+    lua_setfield(L, -2, "__metatable");
+  }
+  lua_setmetatable(L, -2);
+  box->confine_paths = config.confine_paths;
+  box->max_samples = config.max_samples;
+  std::strncpy(box->root, config.root != nullptr ? config.root : "", sizeof box->root - 1);
+  luaL_setfuncs(L, kFunctions, 1);  // the config is upvalue 1 of every function
+  lua_pushinteger(L, static_cast<lua_Integer>(kMaxBatchPoints));
+  lua_setfield(L, -2, "max_batch_points");
+  lua_pushinteger(L, static_cast<lua_Integer>(kMaxContacts));
+  lua_setfield(L, -2, "max_contacts");
+  lua_pushliteral(L, "0.1.0");
+  lua_setfield(L, -2, "version");
+  return 1;
+}
+
+}  // namespace ridgeline::lua

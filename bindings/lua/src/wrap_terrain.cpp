@@ -1,0 +1,340 @@
+// Lua userdata `ridgeline.terrain`: queries, batched heights, placement of game objects.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <glm/geometric.hpp>
+#include <new>
+#include <optional>
+
+#include "lua_util.h"
+
+namespace ridgeline::lua::detail {
+namespace {
+
+const Terrain& live_terrain(lua_State* L) {
+  auto* box = static_cast<TerrainBox*>(check_self(L, kTerrainMeta));
+  if (!box->terrain) luaL_error(L, "attempt to use a released ridgeline.terrain");
+  return *box->terrain;
+}
+
+int t_height(lua_State* L) {
+  const Terrain& t = live_terrain(L);
+  const double x = check_finite(L, 2), z = check_finite(L, 3);
+  const std::optional<double> h = t.height(x, z);
+  if (!h) return lua_pushnil(L), 1;
+  lua_pushnumber(L, *h);
+  return 1;
+}
+
+int push_normal(lua_State* L, const std::optional<glm::vec3>& n) {
+  if (!n) return lua_pushnil(L), 1;
+  lua_pushnumber(L, n->x);
+  lua_pushnumber(L, n->y);
+  lua_pushnumber(L, n->z);
+  return 3;
+}
+
+int t_normal(lua_State* L) {
+  const Terrain& t = live_terrain(L);
+  const double x = check_finite(L, 2), z = check_finite(L, 3);
+  return push_normal(L, t.face_normal(x, z));
+}
+
+int t_smooth_normal(lua_State* L) {
+  const Terrain& t = live_terrain(L);
+  const double x = check_finite(L, 2), z = check_finite(L, 3);
+  return push_normal(L, t.smooth_normal(x, z));
+}
+
+void set_number(lua_State* L, const char* key, double v) {
+  lua_pushnumber(L, v);
+  lua_setfield(L, -2, key);
+}
+
+void set_vector(lua_State* L, const char* key, double x, double y, double z) {
+  lua_createtable(L, 3, 0);
+  lua_pushnumber(L, x);
+  lua_rawseti(L, -2, 1);
+  lua_pushnumber(L, y);
+  lua_rawseti(L, -2, 2);
+  lua_pushnumber(L, z);
+  lua_rawseti(L, -2, 3);
+  lua_setfield(L, -2, key);
+}
+
+// terrain:sample(x, z) -> {height=, normal={...}, smooth_normal={...}, material=} or nil
+int t_sample(lua_State* L) {
+  const Terrain& t = live_terrain(L);
+  const double x = check_finite(L, 2), z = check_finite(L, 3);
+  const std::optional<SurfaceSample> s = t.sample(x, z);
+  if (!s) return lua_pushnil(L), 1;
+  lua_createtable(L, 0, 4);
+  set_number(L, "height", s->height);
+  set_vector(L, "normal", s->face_normal.x, s->face_normal.y, s->face_normal.z);
+  set_vector(L, "smooth_normal", s->smooth_normal.x, s->smooth_normal.y, s->smooth_normal.z);
+  lua_pushinteger(L, s->material);
+  lua_setfield(L, -2, "material");
+  return 1;
+}
+
+// terrain:heights(xz [, out]) -> out: flat {x1, z1, x2, z2, ...} in, one height per point out.
+int t_heights(lua_State* L) {
+  const Terrain& t = live_terrain(L);
+  luaL_checktype(L, 2, LUA_TTABLE);
+  const lua_Unsigned len = lua_rawlen(L, 2);
+  if (len % 2 != 0)
+    luaL_argerror(L, 2,
+                  lua_pushfstring(L, "flat array of x, z pairs expected, got %I numbers",
+                                  static_cast<lua_Integer>(len)));
+  const lua_Unsigned n = len / 2;
+  if (n > kMaxBatchPoints)
+    luaL_argerror(
+        L, 2,
+        lua_pushfstring(L, "at most %I points per call, got %I",
+                        static_cast<lua_Integer>(kMaxBatchPoints), static_cast<lua_Integer>(n)));
+  if (lua_isnoneornil(L, 3)) {
+    lua_settop(L, 2);
+    lua_createtable(L, static_cast<int>(n), 0);
+  } else {
+    luaL_checktype(L, 3, LUA_TTABLE);
+    lua_settop(L, 3);
+  }
+  constexpr int kChunk = 256;
+  glm::dvec2 xz[kChunk];  // trivially destructible: safe across a longjmp
+  double out[kChunk];
+  for (lua_Unsigned base = 0; base < n; base += kChunk) {
+    const int m = static_cast<int>(std::min<lua_Unsigned>(kChunk, n - base));
+    for (int k = 0; k < m; ++k) {
+      for (int c = 0; c < 2; ++c) {
+        const lua_Integer idx = static_cast<lua_Integer>(2 * (base + k) + c + 1);
+        lua_rawgeti(L, 2, idx);
+        int isnum = 0;
+        const double v = lua_tonumberx(L, -1, &isnum);
+        if (!isnum)
+          luaL_argerror(
+              L, 2,
+              lua_pushfstring(L, "entry %I: number expected, got %s", idx, luaL_typename(L, -1)));
+        xz[k][c] = v;
+        lua_pop(L, 1);
+      }
+    }
+    t.heights({xz, static_cast<std::size_t>(m)}, {out, static_cast<std::size_t>(m)});
+    for (int k = 0; k < m; ++k) {
+      lua_pushnumber(L, out[k]);
+      lua_rawseti(L, 3, static_cast<lua_Integer>(base + k + 1));
+    }
+  }
+  return 1;
+}
+
+// terrain:raycast(ox, oy, oz, dx, dy, dz [, max]) -> distance, x, y, z, nx, ny, nz or nil
+int t_raycast(lua_State* L) {
+  const Terrain& t = live_terrain(L);
+  double v[6];
+  for (int i = 0; i < 6; ++i) v[i] = check_finite(L, i + 2);
+  double max = INFINITY;
+  if (!lua_isnoneornil(L, 8)) {
+    max = luaL_checknumber(L, 8);
+    if (std::isnan(max)) luaL_argerror(L, 8, "number or math.huge expected, got nan");
+  }
+  const std::optional<RayHit> hit = t.raycast({v[0], v[1], v[2]}, {v[3], v[4], v[5]}, max);
+  if (!hit) return lua_pushnil(L), 1;
+  lua_pushnumber(L, hit->distance);
+  lua_pushnumber(L, hit->point.x);
+  lua_pushnumber(L, hit->point.y);
+  lua_pushnumber(L, hit->point.z);
+  lua_pushnumber(L, hit->normal.x);
+  lua_pushnumber(L, hit->normal.y);
+  lua_pushnumber(L, hit->normal.z);
+  return 7;
+}
+
+// Frame of heading h (radians about +y, counterclockwise from above, 0 along +z): the vehicle's
+// local (a, b) offset (a along its +x, b forward) goes to world (a cos h + b sin h, -a sin h + b
+// cos h).
+void to_world(double h, double a, double b, double* dx, double* dz) {
+  *dx = a * std::cos(h) + b * std::sin(h);
+  *dz = -a * std::sin(h) + b * std::cos(h);
+}
+
+struct Placement {
+  double x, y, z, pitch, roll;
+  glm::dvec3 forward, up, right;
+};
+
+// Fits a plane h = c0 + cu * u + cv * v to a 3 x 3 grid of surface heights over the footprint
+// (u across, v along the heading; least squares on a symmetric grid), then lifts it until no
+// grid point is above it: the box rests on the highest contact. False when any point is off
+// the terrain.
+bool place_box(const Terrain& t, double x, double z, double length, double width, double h,
+               Placement* p) noexcept {
+  double sum = 0, su = 0, sv = 0, suu = 0, svv = 0, hs[9], us[9], vs[9];
+  int k = 0;
+  for (int i = -1; i <= 1; ++i) {
+    for (int j = -1; j <= 1; ++j, ++k) {
+      const double u = i * width / 2, v = j * length / 2;
+      double dx, dz;
+      to_world(h, u, v, &dx, &dz);
+      const std::optional<double> hh = t.height(x + dx, z + dz);
+      if (!hh) return false;
+      hs[k] = *hh, us[k] = u, vs[k] = v;
+      sum += *hh, su += u * *hh, sv += v * *hh, suu += u * u, svv += v * v;
+    }
+  }
+  const double cu = suu > 0 ? su / suu : 0, cv = svv > 0 ? sv / svv : 0;
+  double c0 = sum / 9, lift = -INFINITY;
+  for (k = 0; k < 9; ++k) lift = std::max(lift, hs[k] - (c0 + cu * us[k] + cv * vs[k]));
+  c0 += lift;
+  double fx, fz, sx, sz;
+  to_world(h, 0, 1, &fx, &fz);
+  to_world(h, 1, 0, &sx, &sz);
+  const glm::dvec3 f = glm::normalize(glm::dvec3(fx, cv, fz));  // forward along the plane
+  const glm::dvec3 s = glm::normalize(glm::dvec3(sx, cu, sz));  // local +x along the plane
+  p->up = glm::normalize(glm::cross(f, s));
+  p->forward = f;
+  p->right = glm::normalize(glm::cross(f, p->up));
+  p->x = x, p->y = c0, p->z = z;
+  p->pitch = std::asin(std::clamp(p->forward.y, -1.0, 1.0));
+  p->roll = std::asin(std::clamp(-p->right.y, -1.0, 1.0));
+  return true;
+}
+
+// terrain:place(x, z, {length=, width=, heading=}) -> placement table or nil, message
+int t_place(lua_State* L) {
+  const Terrain& t = live_terrain(L);
+  const double x = check_finite(L, 2), z = check_finite(L, 3);
+  luaL_checktype(L, 4, LUA_TTABLE);
+  static const char* const kFields[] = {"length", "width", "heading", nullptr};
+  check_fields(L, 4, kFields);
+  double length = 0, width = 0, heading = 0;
+  if (!get_number_field(L, 4, "length", &length) || length <= 0 || length > 1e6)
+    luaL_argerror(L, 4, "field 'length': number in (0, 1e6] metres expected");
+  if (!get_number_field(L, 4, "width", &width) || width <= 0 || width > 1e6)
+    luaL_argerror(L, 4, "field 'width': number in (0, 1e6] metres expected");
+  get_number_field(L, 4, "heading", &heading);
+  Placement p;
+  if (!place_box(t, x, z, length, width, heading, &p)) {
+    lua_pushnil(L);
+    lua_pushliteral(L, "footprint leaves the terrain");
+    return 2;
+  }
+  lua_createtable(L, 0, 9);
+  set_number(L, "x", p.x);
+  set_number(L, "y", p.y);
+  set_number(L, "z", p.z);
+  set_number(L, "heading", heading);
+  set_number(L, "pitch", p.pitch);
+  set_number(L, "roll", p.roll);
+  set_vector(L, "forward", p.forward.x, p.forward.y, p.forward.z);
+  set_vector(L, "up", p.up.x, p.up.y, p.up.z);
+  set_vector(L, "right", p.right.x, p.right.y, p.right.z);
+  return 1;
+}
+
+// terrain:contacts(x, z, heading, offsets) -> array: per offset {x=, y=, z=, nx=, ny=, nz=,
+// material=} or false (off the terrain). One vertical ray per wheel, cast from above the highest
+// point of the terrain.
+int t_contacts(lua_State* L) {
+  const Terrain& t = live_terrain(L);
+  const double x = check_finite(L, 2), z = check_finite(L, 3), heading = check_finite(L, 4);
+  luaL_checktype(L, 5, LUA_TTABLE);
+  const lua_Unsigned n = lua_rawlen(L, 5);
+  if (n > kMaxContacts)
+    luaL_argerror(
+        L, 5,
+        lua_pushfstring(L, "at most %I offsets per call, got %I",
+                        static_cast<lua_Integer>(kMaxContacts), static_cast<lua_Integer>(n)));
+  const Heightfield& hf = t.heightfield();
+  const double top = hf.height_offset() + hf.max_local() + 1.0;
+  const double depth = hf.max_local() - hf.min_local() + 2.0;
+  lua_settop(L, 5);
+  lua_createtable(L, static_cast<int>(n), 0);
+  for (lua_Unsigned i = 1; i <= n; ++i) {
+    lua_rawgeti(L, 5, static_cast<lua_Integer>(i));
+    double o[2];
+    for (int c = 0; c < 2; ++c) {
+      int isnum = 0;
+      if (lua_type(L, -1) == LUA_TTABLE) {
+        lua_rawgeti(L, -1, c + 1);
+        o[c] = lua_tonumberx(L, -1, &isnum);
+        lua_pop(L, 1);
+      }
+      if (!isnum || !std::isfinite(o[c]))
+        luaL_argerror(L, 5,
+                      lua_pushfstring(L, "offset %I: {x, z} of finite numbers expected",
+                                      static_cast<lua_Integer>(i)));
+    }
+    lua_pop(L, 1);
+    double dx, dz;
+    to_world(heading, o[0], o[1], &dx, &dz);
+    const std::optional<RayHit> hit = t.raycast({x + dx, top, z + dz}, {0, -1, 0}, depth);
+    if (!hit) {
+      lua_pushboolean(L, 0);
+    } else {
+      lua_createtable(L, 0, 7);
+      set_number(L, "x", hit->point.x);
+      set_number(L, "y", hit->point.y);
+      set_number(L, "z", hit->point.z);
+      set_number(L, "nx", hit->normal.x);
+      set_number(L, "ny", hit->normal.y);
+      set_number(L, "nz", hit->normal.z);
+      lua_pushinteger(L, hit->material);
+      lua_setfield(L, -2, "material");
+    }
+    lua_rawseti(L, -2, static_cast<lua_Integer>(i));
+  }
+  return 1;
+}
+
+// terrain:bounds() -> min_x, min_z, max_x, max_z, min_height, max_height (metres)
+int t_bounds(lua_State* L) {
+  const Heightfield& hf = live_terrain(L).heightfield();
+  lua_pushnumber(L, hf.origin_x());
+  lua_pushnumber(L, hf.origin_z());
+  lua_pushnumber(L, hf.origin_x() + hf.extent_x());
+  lua_pushnumber(L, hf.origin_z() + hf.extent_z());
+  lua_pushnumber(L, hf.height_offset() + hf.min_local());
+  lua_pushnumber(L, hf.height_offset() + hf.max_local());
+  return 6;
+}
+
+int t_release(lua_State* L) {
+  auto* box = static_cast<TerrainBox*>(check_self(L, kTerrainMeta));
+  box->terrain.reset();
+  box->landscape.reset();
+  return 0;
+}
+
+int t_tostring(lua_State* L) {
+  auto* box = static_cast<TerrainBox*>(check_self(L, kTerrainMeta));
+  if (!box->terrain) {
+    lua_pushliteral(L, "ridgeline.terrain (released)");
+    return 1;
+  }
+  const Heightfield& hf = box->terrain->heightfield();
+  char text[160];
+  std::snprintf(text, sizeof text, "ridgeline.terrain (%u x %u samples, %g x %g m spacing)",
+                hf.width(), hf.height(), hf.spacing_x(), hf.spacing_z());
+  lua_pushstring(L, text);
+  return 1;
+}
+
+const luaL_Reg kMethods[] = {
+    {"height", t_height},   {"normal", t_normal},     {"smooth_normal", t_smooth_normal},
+    {"sample", t_sample},   {"heights", t_heights},   {"raycast", t_raycast},
+    {"place", t_place},     {"contacts", t_contacts}, {"bounds", t_bounds},
+    {"new_view", new_view}, {"release", t_release},   {nullptr, nullptr}};
+const luaL_Reg kMeta[] = {
+    {"__gc", t_release}, {"__close", t_release}, {"__tostring", t_tostring}, {nullptr, nullptr}};
+
+}  // namespace
+
+TerrainBox* push_terrain_box(lua_State* L) {
+  void* mem = lua_newuserdatauv(L, sizeof(TerrainBox), 0);
+  auto* box = new (mem) TerrainBox();  // empty shared_ptrs: nothing to leak if the next call raises
+  push_metatable(L, kTerrainMeta, kMethods, kMeta);
+  lua_setmetatable(L, -2);
+  return box;
+}
+
+}  // namespace ridgeline::lua::detail

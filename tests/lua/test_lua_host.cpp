@@ -1,0 +1,181 @@
+// The embedding Host: limits end the offending call with an error and a traceback, and the host
+// keeps running; callbacks; attaching to an engine's state; symbolic links out of the folder.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <lua.hpp>
+#include <string>
+
+#include "ridgeline/lua/host.h"
+
+namespace {
+
+using ridgeline::lua::Host;
+using ridgeline::lua::HostOptions;
+
+std::unique_ptr<Host> make_host(HostOptions options = {}) {
+  options.data_root = RIDGELINE_TEST_DATA;
+  auto host = Host::create(options);
+  EXPECT_TRUE(host.ok()) << (host.ok() ? "" : host.error().message);
+  return std::move(*host);
+}
+
+void expect_alive(Host& host) {
+  const auto s =
+      host.run("local t = ridgeline.default_terrain(); assert(t:height(10, 10))", "alive");
+  EXPECT_TRUE(s.ok()) << s.message();
+}
+
+TEST(LuaHost, RunsChunksAndReportsErrorsWithTraceback) {
+  auto host = make_host();
+  EXPECT_TRUE(host->run("x = 1 + 1", "ok").ok());
+  const auto s = host->run("local function inner() error('boom') end\ninner()", "script.lua");
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("script.lua:1: boom"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("stack traceback:"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("in local 'inner'"), std::string::npos) << s.message();
+  const auto t = host->run("error({})", "tbl");
+  EXPECT_NE(t.message().find("(error object is a table value)"), std::string::npos);
+  const auto syntax = host->run("x = = 1", "syntax.lua");
+  EXPECT_NE(syntax.message().find("syntax.lua:1:"), std::string::npos) << syntax.message();
+  expect_alive(*host);
+}
+
+TEST(LuaHost, InfiniteLoopEndsTheCallOnly) {
+  HostOptions o;
+  o.instruction_limit = 2'000'000;
+  auto host = make_host(o);
+  const auto s = host->run("local function spin() while true do end end\nspin()", "loop.lua");
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("instruction limit exceeded"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("stack traceback:"), std::string::npos) << s.message();
+  expect_alive(*host);
+  // pcall cannot swallow the budget: every later check raises again.
+  const auto p = host->run("while true do pcall(function() while true do end end) end", "pcall");
+  EXPECT_NE(p.message().find("instruction limit exceeded"), std::string::npos) << p.message();
+  // Nor can a coroutine.
+  const auto c = host->run("coroutine.wrap(function() while true do end end)()", "co");
+  EXPECT_NE(c.message().find("instruction limit exceeded"), std::string::npos) << c.message();
+  expect_alive(*host);
+}
+
+TEST(LuaHost, MemoryBombEndsTheCallOnly) {
+  HostOptions o;
+  o.memory_limit = 16 << 20;
+  auto host = make_host(o);
+  const auto s = host->run("local t = {}\nfor i = 1, 1e9 do t[i] = {i} end", "bomb.lua");
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("memory limit exceeded"), std::string::npos) << s.message();
+  EXPECT_LT(host->memory_used(), std::size_t{8} << 20) << "garbage collected after the failure";
+  expect_alive(*host);
+  // One huge allocation: refused by the allocator (no traceback possible, but a clear message).
+  const auto big = host->run("local s = string.rep('x', 1 << 30)", "rep.lua");
+  ASSERT_FALSE(big.ok());
+  EXPECT_NE(big.message().find("not enough memory"), std::string::npos) << big.message();
+  EXPECT_NE(big.message().find("memory limit exceeded"), std::string::npos) << big.message();
+  // String growth by concatenation.
+  const auto cat = host->run("local s = 'x' while true do s = s .. s end", "cat.lua");
+  EXPECT_FALSE(cat.ok());
+  expect_alive(*host);
+}
+
+TEST(LuaHost, DeepRecursionIsContained) {
+  auto host = make_host();
+  const auto s = host->run("local function f() return 1 + f() end\nf()", "deep.lua");
+  ASSERT_FALSE(s.ok());
+  EXPECT_TRUE(s.message().find("stack overflow") != std::string::npos ||
+              s.message().find("memory") != std::string::npos)
+      << s.message();
+  expect_alive(*host);
+}
+
+TEST(LuaHost, EscapesFailAndAreReported) {
+  auto host = make_host();
+  for (const char* attack :
+       {"io.open('/etc/passwd')", "os.execute('touch /tmp/ridgeline_pwned')", "require('io')",
+        "package.loadlib('libc.so.6', 'system')", "debug.sethook()", "dofile('/etc/passwd')",
+        "load(string.dump(print))", "assert(load(('').dump(function() end)))()",
+        "setmetatable({}, {__gc = function() while true do end end})",
+        "getmetatable('').__index = {}"}) {
+    const auto s = host->run(attack, "attack");
+    EXPECT_FALSE(s.ok()) << attack;
+    EXPECT_NE(s.message().find("stack traceback:"), std::string::npos) << s.message();
+  }
+  EXPECT_FALSE(std::filesystem::exists("/tmp/ridgeline_pwned"));
+  expect_alive(*host);
+}
+
+TEST(LuaHost, GameCallbacks) {
+  auto host = make_host();
+  ASSERT_TRUE(host->run("ticks = 0\nfunction on_tick() ticks = ticks + 1 end", "game.lua").ok());
+  EXPECT_TRUE(host->call_global("on_tick").ok());
+  EXPECT_TRUE(host->call_global("on_tick").ok());
+  EXPECT_TRUE(host->run("assert(ticks == 2)", "check").ok());
+  const auto missing = host->call_global("on_missing");
+  EXPECT_NE(missing.message().find("global 'on_missing' is not a function"), std::string::npos);
+  // A function and arguments pushed by the engine.
+  lua_State* L = host->state();
+  ASSERT_TRUE(host->run("function add(a, b) return a + b end", "add").ok());
+  ASSERT_TRUE(host->run("_G.add_ref = add", "ref").ok());
+  const int top = lua_gettop(L);
+  ASSERT_TRUE(host->run("function fail() error('callback failed') end", "f.lua").ok());
+  ASSERT_TRUE(host->call_global("fail").message().find("callback failed") != std::string::npos);
+  EXPECT_EQ(lua_gettop(L), top) << "a failed call leaves the stack as it was";
+}
+
+TEST(LuaHost, AttachToAnEngineState) {
+  lua_State* L = luaL_newstate();
+  luaL_openlibs(L);
+  {
+    HostOptions o;
+    auto host = Host::attach(L, o);
+    ASSERT_TRUE(host.ok()) << host.error().message;
+    EXPECT_TRUE((*host)->run("assert(io == nil and ridgeline.default_terrain())", "s").ok());
+    const auto loop = (*host)->run("while true do end", "loop");
+    EXPECT_NE(loop.message().find("instruction limit exceeded"), std::string::npos);
+    lua_getglobal(L, "io");
+    EXPECT_TRUE(lua_istable(L, -1)) << "the engine's own globals are untouched";
+    lua_pop(L, 1);
+  }
+  lua_close(L);
+}
+
+TEST(LuaHost, NoSandboxOpensEverything) {
+  HostOptions o;
+  o.sandbox = false;
+  auto host = Host::create(o);
+  ASSERT_TRUE(host.ok());
+  EXPECT_TRUE((*host)->run("assert(io and os and debug and ridgeline)", "full").ok());
+}
+
+TEST(LuaHost, SymlinkOutOfTheGrantedFolderIsRefused) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(RIDGELINE_TEST_TMP) / "lua_root";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  fs::create_symlink(fs::path(RIDGELINE_TEST_DATA), dir / "outside");
+  fs::copy_file(fs::path(RIDGELINE_TEST_DATA) / "ramp16.png", dir / "ramp16.png");
+  HostOptions o;
+  o.data_root = dir.string();
+  auto host = Host::create(o);
+  ASSERT_TRUE(host.ok());
+  const auto s = (*host)->run(R"lua(
+    local t, err = ridgeline.load{heightmap = "outside/ramp16.png"}
+    assert(t == nil and err:find("resolves outside the granted folder", 1, true), err)
+    assert(ridgeline.load{heightmap = "ramp16.png"})
+    local u, e2 = ridgeline.load{heightmap = "missing.png"}
+    assert(u == nil and e2:find("'missing.png'", 1, true) and not e2:find("lua_root", 1, true), e2)
+  )lua",
+                              "links");
+  EXPECT_TRUE(s.ok()) << s.message();
+  HostOptions none;
+  auto closed = Host::create(none);
+  ASSERT_TRUE(closed.ok());
+  const auto c = (*closed)->run(R"(
+    local t, err = ridgeline.load{heightmap = "ramp16.png"}
+    assert(t == nil and err:find("file access is not granted", 1, true), err))",
+                                "none");
+  EXPECT_TRUE(c.ok()) << c.message();
+}
+
+}  // namespace

@@ -1,0 +1,135 @@
+-- ridgeline.terrain: loading, queries, batched heights, errors, release.
+-- ramp16.png is 5 x 4 samples, value(i, j) = 1000 + 100 i + 10 j: a plane, so every query has an
+-- exact answer. Loaded with spacing 2, scale 0.5, offset -10, origin (100, 200):
+-- h(x, z) = -10 + 0.5 (1000 + 50 (x - 100) + 5 (z - 200)).
+local function ramp()
+  local t, err = ridgeline.load{heightmap = DATA .. "ramp16.png", spacing = 2, height_scale = 0.5,
+                                height_offset = -10, origin = {100, 200}}
+  T.truthy(t, "load: " .. tostring(err))
+  return t
+end
+local function h(x, z) return -10 + 0.5 * (1000 + 50 * (x - 100) + 5 * (z - 200)) end
+
+T.case("load and height", function()
+  local t = ramp()
+  T.near(t:height(102, 202), 545, 1e-9, "height at a sample")
+  T.near(t:height(101.3, 203.7), h(101.3, 203.7), 1e-9, "height between samples")
+  T.eq(t:height(99, 202), nil, "off terrain")
+  T.eq(t:height(108.5, 202), nil, "past the far edge")
+  T.near(t:height(108, 206), h(108, 206), 1e-9, "on the far corner")
+  local x0, z0, x1, z1, lo, hi = t:bounds()
+  T.eq(x0, 100); T.eq(z0, 200); T.eq(x1, 108); T.eq(z1, 206)
+  T.near(lo, h(100, 200), 1e-9, "min height"); T.near(hi, h(108, 206), 1e-9, "max height")
+  T.truthy(tostring(t):find("5 x 4 samples", 1, true), "tostring")
+  T.eq(getmetatable(t), "ridgeline.terrain", "protected metatable")
+end)
+
+T.case("normals", function()
+  local t = ramp()
+  local len = math.sqrt(25 * 25 + 1 + 2.5 * 2.5)
+  local nx, ny, nz = t:normal(103.1, 202.7)
+  T.near(nx, -25 / len, 1e-6, "nx"); T.near(ny, 1 / len, 1e-6, "ny"); T.near(nz, -2.5 / len, 1e-6, "nz")
+  nx, ny, nz = t:smooth_normal(103.1, 202.7)
+  T.near(nx, -25 / len, 1e-6, "smooth nx"); T.near(ny, 1 / len, 1e-6, "smooth ny")
+  T.eq(t:normal(0, 0), nil, "normal off terrain")
+  T.eq(t:smooth_normal(0, 0), nil, "smooth normal off terrain")
+  local s = t:sample(103, 203)
+  T.near(s.height, h(103, 203), 1e-9, "sample height"); T.near(s.normal[1], -25 / len, 1e-6)
+  T.eq(s.material, 0, "no material layer")
+  T.eq(t:sample(0, 0), nil, "sample off terrain")
+end)
+
+T.case("raycast", function()
+  local t = ramp()
+  local d, x, y, z, nx, ny, nz = t:raycast(102, 1000, 202, 0, -1, 0, 1e4)
+  T.near(d, 1000 - 545, 1e-6, "distance"); T.near(x, 102, 1e-9); T.near(y, 545, 1e-6)
+  T.near(z, 202, 1e-9); T.truthy(ny > 0 and nx < 0 and nz < 0, "normal points up the slope")
+  T.eq(t:raycast(102, 1000, 202, 0, 1, 0, 1e4), nil, "ray up misses")
+  T.eq(t:raycast(102, 1000, 202, 0, -1, 0, 10), nil, "surface beyond max")
+  T.truthy(t:raycast(102, 1000, 202, 0, -1, 0), "max defaults to infinity")
+  T.truthy(t:raycast(102, 1000, 202, 0, -1, 0, math.huge), "max = math.huge")
+  T.raises("bad argument #7 to 'raycast' (number or math.huge expected, got nan)",
+           function() return t:raycast(102, 1000, 202, 0, -1, 0, 0 / 0) end)
+end)
+
+T.case("batched heights", function()
+  local t = ramp()
+  local out = t:heights{102, 202, 0, 0, 101, 201}
+  T.eq(#out, 3, "one height per point")
+  T.near(out[1], 545, 1e-9); T.truthy(out[2] ~= out[2], "NaN off terrain")
+  T.near(out[3], h(101, 201), 1e-9)
+  local nan = t:heights{0 / 0, 202}
+  T.truthy(nan[1] ~= nan[1], "non-finite coordinates give NaN")
+  local reuse = {}
+  T.eq(t:heights({102, 202}, reuse), reuse, "the out table is reused")
+  local big = {}
+  for i = 1, 2 * 1000 do big[i] = 100 + (i % 9) end
+  local r = t:heights(big)
+  T.eq(#r, 1000)
+  for k = 1, 1000 do
+    local want = t:height(big[2 * k - 1], big[2 * k])
+    T.truthy((want == nil and r[k] ~= r[k]) or r[k] == want, "batch equals single calls")
+  end
+  T.eq(#t:heights{}, 0, "empty batch")
+  T.eq(ridgeline.max_batch_points, 65536)
+  local over = {}
+  for i = 1, 2 * 65537 do over[i] = 0 end
+  T.raises("bad argument #1 to 'heights' (at most 65536 points per call, got 65537)", function() return t:heights(over) end)
+  T.raises("flat array of x, z pairs expected, got 3 numbers", t.heights, t, {1, 2, 3})
+  T.raises("entry 2: number expected, got string", t.heights, t, {1, "a"})
+  T.raises("bad argument #1 to 'heights' (table expected, got number)", function() return t:heights(5) end)
+end)
+
+T.case("bad arguments", function()
+  local t = ramp()
+  T.raises("bad argument #2 to 'height' (number expected, got string)", function() return t:height(1, "a") end)
+  T.raises("bad argument #1 to 'height' (number expected, got no value)", function() return t:height() end)
+  T.raises("bad argument #2 to 'height' (finite number expected, got nan)", function() return t:height(1, 0 / 0) end)
+  T.raises("bad argument #1 to 'normal' (finite number expected, got inf)", function() return t:normal(math.huge, 1) end)
+  T.raises("bad argument #3 to 'raycast' (finite number expected, got -inf)",
+           function() return t:raycast(1, 2, -math.huge, 0, -1, 0, 10) end)
+  T.raises("ridgeline.terrain expected, got number", t.height, 42, 1, 1)
+  T.raises("field 'heightmap': string expected, got nil", ridgeline.load, {})
+  T.raises("bad argument #1 to 'load' (table expected, got string)", function() return ridgeline.load("x.png") end)
+  T.raises("unknown field 'spacin'", ridgeline.load, {heightmap = "x.png", spacin = 2})
+  T.raises("field 'spacing': number expected, got string", ridgeline.load, {heightmap = "x.png", spacing = "2"})
+  T.raises("field 'origin': array of 2 numbers expected", ridgeline.load, {heightmap = "x.png", origin = {1}})
+  T.raises("field 'height_scale': finite number expected, got inf",
+           ridgeline.load, {heightmap = "x.png", height_scale = math.huge})
+  T.raises("field 'fill': 'refuse' or 'nearest' expected", ridgeline.load, {heightmap = "x.png", fill = "zero"})
+end)
+
+T.case("expected misses return nil, message", function()
+  local t, err = ridgeline.load{heightmap = DATA .. "no_such_file.png"}
+  T.eq(t, nil, "missing file")
+  T.truthy(err:find("no_such_file.png", 1, true), "message names the file: " .. err)
+  t, err = ridgeline.load{heightmap = DATA .. "ramp16.png", spacing = -1}
+  T.eq(t, nil, "bad spacing"); T.truthy(err:find("spacing", 1, true), "message names spacing: " .. err)
+  t, err = ridgeline.load{heightmap = DATA .. "rgb8.png"}
+  T.eq(t, nil, "three channels"); T.truthy(#err > 0)
+end)
+
+T.case("default terrain", function()
+  local t = ridgeline.default_terrain()
+  local hh = t:height(1024, 1024)
+  T.truthy(hh > 16 and hh < 219, "height in the documented range")
+  local x0, z0, x1, z1 = t:bounds()
+  T.eq(x1 - x0, 2048); T.eq(z1 - z0, 2048)
+  T.near(ridgeline.default_terrain():height(1024, 1024), hh, 0, "shared and deterministic")
+end)
+
+T.case("release", function()
+  local t = ramp()
+  t:release()
+  T.raises("attempt to use a released ridgeline.terrain", t.height, t, 102, 202)
+  T.raises("attempt to use a released ridgeline.terrain", t.heights, t, {})
+  T.truthy(tostring(t):find("released", 1, true), "tostring after release")
+  t:release() -- twice is fine
+  local kept
+  do
+    local c <close> = ramp()
+    kept = c
+    T.truthy(c:height(102, 202), "alive inside the scope")
+  end
+  T.raises("attempt to use a released ridgeline.terrain", kept.height, kept, 102, 202)
+end)
