@@ -105,18 +105,16 @@ int t_heights(lua_State* L) {
   for (lua_Unsigned base = 0; base < n; base += kChunk) {
     const int m = static_cast<int>(std::min<lua_Unsigned>(kChunk, n - base));
     for (int k = 0; k < m; ++k) {
-      for (int c = 0; c < 2; ++c) {
-        const lua_Integer idx = static_cast<lua_Integer>(2 * (base + k) + c + 1);
-        lua_rawgeti(L, 2, idx);
-        int isnum = 0;
-        const double v = lua_tonumberx(L, -1, &isnum);
-        if (!isnum)
-          luaL_argerror(
-              L, 2,
-              lua_pushfstring(L, "entry %I: number expected, got %s", idx, luaL_typename(L, -1)));
-        xz[k][c] = v;
-        lua_pop(L, 1);
+      const lua_Integer idx = static_cast<lua_Integer>(2 * (base + k) + 1);
+      const int tx = lua_rawgeti(L, 2, idx), tz = lua_rawgeti(L, 2, idx + 1);
+      if (tx != LUA_TNUMBER || tz != LUA_TNUMBER) {
+        const int bad = tx != LUA_TNUMBER ? -2 : -1;
+        luaL_argerror(L, 2,
+                      lua_pushfstring(L, "entry %I: number expected, got %s", idx + (bad == -1),
+                                      luaL_typename(L, bad)));
       }
+      xz[k] = {lua_tonumber(L, -2), lua_tonumber(L, -1)};
+      lua_pop(L, 2);
     }
     t.heights({xz, static_cast<std::size_t>(m)}, {out, static_cast<std::size_t>(m)});
     for (int k = 0; k < m; ++k) {
