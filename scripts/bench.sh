@@ -25,6 +25,9 @@ echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -
 "$ridge" bench queries --default-terrain --json "$out/queries_default.json"
 [ ${#noise[@]} -gt 0 ] && "$ridge" bench queries "${noise[@]}" --json "$out/queries_noise1025.json"
 
+# Lua calls (when the binding is built).
+[ -x build/release/bindings/lua/bench_lua ] && build/release/bindings/lua/bench_lua > "$out/lua.json"
+
 # ROAM along paths. Error measured every 10th frame on every vertex in view.
 lod() {  # NAME ARGS...
   local name=$1; shift
