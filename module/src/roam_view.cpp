@@ -637,6 +637,22 @@ struct RoamView::Impl {
     cache_box(c + 1);
   }
 
+  // Links the children (c0, c1) of n among themselves, to n's outer neighbours (their bases,
+  // updating those neighbours' links) and across n's hypotenuse: c0's right edge borders
+  // `right_of_c0`, c1's left edge `left_of_c1` (the base partner's children, or kNone).
+  void link_children(std::uint32_t n, std::uint32_t c0, std::uint32_t c1, std::uint32_t right_of_c0,
+                     std::uint32_t left_of_c1) {
+    const Node& p = nodes[n];
+    nodes[c0].base = p.left;
+    nodes[c0].left = c1;
+    nodes[c0].right = right_of_c0;
+    nodes[c1].base = p.right;
+    nodes[c1].left = left_of_c1;
+    nodes[c1].right = c0;
+    replace_link(p.left, n, c0);
+    replace_link(p.right, n, c1);
+  }
+
   void split_leaf(std::uint32_t t, bool forced) {
     // Make the base neighbour a diamond partner first (forced splits), then split both.
     while (nodes[t].base != kNone && nodes[nodes[t].base].base != t)
@@ -666,28 +682,8 @@ struct RoamView::Impl {
       b0 = nodes[b].child;
       b1 = b0 + 1;
     }
-    {
-      const Node& T = nodes[t];
-      nodes[t0].base = T.left;
-      nodes[t0].left = t1;
-      nodes[t0].right = b1;
-      nodes[t1].base = T.right;
-      nodes[t1].left = b0;
-      nodes[t1].right = t0;
-      replace_link(T.left, t, t0);
-      replace_link(T.right, t, t1);
-    }
-    if (b != kNone) {
-      const Node& B = nodes[b];
-      nodes[b0].base = B.left;
-      nodes[b0].left = b1;
-      nodes[b0].right = t1;
-      nodes[b1].base = B.right;
-      nodes[b1].left = t0;
-      nodes[b1].right = b0;
-      replace_link(B.left, b, b0);
-      replace_link(B.right, b, b1);
-    }
+    link_children(t, t0, t1, b1, b0);
+    if (b != kNone) link_children(b, b0, b1, t1, t0);
     triangles += b != kNone ? 2 : 1;
     mark_dirty(t);
     if (b != kNone) mark_dirty(b);
