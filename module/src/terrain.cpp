@@ -67,13 +67,18 @@ std::optional<glm::vec3> Terrain::face_normal(double x, double z) const noexcept
   return detail::face_normal(heightfield_, inv_spacing_x_, inv_spacing_z_, p.i, p.j, p.tri);
 }
 
+// Barycentric blend of the area-weighted vertex normals of the triangle under the point.
+static glm::vec3 smooth_normal_at(const Heightfield& hf, const Located& p) noexcept {
+  glm::vec3 n(0.0f);
+  for (int k = 0; k < 3; ++k)
+    n += p.tri.w[k] * detail::vertex_normal(hf, p.i + p.tri.di[k], p.j + p.tri.dj[k]);
+  return detail::unit(n);
+}
+
 std::optional<glm::vec3> Terrain::smooth_normal(double x, double z) const noexcept {
   Located p;
   if (!locate(heightfield_, inv_spacing_x_, inv_spacing_z_, x, z, p)) return std::nullopt;
-  glm::vec3 n(0.0f);
-  for (int k = 0; k < 3; ++k)
-    n += p.tri.w[k] * detail::vertex_normal(heightfield_, p.i + p.tri.di[k], p.j + p.tri.dj[k]);
-  return detail::unit(n);
+  return smooth_normal_at(heightfield_, p);
 }
 
 std::optional<HeightNormal> Terrain::height_normal(double x, double z) const noexcept {
@@ -94,10 +99,7 @@ std::optional<SurfaceSample> Terrain::sample(double x, double z) const noexcept 
   s.height = heightfield_.height_offset() + double(local_height(heightfield_, p));
   s.face_normal =
       detail::face_normal(heightfield_, inv_spacing_x_, inv_spacing_z_, p.i, p.j, p.tri);
-  glm::vec3 n(0.0f);
-  for (int k = 0; k < 3; ++k)
-    n += p.tri.w[k] * detail::vertex_normal(heightfield_, p.i + p.tri.di[k], p.j + p.tri.dj[k]);
-  s.smooth_normal = detail::unit(n);
+  s.smooth_normal = smooth_normal_at(heightfield_, p);
   s.material = heightfield_.material(p.i, p.j);
   return s;
 }
