@@ -146,7 +146,7 @@ Result<std::shared_ptr<const Landscape>> Landscape::create(std::shared_ptr<const
 
   // Roots are independent: split them over the hardware threads.
   const std::uint64_t npr = l->nodes_per_root_plus_one_;
-  const std::uint32_t max_level = l->max_level();
+  const std::uint32_t max_level = l->base_level();  // stored levels: 0 .. base_level - 1
   auto work = [&](std::uint64_t first, std::uint64_t last) {
     for (std::uint64_t root = first; root < last; ++root) {
       float* b = l->bounds_.data() + root * (npr - 1);
