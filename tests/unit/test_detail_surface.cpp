@@ -228,3 +228,41 @@ TEST(DetailSurface, EditsAndSaveFilesWithDetail) {
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().message.find("detail"), std::string::npos) << r.error().message;
 }
+
+TEST(DetailSurface, RaysHitTheFinestSurface) {
+  auto t = detail_terrain(65, 3);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(5, 250), a(0, 2 * M_PI), e(0.05, 0.6);
+  int hits = 0;
+  for (int k = 0; k < 300; ++k) {
+    const double x = u(rng), z = u(rng);
+    // Vertical: the hit is the height there.
+    auto v = t->raycast({x, 1000, z}, {0, -1, 0}, 5000);
+    ASSERT_TRUE(v);
+    EXPECT_NEAR(v->point.y, *t->height(x, z), 2e-5);  // height() blends with float weights
+    // Slanted, grazing-ish: the hit lies on the surface and no earlier sample of the ray is
+    // below it.
+    const double az = a(rng), el = e(rng);
+    const glm::dvec3 dir(std::cos(az) * std::cos(el), -std::sin(el), std::sin(az) * std::cos(el));
+    const glm::dvec3 o(x, *t->height(x, z) + 3.0, z);
+    auto h = t->raycast(o, dir, 400);
+    if (!h) continue;
+    ++hits;
+    ASSERT_FALSE(h->started_below);
+    auto at = t->height(h->point.x, h->point.z);
+    ASSERT_TRUE(at);
+    EXPECT_NEAR(h->point.y, *at, 2e-5);
+    for (double s = 0; s < h->distance - 1e-3; s += 0.02) {
+      const glm::dvec3 p = o + dir * s;
+      if (auto hp = t->height(p.x, p.z)) ASSERT_GT(p.y - *hp, -2e-5) << "ray " << k << " at " << s;
+    }
+    // The normal is the finest triangle's.
+    auto n = t->face_normal(h->point.x, h->point.z);
+    EXPECT_GT(glm::dot(glm::dvec3(*n), glm::dvec3(h->normal)), 0.999);
+  }
+  EXPECT_GT(hits, 100);
+  // Starting below the surface.
+  auto below = t->raycast({100, *t->height(100, 100) - 0.01, 100}, {1, 0, 0}, 10);
+  ASSERT_TRUE(below);
+  EXPECT_TRUE(below->started_below);
+}
