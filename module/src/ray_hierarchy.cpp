@@ -469,14 +469,31 @@ std::optional<RayHit> RayHierarchy::raycast_impl(const Mode& mode, const Heightf
 std::size_t RayHierarchy::triangles_in_box(const Heightfield& hf, const Box& box,
                                            std::vector<SurfaceTriangle>& out,
                                            std::size_t max_triangles) const {
+  return boxes_impl(BaseGrid{hf, inv_sx_, inv_sz_}, hf, 0, 0.0, box, out, max_triangles);
+}
+
+std::size_t RayHierarchy::triangles_in_box_fine(const Terrain& t, const Box& box,
+                                                std::vector<SurfaceTriangle>& out,
+                                                std::size_t max_triangles) const {
+  const int L = int(t.detail_levels());
+  return boxes_impl(FineGrid{t, L, std::ldexp(inv_sx_, L), std::ldexp(inv_sz_, L)},
+                    t.heightfield(), L, t.detail()->contribution_bound(1), box, out,
+                    max_triangles);
+}
+
+template <class Grid>
+std::size_t RayHierarchy::boxes_impl(const Grid& g, const Heightfield& hf, int L, double widen,
+                                     const Box& box, std::vector<SurfaceTriangle>& out,
+                                     std::size_t max_triangles) const {
   for (int a = 0; a < 3; ++a)
     if (!std::isfinite(box.min[a]) || !std::isfinite(box.max[a]) || !(box.min[a] <= box.max[a]))
       return 0;
-  const double sx = hf.spacing_x(), sz = hf.spacing_z();
+  // Cells of `g` (the stored lattice, or the finest one: 2^L per stored cell).
+  const double sx = std::ldexp(hf.spacing_x(), -L), sz = std::ldexp(hf.spacing_z(), -L);
   const double ua = (box.min.x - hf.origin_x()) / sx, ub = (box.max.x - hf.origin_x()) / sx;
   const double va = (box.min.z - hf.origin_z()) / sz, vb = (box.max.z - hf.origin_z()) / sz;
   const double ylo = box.min.y - hf.height_offset(), yhi = box.max.y - hf.height_offset();
-  const double umax = hf.width() - 1.0, vmax = hf.height() - 1.0;
+  const double umax = std::ldexp(hf.width() - 1.0, L), vmax = std::ldexp(hf.height() - 1.0, L);
   if (ub < 0.0 || vb < 0.0 || ua > umax || va > vmax) return 0;
   // Closed cell ranges: a box touching a cell's edge overlaps that cell.
   const auto cell_lo = [](double a, double cells) {
@@ -489,50 +506,48 @@ std::size_t RayHierarchy::triangles_in_box(const Heightfield& hf, const Box& box
   const std::int64_t j0 = cell_lo(va, vmax), j1 = cell_hi(vb, vmax);
 
   const Level& leaf = levels_.front();
+  const int shift = L + int(kLeafShift);  // cell -> leaf block of the pyramid
   std::size_t added = 0;
-  for (std::int64_t bz = j0 >> kLeafShift; bz <= (j1 >> kLeafShift); ++bz) {
-    for (std::int64_t bx = i0 >> kLeafShift; bx <= (i1 >> kLeafShift); ++bx) {
-      const std::size_t block = leaf.index(bx, bz);
-      if (double(leaf.max[block]) < ylo || double(leaf.min[block]) > yhi) continue;
-      const std::int64_t ci_end = std::min(i1, ((bx + 1) << kLeafShift) - 1);
-      const std::int64_t cj_end = std::min(j1, ((bz + 1) << kLeafShift) - 1);
-      for (std::int64_t cj = std::max(j0, bz << kLeafShift); cj <= cj_end; ++cj) {
-        for (std::int64_t ci = std::max(i0, bx << kLeafShift); ci <= ci_end; ++ci) {
-          const auto i = static_cast<std::uint32_t>(ci), j = static_cast<std::uint32_t>(cj);
-          // The box in this cell's fractional coordinates.
-          const double bu0 = ua - double(ci), bu1 = ub - double(ci);
-          const double bv0 = va - double(cj), bv1 = vb - double(cj);
-          for (int which = 0; which < 2; ++which) {
-            const CellTriangle t = detail::cell_triangle(ci, cj, which);
-            float h[3];
-            for (int k = 0; k < 3; ++k) h[k] = hf.local(i + t.di[k], j + t.dj[k]);
-            const double hmin = std::min({h[0], h[1], h[2]}), hmax = std::max({h[0], h[1], h[2]});
-            if (hmax < ylo || hmin > yhi) continue;
-            // Separating axes: the box's axes hold (the cell overlaps the box and the triangle
-            // spans the cell); test the triangle's edge normals.
-            bool separated = false;
-            for (int e = 0; e < 3 && !separated; ++e) {
-              const int a = e, b = (e + 1) % 3, c = (e + 2) % 3;
-              // Normal of edge a-b, turned towards the opposite corner c.
-              double nx = -(double(t.dj[b]) - t.dj[a]), nz = double(t.di[b]) - t.di[a];
-              if (nx * (t.di[c] - t.di[a]) + nz * (t.dj[c] - t.dj[a]) < 0) nx = -nx, nz = -nz;
-              // Separated when even the box corner furthest along the normal lies strictly
-              // behind the edge.
-              const double box_max = nx * (nx >= 0 ? bu1 : bu0) + nz * (nz >= 0 ? bv1 : bv0);
-              separated = box_max < nx * t.di[a] + nz * t.dj[a];
-            }
-            if (separated) continue;
-            if (max_triangles != 0 && added == max_triangles) return added;
-            SurfaceTriangle st;
-            for (int k = 0; k < 3; ++k)
-              st.v[k] = {hf.origin_x() + double(ci + t.di[k]) * sx,
-                         hf.height_offset() + double(h[k]),
-                         hf.origin_z() + double(cj + t.dj[k]) * sz};
-            st.material = hf.material(i, j);
-            out.push_back(st);
-            ++added;
-          }
+  for (std::int64_t cj = j0; cj <= j1; ++cj) {
+    for (std::int64_t ci = i0; ci <= i1; ++ci) {
+      // Blocks whose height range (widened by the detail bound) misses the box are skipped.
+      const std::size_t block = leaf.index(ci >> shift, cj >> shift);
+      if (double(leaf.max[block]) + widen < ylo || double(leaf.min[block]) - widen > yhi) {
+        ci |= (std::int64_t{1} << shift) - 1;  // to the block's last cell
+        continue;
+      }
+      const auto i = static_cast<std::uint32_t>(ci), j = static_cast<std::uint32_t>(cj);
+      // The box in this cell's fractional coordinates.
+      const double bu0 = ua - double(ci), bu1 = ub - double(ci);
+      const double bv0 = va - double(cj), bv1 = vb - double(cj);
+      for (int which = 0; which < 2; ++which) {
+        const CellTriangle t = detail::cell_triangle(ci, cj, which);
+        double h[3];
+        for (int k = 0; k < 3; ++k) h[k] = g.local(i + t.di[k], j + t.dj[k]);
+        const double hmin = std::min({h[0], h[1], h[2]}), hmax = std::max({h[0], h[1], h[2]});
+        if (hmax < ylo || hmin > yhi) continue;
+        // Separating axes: the box's axes hold (the cell overlaps the box and the triangle
+        // spans the cell); test the triangle's edge normals.
+        bool separated = false;
+        for (int e = 0; e < 3 && !separated; ++e) {
+          const int a = e, b = (e + 1) % 3, c = (e + 2) % 3;
+          // Normal of edge a-b, turned towards the opposite corner c.
+          double nx = -(double(t.dj[b]) - t.dj[a]), nz = double(t.di[b]) - t.di[a];
+          if (nx * (t.di[c] - t.di[a]) + nz * (t.dj[c] - t.dj[a]) < 0) nx = -nx, nz = -nz;
+          // Separated when even the box corner furthest along the normal lies strictly
+          // behind the edge.
+          const double box_max = nx * (nx >= 0 ? bu1 : bu0) + nz * (nz >= 0 ? bv1 : bv0);
+          separated = box_max < nx * t.di[a] + nz * t.dj[a];
         }
+        if (separated) continue;
+        if (max_triangles != 0 && added == max_triangles) return added;
+        SurfaceTriangle st;
+        for (int k = 0; k < 3; ++k)
+          st.v[k] = {hf.origin_x() + double(ci + t.di[k]) * sx, hf.height_offset() + h[k],
+                     hf.origin_z() + double(cj + t.dj[k]) * sz};
+        st.material = g.material(i, j);
+        out.push_back(st);
+        ++added;
       }
     }
   }
@@ -547,6 +562,7 @@ std::optional<RayHit> Terrain::raycast(const glm::dvec3& origin, const glm::dvec
 
 std::size_t Terrain::triangles_in_box(const Box& box, std::vector<SurfaceTriangle>& out,
                                       std::size_t max_triangles) const {
+  if (detail_levels_ != 0) return rays_->triangles_in_box_fine(*this, box, out, max_triangles);
   return rays_->triangles_in_box(heightfield_, box, out, max_triangles);
 }
 

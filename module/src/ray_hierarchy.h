@@ -111,6 +111,11 @@ class RayHierarchy {
   std::optional<RayHit> raycast_fine(const Terrain& terrain, const glm::dvec3& origin,
                                      const glm::dvec3& direction, double max_distance) const noexcept;
 
+  /// See Terrain::triangles_in_box, on a terrain with detail (finest triangles).
+  std::size_t triangles_in_box_fine(const Terrain& terrain, const Box& box,
+                                    std::vector<SurfaceTriangle>& out,
+                                    std::size_t max_triangles) const;
+
   /// See Terrain::triangles_in_box.
   std::size_t triangles_in_box(const Heightfield& hf, const Box& box,
                                std::vector<SurfaceTriangle>& out, std::size_t max_triangles) const;
@@ -145,6 +150,10 @@ class RayHierarchy {
   std::optional<RayHit> raycast_impl(const Mode& mode, const Heightfield& hf,
                                      const glm::dvec3& origin, const glm::dvec3& direction,
                                      double max_distance) const noexcept;
+  template <class Grid>
+  std::size_t boxes_impl(const Grid& g, const Heightfield& hf, int L, double widen,
+                         const Box& box, std::vector<SurfaceTriangle>& out,
+                         std::size_t max_triangles) const;
   // Tests the cells [ci0, ci1] x [cj0, cj1] of `grid` that the ray (in grid units) crosses
   // during [ta, tb], in ray order.
   template <class Grid>

@@ -266,3 +266,18 @@ TEST(DetailSurface, RaysHitTheFinestSurface) {
   ASSERT_TRUE(below);
   EXPECT_TRUE(below->started_below);
 }
+
+TEST(DetailSurface, BoxQueryReturnsFinestTriangles) {
+  auto t = detail_terrain(65, 2);  // finest spacing 1 m
+  std::vector<SurfaceTriangle> tris;
+  // A box strictly inside cells [10, 19] x [20, 24] of the finest lattice, spanning all heights.
+  const Box box{{10.5, -1e4, 20.5}, {19.5, 1e4, 24.5}};
+  const std::size_t n = t->triangles_in_box(box, tris);
+  EXPECT_EQ(n, 2u * 10 * 5);
+  for (const SurfaceTriangle& s : tris)
+    for (const glm::dvec3& v : s.v) EXPECT_NEAR(v.y, *t->height(v.x, v.z), 2e-5);
+  // A height range above everything: nothing.
+  tris.clear();
+  EXPECT_EQ(t->triangles_in_box({{10.5, 1e4, 20.5}, {19.5, 2e4, 24.5}}, tris), 0u);
+  EXPECT_EQ(t->triangles_in_box({{10.5, -1e4, 20.5}, {19.5, 1e4, 24.5}}, tris, 7), 7u);
+}
