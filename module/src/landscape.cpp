@@ -12,11 +12,108 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <mutex>
 #include <thread>
 
+#include "edit_listener.h"
+#include "ridgeline/detail.h"
 #include "format.h"
 
 namespace ridgeline {
+
+struct Landscape::Views {
+  std::mutex mutex;
+  std::vector<detail::EditListener*> list;
+};
+
+// Hears the terrain's edits: bounds first, then the views.
+struct Landscape::Hook final : detail::EditListener {
+  explicit Hook(Landscape& l) : self(l) {}
+  void on_edit(const detail::EditRegion& r, EditResult& result) override {
+    result.bounds_updated +=
+        self.update_bounds(r.i0, r.j0, self.edited_end_i(r.i1), self.edited_end_j(r.j1));
+    std::vector<detail::EditListener*> views;
+    {
+      std::lock_guard lock(self.views_->mutex);
+      views = self.views_->list;
+    }
+    for (detail::EditListener* v : views) v->on_edit(r, result);
+  }
+  Landscape& self;
+};
+
+std::int64_t Landscape::edited_end_i(std::uint32_t i1) const noexcept {
+  return i1 + 1 >= terrain_->heightfield().width() ? std::int64_t(patches_x_) * (std::int64_t{1} << exponent_) : i1;
+}
+
+std::int64_t Landscape::edited_end_j(std::uint32_t j1) const noexcept {
+  return j1 + 1 >= terrain_->heightfield().height() ? std::int64_t(patches_z_) * (std::int64_t{1} << exponent_) : j1;
+}
+
+Landscape::~Landscape() {
+  if (hook_ && terrain_) terrain_->remove_listener(hook_.get());
+}
+
+void Landscape::add_listener(detail::EditListener* l) const {
+  std::lock_guard lock(views_->mutex);
+  views_->list.push_back(l);
+}
+
+void Landscape::remove_listener(detail::EditListener* l) const {
+  std::lock_guard lock(views_->mutex);
+  auto& v = views_->list;
+  v.erase(std::remove(v.begin(), v.end(), l), v.end());
+}
+
+std::uint64_t Landscape::update_bounds(std::int64_t i0, std::int64_t j0, std::int64_t i1,
+                                       std::int64_t j1) {
+  const std::int64_t p = std::int64_t{1} << exponent_;
+  // Patches whose closed square holds part of the region.
+  const std::int64_t px0 = std::max<std::int64_t>(0, (i0 + p - 1) / p - 1),
+                     px1 = std::min<std::int64_t>(patches_x_ - 1, i1 / p);
+  const std::int64_t pz0 = std::max<std::int64_t>(0, (j0 + p - 1) / p - 1),
+                     pz1 = std::min<std::int64_t>(patches_z_ - 1, j1 / p);
+  const std::uint64_t npr = nodes_per_root_plus_one_;
+  std::uint64_t updated = 0;
+  struct Item {
+    std::uint64_t heap;
+    LatticeTriangle t;
+  };
+  std::vector<Item> order, stack;
+  for (std::int64_t pz = pz0; pz <= pz1; ++pz) {
+    for (std::int64_t px = px0; px <= px1; ++px) {
+      for (std::uint32_t r = 0; r < 2; ++r) {
+        const auto root = static_cast<std::uint32_t>(2 * (px + pz * patches_x_) + r);
+        // Pre-order over the stored nodes whose triangle's box meets the region; recomputed in
+        // reverse (children before parents) so that nesting reads fresh children.
+        order.clear();
+        stack.push_back({1, base_triangle(root, 1)});
+        while (!stack.empty()) {
+          const Item it = stack.back();
+          stack.pop_back();
+          const LatticeTriangle& t = it.t;
+          if (std::max({t.ax, t.lx, t.rx}) < i0 || std::min({t.ax, t.lx, t.rx}) > i1 ||
+              std::max({t.az, t.lz, t.rz}) < j0 || std::min({t.az, t.lz, t.rz}) > j1)
+            continue;
+          order.push_back(it);
+          if (2 * it.heap < npr) {
+            stack.push_back({2 * it.heap, child_triangle(t, 0)});
+            stack.push_back({2 * it.heap + 1, child_triangle(t, 1)});
+          }
+        }
+        float* b = bounds_.data() + root * (npr - 1);
+        for (auto it = order.rbegin(); it != order.rend(); ++it) {
+          const std::uint64_t h = it->heap;
+          float v = compute_exact(it->t);
+          if (2 * h < npr) v = std::max({v, b[2 * h - 1], b[2 * h]});
+          b[h - 1] = v;
+        }
+        updated += order.size();
+      }
+    }
+  }
+  return updated;
+}
 
 Result<std::shared_ptr<const Landscape>> Landscape::create(std::shared_ptr<const Terrain> terrain,
                                                            const LandscapeDesc& desc) {
@@ -29,7 +126,8 @@ Result<std::shared_ptr<const Landscape>> Landscape::create(std::shared_ptr<const
   const Heightfield& hf = terrain->heightfield();
   l->terrain_ = std::move(terrain);
   l->exponent_ = desc.patch_exponent;
-  const std::int64_t p = l->patch_cells();
+  l->detail_ = l->terrain_->detail_levels();
+  const std::int64_t p = std::int64_t{1} << l->exponent_;  // stored cells per patch
   l->patches_x_ = static_cast<std::uint32_t>((hf.width() - 1 + p - 1) / p);
   l->patches_z_ = static_cast<std::uint32_t>((hf.height() - 1 + p - 1) / p);
   const std::uint64_t roots = std::uint64_t{2} * l->patches_x_ * l->patches_z_;
@@ -40,19 +138,21 @@ Result<std::shared_ptr<const Landscape>> Landscape::create(std::shared_ptr<const
                      static_cast<unsigned long long>(total))};
   l->origin_x_ = hf.origin_x();
   l->origin_z_ = hf.origin_z();
-  l->spacing_x_ = hf.spacing_x();
-  l->spacing_z_ = hf.spacing_z();
+  l->spacing_x_ = std::ldexp(hf.spacing_x(), -int(l->detail_));
+  l->spacing_z_ = std::ldexp(hf.spacing_z(), -int(l->detail_));
+  l->last_i_ = std::int64_t(hf.width() - 1) << l->detail_;
+  l->last_j_ = std::int64_t(hf.height() - 1) << l->detail_;
   l->bounds_.assign(total, 0.0f);
 
   // Roots are independent: split them over the hardware threads.
   const std::uint64_t npr = l->nodes_per_root_plus_one_;
-  const std::uint32_t max_level = l->max_level();
+  const std::uint32_t max_level = l->base_level();  // stored levels: 0 .. base_level - 1
   auto work = [&](std::uint64_t first, std::uint64_t last) {
     for (std::uint64_t root = first; root < last; ++root) {
       float* b = l->bounds_.data() + root * (npr - 1);
       // Exact error per stored node (levels 0 .. max_level - 1), walking levels top-down so each
       // node's triangle comes from its parent's.
-      std::vector<LatticeTriangle> level{l->triangle(static_cast<std::uint32_t>(root), 1)};
+      std::vector<LatticeTriangle> level{l->base_triangle(static_cast<std::uint32_t>(root), 1)};
       std::vector<LatticeTriangle> next;
       std::uint64_t first_heap = 1;
       for (std::uint32_t lv = 0; lv < max_level; ++lv) {
@@ -83,6 +183,9 @@ Result<std::shared_ptr<const Landscape>> Landscape::create(std::shared_ptr<const
   }
   l->build_ms_ =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  l->views_ = std::make_unique<Views>();
+  l->hook_ = std::make_unique<Hook>(*l);
+  l->terrain_->add_listener(l->hook_.get());
   return std::shared_ptr<const Landscape>(std::move(l));
 }
 
@@ -93,8 +196,33 @@ LatticeTriangle Landscape::child_triangle(const LatticeTriangle& t, int child) n
 }
 
 LatticeTriangle Landscape::triangle(std::uint32_t root, std::uint64_t heap) const noexcept {
+  LatticeTriangle t = base_triangle(root, 1);
+  const int d = int(detail_);
+  t = {t.ax << d, t.az << d, t.lx << d, t.lz << d, t.rx << d, t.rz << d};
+  const int depth = 63 - __builtin_clzll(heap);
+  for (int bit = depth - 1; bit >= 0; --bit) t = child_triangle(t, int((heap >> bit) & 1));
+  return t;
+}
+
+float Landscape::detail_bound(int level, const LatticeTriangle& t) const noexcept {
+  // Stored levels: the whole detail (from level 1). Level 2k + 2(m - 1) and 2k + 2m - 1 resolve
+  // detail levels below m; their error is at most twice the contribution of levels >= m
+  // (docs/detail.md, "Bounds"), non-increasing down the tree, so the sum stays nested.
+  const int base = int(base_level());
+  const int from = level < base ? 1 : (level - base) / 2 + 1;
+  if (from > int(detail_)) return 0.0f;
+  const DetailField& f = *terrain_->detail();
+  const double b = 2.0 * f.contribution_bound(std::uint32_t(from), detail_,
+                                              std::min({t.ax, t.lx, t.rx}), std::min({t.az, t.lz, t.rz}),
+                                              std::max({t.ax, t.lx, t.rx}), std::max({t.az, t.lz, t.rz}));
+  float r = static_cast<float>(b);
+  if (double(r) < b) r = std::nextafter(r, INFINITY);
+  return r;
+}
+
+LatticeTriangle Landscape::base_triangle(std::uint32_t root, std::uint64_t heap) const noexcept {
   const std::uint32_t patch = root / 2;
-  const std::int64_t p = patch_cells();
+  const std::int64_t p = std::int64_t{1} << exponent_;
   const std::int64_t ox = std::int64_t(patch % patches_x_) * p;
   const std::int64_t oz = std::int64_t(patch / patches_x_) * p;
   LatticeTriangle t = (root & 1) == 0 ? LatticeTriangle{ox + p, oz, ox, oz, ox + p, oz + p}
@@ -107,8 +235,8 @@ LatticeTriangle Landscape::triangle(std::uint32_t root, std::uint64_t heap) cons
 float Landscape::compute_exact(const LatticeTriangle& t) const noexcept {
   const std::int64_t x0 = std::min({t.ax, t.lx, t.rx}), x1 = std::max({t.ax, t.lx, t.rx});
   const std::int64_t z0 = std::min({t.az, t.lz, t.rz}), z1 = std::max({t.az, t.lz, t.rz});
-  const double ha = lattice_height(t.ax, t.az), hl = lattice_height(t.lx, t.lz),
-               hr = lattice_height(t.rx, t.rz);
+  const double ha = base_height(t.ax, t.az), hl = base_height(t.lx, t.lz),
+               hr = base_height(t.rx, t.rz);
   // Edge functions in integer arithmetic; w is twice the signed area.
   auto cross = [](std::int64_t ux, std::int64_t uz, std::int64_t vx, std::int64_t vz) {
     return ux * vz - uz * vx;
@@ -119,17 +247,38 @@ float Landscape::compute_exact(const LatticeTriangle& t) const noexcept {
   double worst = 0.0;
   const Heightfield& hf = terrain_->heightfield();
   const std::int64_t wmax = hf.width() - 1, hmax = hf.height() - 1;
+  // The three edge functions e(x, z) = a * x + c(z) (weights of R, A and L); inside means all
+  // share w's sign. Per row, each edge bounds x from one side: the span is found exactly in
+  // integer arithmetic, so only the samples inside are visited.
+  const std::int64_t sgn = w > 0 ? 1 : -1;
+  const std::int64_t ex[3][2] = {{t.ax, t.az}, {t.lx, t.lz}, {t.rx, t.rz}};
+  // Edge k runs from vertex p to vertex q: e = (q - p) x (v - p).
+  const int from[3] = {0, 1, 2}, to[3] = {1, 2, 0};
+  auto floor_div = [](std::int64_t n, std::int64_t d) {  // d > 0
+    return n >= 0 ? n / d : -((-n + d - 1) / d);
+  };
   for (std::int64_t z = z0; z <= z1; ++z) {
-    for (std::int64_t x = x0; x <= x1; ++x) {
-      const std::int64_t e_r = cross(t.lx - t.ax, t.lz - t.az, x - t.ax, z - t.az);  // weight of R
-      const std::int64_t e_a = cross(t.rx - t.lx, t.rz - t.lz, x - t.lx, z - t.lz);  // weight of A
-      const std::int64_t e_l = cross(t.ax - t.rx, t.az - t.rz, x - t.rx, z - t.rz);  // weight of L
-      const bool inside =
-          w > 0 ? (e_r >= 0 && e_a >= 0 && e_l >= 0) : (e_r <= 0 && e_a <= 0 && e_l <= 0);
-      if (!inside) continue;
-      const double plane = (e_a * ha + e_l * hl + e_r * hr) * inv_w;
-      const double h = hf.local(static_cast<std::uint32_t>(std::clamp<std::int64_t>(x, 0, wmax)),
-                                static_cast<std::uint32_t>(std::clamp<std::int64_t>(z, 0, hmax)));
+    std::int64_t lo = x0, hi = x1;
+    std::int64_t coef[3], off[3];
+    for (int k = 0; k < 3; ++k) {
+      const std::int64_t px = ex[from[k]][0], pz = ex[from[k]][1];
+      const std::int64_t ux = ex[to[k]][0] - px, uz = ex[to[k]][1] - pz;
+      // e(x) = ux * (z - pz) - uz * (x - px) = a * x + c, made >= 0 inside by the sign.
+      const std::int64_t a = -uz * sgn, c = (ux * (z - pz) + uz * px) * sgn;
+      coef[k] = a, off[k] = c;
+      if (a > 0) lo = std::max(lo, -floor_div(c, a));      // x >= ceil(-c / a)
+      else if (a < 0) hi = std::min(hi, floor_div(c, -a));  // x <= floor(c / -a)
+      else if (c < 0) lo = hi + 1;                          // edge parallel to x, row outside
+    }
+    if (lo > hi) continue;
+    const std::uint32_t zc = static_cast<std::uint32_t>(std::clamp<std::int64_t>(z, 0, hmax));
+    for (std::int64_t x = lo; x <= hi; ++x) {
+      // Barycentric weights from the edge functions (e_k is opposite the vertex after edge k).
+      const std::int64_t e_ab = coef[0] * x + off[0];  // edge A->L: weight of R
+      const std::int64_t e_lr = coef[1] * x + off[1];  // edge L->R: weight of A
+      const std::int64_t e_ra = coef[2] * x + off[2];  // edge R->A: weight of L
+      const double plane = (double(e_lr) * ha + double(e_ra) * hl + double(e_ab) * hr) * inv_w * sgn;
+      const double h = hf.local(static_cast<std::uint32_t>(std::clamp<std::int64_t>(x, 0, wmax)), zc);
       worst = std::max(worst, std::abs(h - plane));
     }
   }
@@ -140,7 +289,7 @@ float Landscape::compute_exact(const LatticeTriangle& t) const noexcept {
 }
 
 float Landscape::exact_error(std::uint32_t root, std::uint64_t heap) const noexcept {
-  return compute_exact(triangle(root, heap));
+  return heap < nodes_per_root_plus_one_ ? compute_exact(base_triangle(root, heap)) : 0.0f;
 }
 
 }  // namespace ridgeline
