@@ -4,7 +4,7 @@
 # Installs missing Debian packages first.
 # Usage: scripts/test.sh            (all stages)
 #        STAGES="release" scripts/test.sh   (a subset: release asan fuzz)
-#        FUZZ_SECONDS=600 STAGES=fuzz scripts/test.sh   (a longer fuzz run; default 40 s a target)
+#        FUZZ_SECONDS=600 STAGES=fuzz scripts/test.sh   (a longer fuzz run; default 30 s a target)
 set -uo pipefail
 source "$(dirname "$0")/lib/common.sh"
 cd "$RIDGELINE_ROOT"
@@ -45,9 +45,9 @@ asan() {
 # libFuzzer targets (tests/fuzz, docs/reliability.md) in a clang build with ASan + UBSan + fuzzer
 # instrumentation, each run for FUZZ_SECONDS on a copy of its committed corpus. A crash fails the
 # stage; the input is kept in build/fuzz/crashes/ (commit it under tests/fuzz/corpus/ with the fix).
-FUZZ_TARGETS=(fuzz_raw fuzz_camera_path fuzz_image fuzz_lua)
+FUZZ_TARGETS=(fuzz_raw fuzz_camera_path fuzz_image fuzz_edit_json fuzz_edit_state fuzz_lua)
 fuzz() {
-  local dir=build/fuzz t rc=0 secs=${FUZZ_SECONDS:-40}
+  local dir=build/fuzz t rc=0 secs=${FUZZ_SECONDS:-30}
   mkdir -p "$dir/crashes"
   cmake -S "$RIDGELINE_ROOT" -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DCMAKE_CXX_COMPILER=clang++-14 -DRIDGELINE_SANITIZE=address,undefined -DRIDGELINE_FUZZ=ON \
