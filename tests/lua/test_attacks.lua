@@ -240,10 +240,26 @@ T.case("file names: traversal, absolute, NUL, odd names", function()
     {"no such file.png", "'no such file.png'"},
     {"%s%n%x.png", "'%s%n%x.png'"},
   }
+  local target = ridgeline.load{heightmap = "ramp16.png"}
   for _, case in ipairs(bad) do
     local tr, err = ridgeline.load{heightmap = case[1]}
     T.eq(tr, nil, case[1]); T.truthy(err:find(case[2], 1, true), ("%q: %s"):format(case[1], err))
+    -- Every other call that takes a file name follows the same rules.
+    if case[2]:find("not allowed", 1, true) or case[2]:find("too long", 1, true) then
+      local ok, e2 = ridgeline.save_edits(target, case[1])
+      T.eq(ok, nil, "save " .. case[1]); T.truthy(e2:find(case[2], 1, true), e2)
+      local r, e3 = ridgeline.load_edits(target, case[1])
+      T.eq(r, nil, "load edits " .. case[1]); T.truthy(e3:find(case[2], 1, true), e3)
+      local ok2, e5 = target:save_edits(case[1])
+      T.eq(ok2, nil, "method save " .. case[1]); T.truthy(e5:find(case[2], 1, true), e5)
+      local r2, e6 = target:load_edits(case[1])
+      T.eq(r2, nil, "method load " .. case[1]); T.truthy(e6:find(case[2], 1, true), e6)
+    end
   end
+  T.raises("NUL byte", ridgeline.save_edits, target, "x.bin\0/../../etc/passwd")
+  T.raises("NUL byte", ridgeline.load_edits, target, "\0")
+  local r, e4 = ridgeline.load_edits(target, "ramp16.png")  -- a file that is not a save
+  T.eq(r, nil); T.truthy(e4 ~= nil)
   T.raises("embedded zero in file name", ridgeline.load, {heightmap = "ramp16.png\0"})
   T.raises("embedded zero in file name", ridgeline.load, {heightmap = "\0/etc/passwd"})
   T.raises("field 'heightmap': string expected, got table", ridgeline.load,

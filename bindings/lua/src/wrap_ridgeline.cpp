@@ -69,6 +69,7 @@ bool do_load(const ConfigBox& config, const LoadArgs& a, TerrainBox* box, char* 
       return false;
     }
     box->terrain = std::move(*t);
+    set_path_rules(box, config);
     return true;
   } catch (const std::exception& e) {
     copy_error(err, e.what());
@@ -145,6 +146,7 @@ bool make_default(ConfigBox* config, TerrainBox* box, char* err) noexcept {
       config->default_terrain = Terrain::create(std::move(*hf));
     }
     box->terrain = config->default_terrain;
+    set_path_rules(box, *config);
     return true;
   } catch (const std::exception& e) {
     copy_error(err, e.what());
