@@ -30,11 +30,13 @@ release() {
   (cd build/release && ctest --output-on-failure -j "$JOBS")
 }
 
+# One clang build with ASan, UBSan and libFuzzer instrumentation serves the sanitizer tests and
+# the fuzz stage (the fuzz targets are libFuzzer binaries there; ctest replays their corpus).
+ASAN_CMAKE_ARGS=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++-14
+  -DRIDGELINE_SANITIZE=address,undefined -DRIDGELINE_FUZZ=ON -DRIDGELINE_BUILD_BENCHMARKS=OFF)
+
 asan() {
-  # clang for the sanitizer build (the same build will carry the fuzzers).
-  configure_and_build build/asan -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-    -DCMAKE_CXX_COMPILER=clang++-14 -DRIDGELINE_SANITIZE=address,undefined \
-    -DRIDGELINE_BUILD_BENCHMARKS=OFF || return 1
+  configure_and_build build/asan "${ASAN_CMAKE_ARGS[@]}" || return 1
   # Readable sanitizer stacks where llvm-symbolizer is installed (suppressions do not need it).
   local sym=/usr/lib/llvm-14/bin/llvm-symbolizer
   [ -x "$sym" ] && export ASAN_SYMBOLIZER_PATH=$sym
@@ -42,22 +44,21 @@ asan() {
      UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 ctest --output-on-failure -j "$JOBS")
 }
 
-# libFuzzer targets (tests/fuzz, docs/reliability.md) in a clang build with ASan + UBSan + fuzzer
-# instrumentation, each run for FUZZ_SECONDS on a copy of its committed corpus. A crash fails the
-# stage; the input is kept in build/fuzz/crashes/ (commit it under tests/fuzz/corpus/ with the fix).
+# libFuzzer targets (tests/fuzz, docs/reliability.md) from the asan stage's build (built here if
+# that stage did not run), each run for FUZZ_SECONDS on a copy of its committed corpus. A crash
+# fails the stage; the input is kept in build/asan/crashes/ (commit it under tests/fuzz/corpus/
+# with the fix).
 FUZZ_TARGETS=(fuzz_raw fuzz_camera_path fuzz_image fuzz_edit_json fuzz_edit_state fuzz_lua)
 fuzz() {
-  local dir=build/fuzz t rc=0 secs=${FUZZ_SECONDS:-30}
+  local dir=build/asan t rc=0 secs=${FUZZ_SECONDS:-30}
   mkdir -p "$dir/crashes"
-  cmake -S "$RIDGELINE_ROOT" -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-    -DCMAKE_CXX_COMPILER=clang++-14 -DRIDGELINE_SANITIZE=address,undefined -DRIDGELINE_FUZZ=ON \
-    -DRIDGELINE_BUILD_BENCHMARKS=OFF -DRIDGELINE_BUILD_TOOLS=OFF > "$dir.configure.log" 2>&1 || {
-    cat "$dir.configure.log"; return 1; }
+  cmake -S "$RIDGELINE_ROOT" -B "$dir" -G Ninja "${ASAN_CMAKE_ARGS[@]}" > "$dir.configure.log" 2>&1 ||
+    { cat "$dir.configure.log"; return 1; }
   cmake --build "$dir" -j "$JOBS" --target "${FUZZ_TARGETS[@]}" || return 1
   local sym=/usr/lib/llvm-14/bin/llvm-symbolizer
   [ -x "$sym" ] && export ASAN_SYMBOLIZER_PATH=$sym
   for t in "${FUZZ_TARGETS[@]}"; do
-    local work=$dir/corpus/$t dict=tests/fuzz/$t.dict extra=()
+    local work=$dir/fuzz_corpus/$t dict=tests/fuzz/$t.dict extra=()
     mkdir -p "$work"
     [ -f "$dict" ] && extra+=(-dict="$dict")
     ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
