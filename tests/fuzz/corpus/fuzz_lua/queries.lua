@@ -1,4 +1,4 @@
-local t = ridgeline.default_terrain()
+local t = ridgeline.load{heightmap = "ramp16.png", spacing = 4}
 local h = t:height(100, 200)
 local nx, ny, nz = t:normal(100, 200)
 local s = t:sample(10, 10)
