@@ -193,7 +193,9 @@ TEST(ReportMeasure, AgreesWithBruteForceOnASmallField) {
       EXPECT_EQ(a.vertices, b.vertices);
       EXPECT_EQ(a.uncovered, 0u);
       EXPECT_EQ(b.uncovered, 0u);
-      if (&m == &meshes[0]) EXPECT_GT(b.max_m, 0.1);  // coarse: the comparison is not of zeros
+      if (&m == &meshes[0]) {
+        EXPECT_GT(b.max_m, 0.1);  // coarse: the comparison is not of zeros
+      }
       EXPECT_NEAR(a.max_m, b.max_m, 1e-4);
       EXPECT_NEAR(a.rms_m, b.rms_m, 1e-4);
       EXPECT_NEAR(a.max_px, b.max_px, 1e-3 * std::max(1.0, b.max_px));

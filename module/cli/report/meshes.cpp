@@ -263,30 +263,56 @@ Cdlod::Cdlod(const Heightfield& hf, std::uint32_t grid)
     per_row_[L] = nx;
     nodes_[L].resize(std::size_t(nx * nz));
     for (std::int64_t b = 0; b < nz; ++b)
-      for (std::int64_t a = 0; a < nx; ++a) {
-        Node n{std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity()};
-        if (L == 0) {
-          for (std::int64_t j = b * size; j <= std::min((b + 1) * size, cells_z_); ++j)
-            for (std::int64_t i = a * size; i <= std::min((a + 1) * size, cells_x_); ++i) {
-              const float h = hf.local(std::uint32_t(i), std::uint32_t(j));
-              n.lo = std::min(n.lo, h);
-              n.hi = std::max(n.hi, h);
-            }
-        } else {
-          for (int q = 0; q < 4; ++q) {
-            const std::int64_t ca = 2 * a + (q & 1), cb = 2 * b + (q >> 1);
-            if (ca >= per_row_[L - 1] || cb * per_row_[L - 1] >= std::int64_t(nodes_[L - 1].size()))
-              continue;
-            const Node& c = nodes_[L - 1][std::size_t(ca + cb * per_row_[L - 1])];
-            n.lo = std::min(n.lo, c.lo);
-            n.hi = std::max(n.hi, c.hi);
-          }
-        }
-        nodes_[L][std::size_t(a + b * nx)] = n;
-      }
+      for (std::int64_t a = 0; a < nx; ++a) nodes_[L][std::size_t(a + b * nx)] = compute(L, a, b);
   }
+  compute_min_r0();
+}
+
+Cdlod::Node Cdlod::compute(std::uint32_t L, std::int64_t a, std::int64_t b) const {
+  const Heightfield& hf = *hf_;
+  const std::int64_t size = std::int64_t(grid_) << L;
+  Node n{std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity()};
+  if (L == 0) {
+    for (std::int64_t j = b * size; j <= std::min((b + 1) * size, cells_z_); ++j)
+      for (std::int64_t i = a * size; i <= std::min((a + 1) * size, cells_x_); ++i) {
+        const float h = hf.local(std::uint32_t(i), std::uint32_t(j));
+        n.lo = std::min(n.lo, h);
+        n.hi = std::max(n.hi, h);
+      }
+    return n;
+  }
+  const std::int64_t rows = std::int64_t(nodes_[L - 1].size()) / per_row_[L - 1];
+  for (int q = 0; q < 4; ++q) {
+    const std::int64_t ca = 2 * a + (q & 1), cb = 2 * b + (q >> 1);
+    if (ca >= per_row_[L - 1] || cb >= rows) continue;
+    const Node& c = nodes_[L - 1][std::size_t(ca + cb * per_row_[L - 1])];
+    n.lo = std::min(n.lo, c.lo);
+    n.hi = std::max(n.hi, c.hi);
+  }
+  return n;
+}
+
+void Cdlod::refresh(std::int64_t i0, std::int64_t j0, std::int64_t i1, std::int64_t j1) {
+  i0 = std::clamp<std::int64_t>(i0, 0, cells_x_);
+  i1 = std::clamp<std::int64_t>(i1, 0, cells_x_);
+  j0 = std::clamp<std::int64_t>(j0, 0, cells_z_);
+  j1 = std::clamp<std::int64_t>(j1, 0, cells_z_);
+  for (std::uint32_t L = 0; L < levels_; ++L) {
+    const std::int64_t size = std::int64_t(grid_) << L;
+    const std::int64_t rows = std::int64_t(nodes_[L].size()) / per_row_[L];
+    // Closed footprints: a sample on a node border belongs to both nodes.
+    for (std::int64_t b = std::max<std::int64_t>(0, (j0 - 1) / size); b <= std::min(rows - 1, j1 / size); ++b)
+      for (std::int64_t a = std::max<std::int64_t>(0, (i0 - 1) / size);
+           a <= std::min(per_row_[L] - 1, i1 / size); ++a)
+        nodes_[L][std::size_t(a + b * per_row_[L])] = compute(L, a, b);
+  }
+  compute_min_r0();
+}
+
+void Cdlod::compute_min_r0() {
   // Smallest r0 for which a coarser neighbour's vertices are unmorphed where a finer chunk meets
   // it: the diagonal of every level-(L+1) node must fit in the band [range_L, start_{L+1}].
+  min_r0_ = 0;
   for (std::uint32_t L = 0; L + 2 < levels_; ++L) {
     const std::int64_t size = std::int64_t(grid_) << (L + 1);
     for (std::size_t n = 0; n < nodes_[L + 1].size(); ++n) {

@@ -141,6 +141,10 @@ class Cdlod {
   };
   Match match(const std::vector<Camera>& frames, double target, std::size_t step = 1) const;
 
+  /// Recomputes the min/max heights of the nodes over lattice cells [i0, i1] x [j0, j1] after the
+  /// heights there changed (an edit), and min_r0(). O(changed area + levels).
+  void refresh(std::int64_t i0, std::int64_t j0, std::int64_t i1, std::int64_t j1);
+
   double min_r0() const noexcept { return min_r0_; }
   std::uint32_t grid() const noexcept { return grid_; }
   std::uint32_t levels() const noexcept { return levels_; }
@@ -153,6 +157,8 @@ class Cdlod {
     float lo, hi;
   };
   const Node& node(std::uint32_t level, std::int64_t i0, std::int64_t j0) const;
+  Node compute(std::uint32_t level, std::int64_t a, std::int64_t b) const;
+  void compute_min_r0();
   void box(std::uint32_t level, std::int64_t i0, std::int64_t j0, glm::dvec3* lo,
            glm::dvec3* hi) const;
   bool select_node(std::uint32_t level, std::int64_t i0, std::int64_t j0, const ViewFrustum& f,
