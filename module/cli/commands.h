@@ -24,6 +24,10 @@ Command add_mesh_command(CLI::App& parent);
 Command add_bench_lod_command(CLI::App& bench);
 /// `ridge report`: speed versus error of ROAM and two comparators (cmd_report.cpp).
 Command add_report_command(CLI::App& parent);
+/// `ridge deform --edits EDITS.json [--save STATE.bin]`: apply edits, save the state (JSON report).
+Command add_deform_command(CLI::App& parent);
+/// `ridge bench deform`: ms per crater edit for several radii (JSON).
+Command add_bench_deform_command(CLI::App& bench);
 /// `ridge bench queries`: query speed (JSON), measured by bench_queries.h.
 Command add_bench_queries_command(CLI::App& bench);
 

@@ -144,7 +144,11 @@ int config_gc(lua_State* L) {
 }
 
 const luaL_Reg kFunctions[] = {
-    {"load", r_load}, {"default_terrain", r_default_terrain}, {nullptr, nullptr}};
+    {"load", r_load},
+    {"default_terrain", r_default_terrain},
+    {"save_edits", r_save_edits},
+    {"load_edits", r_load_edits},
+    {nullptr, nullptr}};
 
 }  // namespace
 }  // namespace ridgeline::lua::detail
