@@ -7,6 +7,7 @@
 #include <random>
 
 #include "report/meshes.h"
+#include "ridgeline/edit.h"
 #include "ridgeline/landscape.h"
 
 namespace ridgeline::report {
@@ -141,6 +142,37 @@ TEST(ReportCdlod, MatchesAFeasibleTriangleTargetWithinTenPercent) {
     const auto m = cd.match(path, target);
     EXPECT_GE(m.r0, cd.min_r0());
     EXPECT_NEAR(m.median / target, 1.0, 0.10) << target;
+  }
+}
+
+TEST(ReportCdlod, RefreshAfterAnEditEqualsARebuiltQuadtree) {
+  HeightfieldDesc d;
+  d.width = d.height = 129;
+  std::vector<float> v(129 * 129);
+  for (std::size_t k = 0; k < v.size(); ++k) v[k] = float(30 + 10 * std::sin(0.1 * double(k % 129)));
+  auto hf = Heightfield::create(d, v);
+  ASSERT_TRUE(hf.ok());
+  auto t = Terrain::create(std::move(*hf));
+  Cdlod cd(t->heightfield(), 8);
+  Edit e;
+  e.brush = Brush::kCrater;
+  e.x = 70;
+  e.z = 40;
+  e.radius = 12;
+  e.depth = 30;  // deep: the node boxes around it must grow
+  auto r = t->apply_edit(e);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  ASSERT_FALSE(r->empty());
+  cd.refresh(std::int64_t(r->changed.min.x) - 1, std::int64_t(r->changed.min.z) - 1,
+             std::int64_t(r->changed.max.x) + 1, std::int64_t(r->changed.max.z) + 1);
+  const Cdlod rebuilt(t->heightfield(), 8);
+  EXPECT_EQ(cd.min_r0(), rebuilt.min_r0());
+  for (const Camera& c : cameras()) {
+    const auto a = cd.select(c, rebuilt.min_r0() * 1.2, false);
+    const auto b = rebuilt.select(c, rebuilt.min_r0() * 1.2, false);
+    ASSERT_EQ(a.chunks.size(), b.chunks.size());
+    EXPECT_EQ(a.triangles, b.triangles);
+    EXPECT_EQ(check_watertight(t->heightfield(), cd.mesh(a, c, true)), "");
   }
 }
 

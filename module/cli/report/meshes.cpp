@@ -227,7 +227,7 @@ UniformGrid UniformGrid::for_triangles(const Heightfield& hf, double triangles) 
   return best;
 }
 
-DrawnMesh UniformGrid::mesh(const Heightfield& hf) const {
+std::vector<glm::dvec3> UniformGrid::vertices(const Heightfield& hf) const {
   const double W = hf.width() - 1, H = hf.height() - 1;
   std::vector<glm::dvec3> v(std::size_t(nx + 1) * (nz + 1));
   for (std::uint32_t b = 0; b <= nz; ++b)
@@ -235,6 +235,26 @@ DrawnMesh UniformGrid::mesh(const Heightfield& hf) const {
       const double u = a == nx ? W : W * a / nx, w = b == nz ? H : H * b / nz;
       v[a + std::size_t(b) * (nx + 1)] = {u, surface_height(hf, u, w), w};
     }
+  return v;
+}
+
+std::size_t UniformGrid::resample(const Heightfield& hf, std::vector<glm::dvec3>& v, double u0,
+                                  double v0, double u1, double v1) const {
+  const double W = hf.width() - 1, H = hf.height() - 1;
+  const auto a0 = static_cast<std::int64_t>(std::max(0.0, std::floor(u0 * nx / W)));
+  const auto a1 = std::min<std::int64_t>(nx, std::int64_t(std::ceil(u1 * nx / W)));
+  const auto b0 = static_cast<std::int64_t>(std::max(0.0, std::floor(v0 * nz / H)));
+  const auto b1 = std::min<std::int64_t>(nz, std::int64_t(std::ceil(v1 * nz / H)));
+  std::size_t n = 0;
+  for (std::int64_t b = b0; b <= b1; ++b)
+    for (std::int64_t a = a0; a <= a1; ++a, ++n) {
+      glm::dvec3& p = v[std::size_t(a) + std::size_t(b) * (nx + 1)];
+      p.y = surface_height(hf, p.x, p.z);
+    }
+  return n;
+}
+
+DrawnMesh UniformGrid::mesh_of(const std::vector<glm::dvec3>& v) const {
   DrawnMesh out;
   out.corners.reserve(std::size_t(triangles()) * 3);
   for (std::uint32_t b = 0; b < nz; ++b)

@@ -97,7 +97,14 @@ struct UniformGrid {
   /// The grid closest to `triangles` triangles whose quads are as square as the terrain allows
   /// (at least 1 x 1, at most one quad per lattice cell... and beyond: never coarser than 1).
   static UniformGrid for_triangles(const Heightfield& hf, double triangles);
-  DrawnMesh mesh(const Heightfield& hf) const;
+  DrawnMesh mesh(const Heightfield& hf) const { return mesh_of(vertices(hf)); }
+  /// The (nx + 1) x (nz + 1) vertices, row by row, and the mesh over them.
+  std::vector<glm::dvec3> vertices(const Heightfield& hf) const;
+  DrawnMesh mesh_of(const std::vector<glm::dvec3>& vertices) const;
+  /// Re-samples the heights of the vertices inside lattice range [u0, u1] x [v0, v1] (after an
+  /// edit there); returns how many.
+  std::size_t resample(const Heightfield& hf, std::vector<glm::dvec3>& vertices, double u0,
+                       double v0, double u1, double v1) const;
 };
 
 // ---- CDLOD-like chunked quadtree --------------------------------------------------------
