@@ -40,8 +40,8 @@ std::vector<NamedPath> make_paths(const Terrain& terrain, int frames) {
   const double alt = top + 0.08 * E;
   for (int k = 0; k < n; ++k) {
     const double s = double(k) / n;
-    {  // flyover: full circle
-      const double a = 2 * kPi * s;
+    {  // flyover: 1 degree per frame (the 360-frame circle of docs/benchmarks.md)
+      const double a = 2 * kPi * k / 360.0;
       const glm::dvec3 eye(cx + 0.3 * E * std::cos(a), alt, cz + 0.3 * E * std::sin(a));
       const glm::dvec3 ahead(-std::sin(a), 0, std::cos(a));
       out[0].frames.push_back(cam(eye, eye + ahead * (0.1 * E) - glm::dvec3(0, 0.05 * E, 0)));
@@ -60,8 +60,8 @@ std::vector<NamedPath> make_paths(const Terrain& terrain, int frames) {
       out[2].frames.push_back(
           cam(eye, eye + glm::dvec3(100 * std::cos(a), -20, 100 * std::sin(a))));
     }
-    {  // zoom: slow flight; field of view snaps 70 -> 8 -> 70
-      const double x = cx - 0.2 * E + 0.4 * E * s;
+    {  // zoom: slow flight (0.002 x extent per frame); field of view snaps 70 -> 8 -> 70
+      const double x = cx - 0.2 * E + 0.002 * E * k;
       const glm::dvec3 eye(x, top + 0.03 * E, cz - 0.3 * E);
       const double fov = (k >= n / 3 && k < 2 * n / 3) ? 8.0 : 70.0;
       out[3].frames.push_back(cam(eye, {x, ground(x, cz), cz}, fov));
