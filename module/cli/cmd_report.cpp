@@ -931,10 +931,10 @@ Command add_report_command(CLI::App& parent) {
                   "The DEM's no-data value (default -32768, elev.tif's GDAL tag, which the loader "
                   "does not read)")
       ->type_name("V");
-  app->add_option("--frames", a->frames, "Frames per path (default 120; smoke 12)")
+  app->add_option("--frames", a->frames, "Frames per path (default 60; smoke 12)")
       ->type_name("N");
   app->add_option("--error-every", a->error_every,
-                  "Measure error and popping every K-th frame (default 10; smoke 3)")
+                  "Measure error and popping every K-th frame (default 6; smoke 3)")
       ->type_name("K");
   app->add_option("--paths", a->paths, "Only these paths (comma-separated)")->type_name("LIST");
   app->add_option("--work", a->work, "Directory for the loader hard cases' files (default: temp)")
