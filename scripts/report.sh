@@ -4,6 +4,7 @@
 # Debian's r-cran-terra, without installing R), runs `ridge report` once over every scene, path,
 # setting and mode, then plots with gnuplot.
 # Usage: bash scripts/report.sh [OUT_DIR]   (default docs/benchmarks/report; inputs in build/report-data)
+#        RIDGE=build/x/module/ridge bash scripts/report.sh   (use an already built Release ridge)
 set -euo pipefail
 source "$(dirname "$0")/lib/common.sh"
 cd "$RIDGELINE_ROOT"
@@ -11,8 +12,11 @@ out=${1:-docs/benchmarks/report}
 data=build/report-data
 mkdir -p "$out" "$data"
 ensure_packages "${RIDGELINE_PACKAGES[@]}" "${RIDGELINE_REPORT_PACKAGES[@]}"
-configure_and_build build/release -DCMAKE_BUILD_TYPE=Release > /dev/null
-ridge=build/release/module/ridge
+ridge=${RIDGE:-}
+if [ -z "$ridge" ]; then
+  configure_and_build build/release -DCMAKE_BUILD_TYPE=Release > /dev/null
+  ridge=build/release/module/ridge
+fi
 
 gen=$RIDGELINE_ROOT/../shared/tools/make-noise-field
 [ -f "$data/noise1025.png" ] || python3 "$gen" "$data" > /dev/null
@@ -27,7 +31,7 @@ fi
 {
   echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)," \
        "$(awk '/MemTotal/ {printf "%.1f GB", $2 / 1048576}' /proc/meminfo)"
-  echo "date: $(date -u +%Y-%m-%dT%H:%MZ), commit $(git rev-parse --short HEAD)"
+  echo "date: $(date -u +%Y-%m-%dT%H:%MZ), commit $(git rev-parse --short HEAD), binary $ridge"
   echo "load average at start: $(cut -d' ' -f1-3 /proc/loadavg)"
 } > "$out/machine.txt"
 "$ridge" report --noise "$data/noise1025.png" --dem "$dem" --out "$out" --work "$data/hard"
