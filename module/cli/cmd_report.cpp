@@ -377,6 +377,18 @@ CellBox cells_of(const Heightfield& hf, const Box& b) {
           std::int64_t(std::ceil((b.max.z - hf.origin_z()) / hf.spacing_z())) + 1};
 }
 
+// Applies frame k's crater to `t`, timing it into r.edit_ms; the lattice cells it changed (none
+// when it changed nothing), or the edit's error.
+Result<std::optional<CellBox>> storm_edit(Terrain& t, const Camera& c, std::size_t k,
+                                          ModeResult& r) {
+  const auto t0 = Clock::now();
+  auto e = t.apply_edit(crater_for(t, c, k));
+  r.edit_ms.push_back(ms_since(t0));
+  if (!e) return e.error();
+  if (e->empty()) return std::optional<CellBox>{};
+  return std::optional<CellBox>{cells_of(t.heightfield(), e->changed)};
+}
+
 Result<ModeResult> storm_roam(const Pristine& pr, const NamedPath& path, const Setting& st,
                               RoamMode mode, const Options& o) {
   auto t = pr.fresh();
@@ -395,10 +407,7 @@ Result<ModeResult> storm_roam(const Pristine& pr, const NamedPath& path, const S
   run_mode(
       t->heightfield(), path.frames, o,
       [&](std::size_t k) {
-        const auto t0 = Clock::now();
-        auto e = t->apply_edit(crater_for(*t, path.frames[k], k));
-        r.edit_ms.push_back(ms_since(t0));
-        if (!e) err = e.error().message;
+        if (auto e = storm_edit(*t, path.frames[k], k, r); !e) err = e.error().message;
         auto s = view.update(path.frames[k]);
         if (!s) {
           err = s.error().message;
@@ -429,19 +438,15 @@ Result<ModeResult> storm_uniform(const Pristine& pr, const NamedPath& path, doub
   run_mode(
       hf, path.frames, o,
       [&](std::size_t k) {
-        const auto t0 = Clock::now();
-        auto e = t->apply_edit(crater_for(*t, path.frames[k], k));
-        r.edit_ms.push_back(ms_since(t0));
+        auto e = storm_edit(*t, path.frames[k], k, r);
         if (!e) {
           err = e.error().message;
           return;
         }
         const auto t1 = Clock::now();
-        if (!e->empty()) {
-          const CellBox c = cells_of(hf, e->changed);
+        if (const auto& c = *e)
           resampled +=
-              g.resample(hf, verts, double(c.i0), double(c.j0), double(c.i1), double(c.j1));
-        }
+              g.resample(hf, verts, double(c->i0), double(c->j0), double(c->i1), double(c->j1));
         r.ms.push_back(ms_since(t1));
         r.tris.push_back(double(g.triangles()));
         r.changes.push_back(0);
@@ -471,18 +476,13 @@ Result<ModeResult> storm_cdlod(Scene& base, const Pristine& pr, const NamedPath&
   run_mode(
       hf, path.frames, o,
       [&](std::size_t k) {
-        const auto t0 = Clock::now();
-        auto e = t->apply_edit(crater_for(*t, path.frames[k], k));
-        r.edit_ms.push_back(ms_since(t0));
+        auto e = storm_edit(*t, path.frames[k], k, r);
         if (!e) {
           err = e.error().message;
           return;
         }
         const auto t1 = Clock::now();
-        if (!e->empty()) {
-          const CellBox c = cells_of(hf, e->changed);
-          cd.refresh(c.i0, c.j0, c.i1, c.j1);
-        }
+        if (const auto& c = *e) cd.refresh(c->i0, c->j0, c->i1, c->j1);
         sel = cd.select(path.frames[k], ch.r0);
         r.ms.push_back(ms_since(t1));
         r.tris.push_back(double(sel.triangles));

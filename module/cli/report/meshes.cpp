@@ -18,6 +18,19 @@ constexpr double kMorphStartRatio = 0.66;  // Strugar's default
 
 double sq(double x) { return x * x; }
 
+// Appends the two triangles of every quad of a row-major (nx + 1) x (nz + 1) vertex grid, split
+// along (0,0)-(1,1).
+void triangulate_grid(const std::vector<glm::dvec3>& v, std::uint32_t nx, std::uint32_t nz,
+                      DrawnMesh& out) {
+  for (std::uint32_t b = 0; b < nz; ++b)
+    for (std::uint32_t a = 0; a < nx; ++a) {
+      const std::size_t r0 = std::size_t(b) * (nx + 1), r1 = r0 + nx + 1;
+      const glm::dvec3 &p00 = v[a + r0], &p10 = v[a + 1 + r0], &p01 = v[a + r1],
+                       &p11 = v[a + 1 + r1];
+      out.corners.insert(out.corners.end(), {p00, p11, p10, p00, p01, p11});
+    }
+}
+
 glm::dvec3 to_world(const Heightfield& hf, const glm::dvec3& c) {
   return {hf.origin_x() + c.x * hf.spacing_x(), c.y, hf.origin_z() + c.z * hf.spacing_z()};
 }
@@ -257,13 +270,7 @@ std::size_t UniformGrid::resample(const Heightfield& hf, std::vector<glm::dvec3>
 DrawnMesh UniformGrid::mesh_of(const std::vector<glm::dvec3>& v) const {
   DrawnMesh out;
   out.corners.reserve(std::size_t(triangles()) * 3);
-  for (std::uint32_t b = 0; b < nz; ++b)
-    for (std::uint32_t a = 0; a < nx; ++a) {
-      const glm::dvec3 &p00 = v[a + std::size_t(b) * (nx + 1)], &p10 = v[a + 1 + std::size_t(b) * (nx + 1)],
-                       &p01 = v[a + std::size_t(b + 1) * (nx + 1)],
-                       &p11 = v[a + 1 + std::size_t(b + 1) * (nx + 1)];
-      out.corners.insert(out.corners.end(), {p00, p11, p10, p00, p01, p11});
-    }
+  triangulate_grid(v, nx, nz, out);
   return out;
 }
 
@@ -465,13 +472,7 @@ void Cdlod::emit_quadrant(const Chunk& c, int q, const ViewFrustum& f, bool morp
       const double mw = std::min(w - double(gz & 1) * double(s) * m, double(cells_z_));
       v[a + std::size_t(b) * (g + 1)] = {mu, surface_height(hf, mu, mw), mw};
     }
-  for (std::uint32_t b = 0; b < g; ++b)
-    for (std::uint32_t a = 0; a < g; ++a) {
-      const glm::dvec3 &p00 = v[a + std::size_t(b) * (g + 1)], &p10 = v[a + 1 + std::size_t(b) * (g + 1)],
-                       &p01 = v[a + std::size_t(b + 1) * (g + 1)],
-                       &p11 = v[a + 1 + std::size_t(b + 1) * (g + 1)];
-      out.corners.insert(out.corners.end(), {p00, p11, p10, p00, p01, p11});
-    }
+  triangulate_grid(v, g, g, out);
 }
 
 DrawnMesh Cdlod::mesh(const Selection& s, const Camera& camera, bool morph) const {
