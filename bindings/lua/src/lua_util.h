@@ -21,6 +21,7 @@ namespace ridgeline::lua::detail {
 inline constexpr char kTerrainMeta[] = "ridgeline.terrain";
 inline constexpr char kViewMeta[] = "ridgeline.view";
 inline constexpr char kConfigMeta[] = "ridgeline.config";
+inline constexpr char kBudgetMeta[] = "ridgeline.budget_controller";
 inline constexpr std::size_t kErrSize = 512;
 
 /// Per-module-table settings and caches: a userdata (with __gc) that module functions reach as
@@ -88,5 +89,6 @@ void account_memory(lua_State* L, std::size_t bytes);
 
 /// Method tables, for `open_module`.
 int new_view(lua_State* L);  // terrain:new_view, defined in wrap_view.cpp
+int new_budget_controller(lua_State* L);  // ridgeline.budget_controller, wrap_budget.cpp
 
 }  // namespace ridgeline::lua::detail

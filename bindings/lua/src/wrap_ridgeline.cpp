@@ -144,7 +144,10 @@ int config_gc(lua_State* L) {
 }
 
 const luaL_Reg kFunctions[] = {
-    {"load", r_load}, {"default_terrain", r_default_terrain}, {nullptr, nullptr}};
+    {"load", r_load},
+    {"default_terrain", r_default_terrain},
+    {"budget_controller", new_budget_controller},
+    {nullptr, nullptr}};
 
 }  // namespace
 }  // namespace ridgeline::lua::detail
