@@ -154,6 +154,11 @@ const luaL_Reg kFunctions[] = {
 
 namespace ridgeline::lua {
 
+void push_terrain(lua_State* L, std::shared_ptr<const Terrain> terrain) {
+  detail::TerrainBox* box = detail::push_terrain_box(L);
+  box->terrain = std::move(terrain);  // no Lua call after the push: nothing can longjmp here
+}
+
 int open_module(lua_State* L, const ModuleConfig& config) {
   using namespace detail;
   lua_createtable(L, 0, 8);
