@@ -18,10 +18,12 @@ int main(int argc, char** argv) {
   commands.push_back(add_query_command(app));
   commands.push_back(add_profile_command(app));
   commands.push_back(add_mesh_command(app));
+  commands.push_back(add_deform_command(app));
   auto* bench = app.add_subcommand("bench", "Benchmarks that print JSON");
   bench->require_subcommand(1);
   commands.push_back(add_bench_queries_command(*bench));
   commands.push_back(add_bench_lod_command(*bench));
+  commands.push_back(add_bench_deform_command(*bench));
 
   try {
     app.parse(argc, argv);

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "cli_util.h"
+#include "ridgeline/edit.h"
 #include "ridgeline/io.h"
 
 namespace ridgeline::cli {
@@ -69,6 +70,11 @@ void TerrainArgs::add_to(CLI::App& app) {
                  "8-bit single-channel image of the heightmap's size holding a material id per "
                  "sample")
       ->type_name("FILE")
+      ->group(g);
+  app.add_option("--load", load_,
+                 "Apply the edit state saved by `ridge deform --save` (refused when it belongs to "
+                 "another terrain)")
+      ->type_name("STATE.bin")
       ->group(g);
 }
 
@@ -195,10 +201,15 @@ Result<Heightfield> TerrainArgs::load_heightfield() const {
   return io::load_heightmap(heightmap_, options);
 }
 
-Result<std::shared_ptr<const Terrain>> TerrainArgs::load_terrain() const {
+Result<std::shared_ptr<Terrain>> TerrainArgs::load_terrain() const {
   auto hf = load_heightfield();
   if (!hf) return hf.error();
-  return Terrain::create(std::move(*hf));
+  std::shared_ptr<Terrain> terrain = Terrain::create(std::move(*hf));
+  if (given("--load")) {
+    auto r = load_edits(*terrain, load_);
+    if (!r) return Error{"--load: " + r.error().message};
+  }
+  return terrain;
 }
 
 }  // namespace ridgeline::cli

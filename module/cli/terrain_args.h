@@ -19,15 +19,16 @@ namespace ridgeline::cli {
 class TerrainArgs {
  public:
   /// Adds --heightmap, --default-terrain, --raw-size, --raw-type, --spacing, --height-scale,
-  /// --height-offset, --origin, --nodata, --fill, --max-samples, --channel and --materials to
+  /// --height-offset, --origin, --nodata, --fill, --max-samples, --channel, --materials and --load to
   /// `app`, in an option group "Terrain". The object must outlive the parse.
   void add_to(CLI::App& app);
 
   /// The heightfield the flags describe: loaded from --heightmap or generated (--default-terrain),
   /// placed by the placement flags.
   Result<Heightfield> load_heightfield() const;
-  /// load_heightfield() wrapped into a Terrain (builds the query structures).
-  Result<std::shared_ptr<const Terrain>> load_terrain() const;
+  /// load_heightfield() wrapped into a Terrain (builds the query structures), with the edit
+  /// state of --load STATE.bin applied when given.
+  Result<std::shared_ptr<Terrain>> load_terrain() const;
 
   /// "default terrain" or the heightmap path: for reports.
   std::string source() const;
@@ -39,7 +40,7 @@ class TerrainArgs {
   std::string heightmap_;
   bool default_terrain_ = false;
   std::string raw_size_, raw_type_, spacing_, height_scale_, height_offset_, origin_, nodata_,
-      fill_, max_samples_, channel_, materials_;
+      fill_, max_samples_, channel_, materials_, load_;
   CLI::App* app_ = nullptr;
 };
 

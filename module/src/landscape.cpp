@@ -12,11 +12,107 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <mutex>
 #include <thread>
 
+#include "edit_listener.h"
 #include "format.h"
 
 namespace ridgeline {
+
+struct Landscape::Views {
+  std::mutex mutex;
+  std::vector<detail::EditListener*> list;
+};
+
+// Hears the terrain's edits: bounds first, then the views.
+struct Landscape::Hook final : detail::EditListener {
+  explicit Hook(Landscape& l) : self(l) {}
+  void on_edit(const detail::EditRegion& r, EditResult& result) override {
+    result.bounds_updated +=
+        self.update_bounds(r.i0, r.j0, self.edited_end_i(r.i1), self.edited_end_j(r.j1));
+    std::vector<detail::EditListener*> views;
+    {
+      std::lock_guard lock(self.views_->mutex);
+      views = self.views_->list;
+    }
+    for (detail::EditListener* v : views) v->on_edit(r, result);
+  }
+  Landscape& self;
+};
+
+std::int64_t Landscape::edited_end_i(std::uint32_t i1) const noexcept {
+  return i1 + 1 >= terrain_->heightfield().width() ? std::int64_t(patches_x_) * patch_cells() : i1;
+}
+
+std::int64_t Landscape::edited_end_j(std::uint32_t j1) const noexcept {
+  return j1 + 1 >= terrain_->heightfield().height() ? std::int64_t(patches_z_) * patch_cells() : j1;
+}
+
+Landscape::~Landscape() {
+  if (hook_ && terrain_) terrain_->remove_listener(hook_.get());
+}
+
+void Landscape::add_listener(detail::EditListener* l) const {
+  std::lock_guard lock(views_->mutex);
+  views_->list.push_back(l);
+}
+
+void Landscape::remove_listener(detail::EditListener* l) const {
+  std::lock_guard lock(views_->mutex);
+  auto& v = views_->list;
+  v.erase(std::remove(v.begin(), v.end(), l), v.end());
+}
+
+std::uint64_t Landscape::update_bounds(std::int64_t i0, std::int64_t j0, std::int64_t i1,
+                                       std::int64_t j1) {
+  const std::int64_t p = patch_cells();
+  // Patches whose closed square holds part of the region.
+  const std::int64_t px0 = std::max<std::int64_t>(0, (i0 + p - 1) / p - 1),
+                     px1 = std::min<std::int64_t>(patches_x_ - 1, i1 / p);
+  const std::int64_t pz0 = std::max<std::int64_t>(0, (j0 + p - 1) / p - 1),
+                     pz1 = std::min<std::int64_t>(patches_z_ - 1, j1 / p);
+  const std::uint64_t npr = nodes_per_root_plus_one_;
+  std::uint64_t updated = 0;
+  struct Item {
+    std::uint64_t heap;
+    LatticeTriangle t;
+  };
+  std::vector<Item> order, stack;
+  for (std::int64_t pz = pz0; pz <= pz1; ++pz) {
+    for (std::int64_t px = px0; px <= px1; ++px) {
+      for (std::uint32_t r = 0; r < 2; ++r) {
+        const auto root = static_cast<std::uint32_t>(2 * (px + pz * patches_x_) + r);
+        // Pre-order over the stored nodes whose triangle's box meets the region; recomputed in
+        // reverse (children before parents) so that nesting reads fresh children.
+        order.clear();
+        stack.push_back({1, triangle(root, 1)});
+        while (!stack.empty()) {
+          const Item it = stack.back();
+          stack.pop_back();
+          const LatticeTriangle& t = it.t;
+          if (std::max({t.ax, t.lx, t.rx}) < i0 || std::min({t.ax, t.lx, t.rx}) > i1 ||
+              std::max({t.az, t.lz, t.rz}) < j0 || std::min({t.az, t.lz, t.rz}) > j1)
+            continue;
+          order.push_back(it);
+          if (2 * it.heap < npr) {
+            stack.push_back({2 * it.heap, child_triangle(t, 0)});
+            stack.push_back({2 * it.heap + 1, child_triangle(t, 1)});
+          }
+        }
+        float* b = bounds_.data() + root * (npr - 1);
+        for (auto it = order.rbegin(); it != order.rend(); ++it) {
+          const std::uint64_t h = it->heap;
+          float v = compute_exact(it->t);
+          if (2 * h < npr) v = std::max({v, b[2 * h - 1], b[2 * h]});
+          b[h - 1] = v;
+        }
+        updated += order.size();
+      }
+    }
+  }
+  return updated;
+}
 
 Result<std::shared_ptr<const Landscape>> Landscape::create(std::shared_ptr<const Terrain> terrain,
                                                            const LandscapeDesc& desc) {
@@ -83,6 +179,9 @@ Result<std::shared_ptr<const Landscape>> Landscape::create(std::shared_ptr<const
   }
   l->build_ms_ =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  l->views_ = std::make_unique<Views>();
+  l->hook_ = std::make_unique<Hook>(*l);
+  l->terrain_->add_listener(l->hook_.get());
   return std::shared_ptr<const Landscape>(std::move(l));
 }
 
@@ -119,17 +218,38 @@ float Landscape::compute_exact(const LatticeTriangle& t) const noexcept {
   double worst = 0.0;
   const Heightfield& hf = terrain_->heightfield();
   const std::int64_t wmax = hf.width() - 1, hmax = hf.height() - 1;
+  // The three edge functions e(x, z) = a * x + c(z) (weights of R, A and L); inside means all
+  // share w's sign. Per row, each edge bounds x from one side: the span is found exactly in
+  // integer arithmetic, so only the samples inside are visited.
+  const std::int64_t sgn = w > 0 ? 1 : -1;
+  const std::int64_t ex[3][2] = {{t.ax, t.az}, {t.lx, t.lz}, {t.rx, t.rz}};
+  // Edge k runs from vertex p to vertex q: e = (q - p) x (v - p).
+  const int from[3] = {0, 1, 2}, to[3] = {1, 2, 0};
+  auto floor_div = [](std::int64_t n, std::int64_t d) {  // d > 0
+    return n >= 0 ? n / d : -((-n + d - 1) / d);
+  };
   for (std::int64_t z = z0; z <= z1; ++z) {
-    for (std::int64_t x = x0; x <= x1; ++x) {
-      const std::int64_t e_r = cross(t.lx - t.ax, t.lz - t.az, x - t.ax, z - t.az);  // weight of R
-      const std::int64_t e_a = cross(t.rx - t.lx, t.rz - t.lz, x - t.lx, z - t.lz);  // weight of A
-      const std::int64_t e_l = cross(t.ax - t.rx, t.az - t.rz, x - t.rx, z - t.rz);  // weight of L
-      const bool inside =
-          w > 0 ? (e_r >= 0 && e_a >= 0 && e_l >= 0) : (e_r <= 0 && e_a <= 0 && e_l <= 0);
-      if (!inside) continue;
-      const double plane = (e_a * ha + e_l * hl + e_r * hr) * inv_w;
-      const double h = hf.local(static_cast<std::uint32_t>(std::clamp<std::int64_t>(x, 0, wmax)),
-                                static_cast<std::uint32_t>(std::clamp<std::int64_t>(z, 0, hmax)));
+    std::int64_t lo = x0, hi = x1;
+    std::int64_t coef[3], off[3];
+    for (int k = 0; k < 3; ++k) {
+      const std::int64_t px = ex[from[k]][0], pz = ex[from[k]][1];
+      const std::int64_t ux = ex[to[k]][0] - px, uz = ex[to[k]][1] - pz;
+      // e(x) = ux * (z - pz) - uz * (x - px) = a * x + c, made >= 0 inside by the sign.
+      const std::int64_t a = -uz * sgn, c = (ux * (z - pz) + uz * px) * sgn;
+      coef[k] = a, off[k] = c;
+      if (a > 0) lo = std::max(lo, -floor_div(c, a));      // x >= ceil(-c / a)
+      else if (a < 0) hi = std::min(hi, floor_div(c, -a));  // x <= floor(c / -a)
+      else if (c < 0) lo = hi + 1;                          // edge parallel to x, row outside
+    }
+    if (lo > hi) continue;
+    const std::uint32_t zc = static_cast<std::uint32_t>(std::clamp<std::int64_t>(z, 0, hmax));
+    for (std::int64_t x = lo; x <= hi; ++x) {
+      // Barycentric weights from the edge functions (e_k is opposite the vertex after edge k).
+      const std::int64_t e_ab = coef[0] * x + off[0];  // edge A->L: weight of R
+      const std::int64_t e_lr = coef[1] * x + off[1];  // edge L->R: weight of A
+      const std::int64_t e_ra = coef[2] * x + off[2];  // edge R->A: weight of L
+      const double plane = (double(e_lr) * ha + double(e_ra) * hl + double(e_ab) * hr) * inv_w * sgn;
+      const double h = hf.local(static_cast<std::uint32_t>(std::clamp<std::int64_t>(x, 0, wmax)), zc);
       worst = std::max(worst, std::abs(h - plane));
     }
   }

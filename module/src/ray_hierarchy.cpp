@@ -60,44 +60,71 @@ RayHierarchy::RayHierarchy(const Heightfield& hf)
   leaf.nz = (cells_z + kLeafCells - 1) >> kLeafShift;
   leaf.max.resize(std::size_t{leaf.nx} * leaf.nz);
   leaf.min.resize(leaf.max.size());
-  for (std::uint32_t bz = 0; bz < leaf.nz; ++bz) {
-    const std::uint32_t j0 = bz << kLeafShift, j1 = std::min(j0 + kLeafCells, cells_z);
-    for (std::uint32_t bx = 0; bx < leaf.nx; ++bx) {
-      const std::uint32_t i0 = bx << kLeafShift, i1 = std::min(i0 + kLeafCells, cells_x);
-      float lo = hf.local(i0, j0), hi = lo;
-      for (std::uint32_t j = j0; j <= j1; ++j) {
-        for (std::uint32_t i = i0; i <= i1; ++i) {
-          const float h = hf.local(i, j);
-          lo = std::min(lo, h);
-          hi = std::max(hi, h);
-        }
-      }
-      leaf.min[leaf.index(bx, bz)] = lo;
-      leaf.max[leaf.index(bx, bz)] = hi;
-    }
-  }
   levels_.push_back(std::move(leaf));
+  for (std::uint32_t bz = 0; bz < levels_[0].nz; ++bz)
+    for (std::uint32_t bx = 0; bx < levels_[0].nx; ++bx) leaf_block(hf, bx, bz);
   while (levels_.back().nx > 1 || levels_.back().nz > 1) {
-    const Level& below = levels_.back();
     Level up;
-    up.nx = (below.nx + 1) / 2;
-    up.nz = (below.nz + 1) / 2;
+    up.nx = (levels_.back().nx + 1) / 2;
+    up.nz = (levels_.back().nz + 1) / 2;
     up.max.resize(std::size_t{up.nx} * up.nz);
     up.min.resize(up.max.size());
-    for (std::uint32_t z = 0; z < up.nz; ++z) {
-      for (std::uint32_t x = 0; x < up.nx; ++x) {
-        float lo = below.min[below.index(2 * x, 2 * z)], hi = below.max[below.index(2 * x, 2 * z)];
-        for (std::uint32_t c = 1; c < 4; ++c) {
-          const std::uint32_t cx = 2 * x + (c & 1), cz = 2 * z + (c >> 1);
-          if (cx >= below.nx || cz >= below.nz) continue;
-          lo = std::min(lo, below.min[below.index(cx, cz)]);
-          hi = std::max(hi, below.max[below.index(cx, cz)]);
-        }
-        up.min[up.index(x, z)] = lo;
-        up.max[up.index(x, z)] = hi;
-      }
-    }
     levels_.push_back(std::move(up));
+    const std::size_t lv = levels_.size() - 1;
+    for (std::uint32_t z = 0; z < levels_[lv].nz; ++z)
+      for (std::uint32_t x = 0; x < levels_[lv].nx; ++x) parent_node(lv, x, z);
+  }
+}
+
+// Min and max of the samples of leaf block (bx, bz) (its cells' corners).
+void RayHierarchy::leaf_block(const Heightfield& hf, std::uint32_t bx, std::uint32_t bz) {
+  const std::uint32_t cells_x = hf.width() - 1, cells_z = hf.height() - 1;
+  const std::uint32_t j0 = bz << kLeafShift, j1 = std::min(j0 + kLeafCells, cells_z);
+  const std::uint32_t i0 = bx << kLeafShift, i1 = std::min(i0 + kLeafCells, cells_x);
+  float lo = hf.local(i0, j0), hi = lo;
+  for (std::uint32_t j = j0; j <= j1; ++j) {
+    for (std::uint32_t i = i0; i <= i1; ++i) {
+      const float h = hf.local(i, j);
+      lo = std::min(lo, h);
+      hi = std::max(hi, h);
+    }
+  }
+  Level& leaf = levels_[0];
+  leaf.min[leaf.index(bx, bz)] = lo;
+  leaf.max[leaf.index(bx, bz)] = hi;
+}
+
+// Node (x, z) of `level` >= 1 from its (up to four) children.
+void RayHierarchy::parent_node(std::size_t level, std::uint32_t x, std::uint32_t z) {
+  const Level& below = levels_[level - 1];
+  Level& up = levels_[level];
+  float lo = below.min[below.index(2 * x, 2 * z)], hi = below.max[below.index(2 * x, 2 * z)];
+  for (std::uint32_t c = 1; c < 4; ++c) {
+    const std::uint32_t cx = 2 * x + (c & 1), cz = 2 * z + (c >> 1);
+    if (cx >= below.nx || cz >= below.nz) continue;
+    lo = std::min(lo, below.min[below.index(cx, cz)]);
+    hi = std::max(hi, below.max[below.index(cx, cz)]);
+  }
+  up.min[up.index(x, z)] = lo;
+  up.max[up.index(x, z)] = hi;
+}
+
+void RayHierarchy::update_cells(const Heightfield& hf, std::uint32_t i0, std::uint32_t j0,
+                                std::uint32_t i1, std::uint32_t j1) {
+  // A sample on a block border belongs to both blocks: widen by one cell.
+  const std::uint32_t cells_x = hf.width() - 1, cells_z = hf.height() - 1;
+  i0 = i0 > 0 ? i0 - 1 : 0;
+  j0 = j0 > 0 ? j0 - 1 : 0;
+  i1 = std::min(i1 + 1, cells_x - 1);
+  j1 = std::min(j1 + 1, cells_z - 1);
+  std::uint32_t x0 = i0 >> kLeafShift, x1 = i1 >> kLeafShift;
+  std::uint32_t z0 = j0 >> kLeafShift, z1 = j1 >> kLeafShift;
+  for (std::uint32_t bz = z0; bz <= z1; ++bz)
+    for (std::uint32_t bx = x0; bx <= x1; ++bx) leaf_block(hf, bx, bz);
+  for (std::size_t lv = 1; lv < levels_.size(); ++lv) {
+    x0 >>= 1, x1 >>= 1, z0 >>= 1, z1 >>= 1;
+    for (std::uint32_t z = z0; z <= z1; ++z)
+      for (std::uint32_t x = x0; x <= x1; ++x) parent_node(lv, x, z);
   }
 }
 

@@ -88,6 +88,13 @@ class RayHierarchy {
   static constexpr std::uint32_t kLeafCells = 1u << kLeafShift;
 
   explicit RayHierarchy(const Heightfield& hf);
+  RayHierarchy(const RayHierarchy&) = default;
+
+  /// Recomputes the pyramid over the cells [i0, i1] x [j0, j1] (inclusive cell indices) after
+  /// their heights changed: the leaf blocks holding them, then their ancestors. Cost: the blocks'
+  /// samples plus the ancestors, about the edited area.
+  void update_cells(const Heightfield& hf, std::uint32_t i0, std::uint32_t j0, std::uint32_t i1,
+                    std::uint32_t j1);
 
   /// Bytes held by the pyramid.
   std::size_t memory_bytes() const noexcept;
@@ -119,6 +126,8 @@ class RayHierarchy {
     }
   };
   struct Ray;
+  void leaf_block(const Heightfield& hf, std::uint32_t bx, std::uint32_t bz);
+  void parent_node(std::size_t level, std::uint32_t x, std::uint32_t z);
 
   bool leaf_hit(const Heightfield& hf, const Ray& ray, std::uint32_t bx, std::uint32_t bz,
                 double ta, double tb, RayHit& hit) const noexcept;

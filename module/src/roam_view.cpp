@@ -27,6 +27,7 @@
 
 #include "format.h"
 #include "ridgeline/log.h"
+#include "edit_listener.h"
 #include "surface_eval.h"
 
 namespace ridgeline {
@@ -858,6 +859,59 @@ struct RoamView::Impl {
     return std::chrono::steady_clock::now() >= deadline;
   }
 
+  // An edit changed the samples in [i0, i1] x [j0, j1] (padding-extended by the landscape):
+  // refresh every node whose triangle's box meets the region (bound, box, visibility), requeue
+  // the queued ones, mark the patches whose vertices or vertex normals changed dirty.
+  std::uint64_t on_edit(std::int64_t i0, std::int64_t j0, std::int64_t i1, std::int64_t j1) {
+    const std::int64_t p = land.patch_cells();
+    // Vertex normals read the samples one step around a vertex: one more sample for dirtiness.
+    const std::int64_t di0 = i0 - 1, dj0 = j0 - 1, di1 = i1 + 1, dj1 = j1 + 1;
+    auto patch_range = [&](std::int64_t a0, std::int64_t a1, std::uint32_t n, std::int64_t& lo,
+                           std::int64_t& hi) {
+      lo = std::max<std::int64_t>(0, (a0 + p - 1) / p - 1);
+      if (a0 < 0) lo = 0;
+      hi = std::min<std::int64_t>(std::int64_t(n) - 1, a1 / p);
+    };
+    std::int64_t px0, px1, pz0, pz1;
+    patch_range(di0, di1, land.patches_x(), px0, px1);
+    patch_range(dj0, dj1, land.patches_z(), pz0, pz1);
+    for (std::int64_t pz = pz0; pz <= pz1; ++pz)
+      for (std::int64_t px = px0; px <= px1; ++px)
+        mark_dirty(static_cast<std::uint32_t>(2 * (px + pz * land.patches_x())));
+    if (reset_pending) return 0;  // the next update starts from the roots with fresh data
+    std::uint64_t refreshed = 0;
+    std::vector<std::uint32_t> stack;
+    patch_range(i0, i1, land.patches_x(), px0, px1);
+    patch_range(j0, j1, land.patches_z(), pz0, pz1);
+    for (std::int64_t pz = pz0; pz <= pz1; ++pz) {
+      for (std::int64_t px = px0; px <= px1; ++px) {
+        for (std::uint32_t r = 0; r < 2; ++r) {
+          stack.push_back(static_cast<std::uint32_t>(2 * (px + pz * land.patches_x()) + r));
+          while (!stack.empty()) {
+            const std::uint32_t n = stack.back();
+            stack.pop_back();
+            const Node& nd = nodes[n];
+            const LatticeTriangle t = land.triangle_at(nd.ax, nd.az, nd.root, nd.heap);
+            if (std::max({t.ax, t.lx, t.rx}) < i0 || std::min({t.ax, t.lx, t.rx}) > i1 ||
+                std::max({t.az, t.lz, t.rz}) < j0 || std::min({t.az, t.lz, t.rz}) > j1)
+              continue;
+            cache_box(n);
+            ++refreshed;
+            if (is_leaf(n)) {
+              if (nodes[n].qslot != kNone) requeue(n);
+            } else {
+              const std::uint32_t rep = rep_of(n);
+              if (nodes[rep].qslot != kNone) requeue(rep);
+              stack.push_back(nodes[n].child);
+              stack.push_back(nodes[n].child + 1);
+            }
+          }
+        }
+      }
+    }
+    return refreshed;
+  }
+
   enum class Refresh { kDone, kRebuild, kOutOfTime };
 
   // Recomputes expired keys. Stops with kRebuild when more than `rebuild_above` expired (then
@@ -903,6 +957,16 @@ float morph_factor(float morph_bound, double distance_m, double k, double thresh
   return static_cast<float>(std::clamp(p / threshold_px - 1.0, 0.0, 1.0));
 }
 
+struct RoamView::EditHook final : detail::EditListener {
+  explicit EditHook(RoamView& v) : view(v) {}
+  void on_edit(const detail::EditRegion& r, EditResult& result) override {
+    const Landscape& l = *view.landscape_;
+    result.view_nodes_updated +=
+        view.impl_->on_edit(r.i0, r.j0, l.edited_end_i(r.i1), l.edited_end_j(r.j1));
+  }
+  RoamView& view;
+};
+
 Result<std::unique_ptr<RoamView>> RoamView::create(std::shared_ptr<const Landscape> landscape,
                                                    const RoamSettings& settings) {
   if (!landscape) return Error{"roam view: no landscape given"};
@@ -918,10 +982,14 @@ Result<std::unique_ptr<RoamView>> RoamView::create(std::shared_ptr<const Landsca
   m.mesh_built_version.assign(np, ~std::uint64_t{0});
   m.reset_to_roots();
   v->triangles_ = m.triangles;
+  v->hook_ = std::make_unique<EditHook>(*v);
+  v->landscape_->add_listener(v->hook_.get());
   return v;
 }
 
-RoamView::~RoamView() = default;
+RoamView::~RoamView() {
+  if (hook_) landscape_->remove_listener(hook_.get());
+}
 
 Status RoamView::set_settings(const RoamSettings& s) {
   if (!std::isfinite(s.threshold) || s.threshold < 0.0)

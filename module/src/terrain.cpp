@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "edit_layer.h"
+#include "edit_listener.h"
 #include "ray_hierarchy.h"
 #include "surface_eval.h"
 
@@ -20,15 +22,18 @@ struct Located {
 
 }  // namespace
 
-std::shared_ptr<const Terrain> Terrain::create(Heightfield heightfield) {
-  return std::shared_ptr<const Terrain>(new Terrain(std::move(heightfield)));
+std::shared_ptr<Terrain> Terrain::create(Heightfield heightfield) {
+  return std::shared_ptr<Terrain>(new Terrain(std::move(heightfield)));
 }
 
 Terrain::Terrain(Heightfield heightfield)
     : heightfield_(std::move(heightfield)),
       rays_(std::make_unique<RayHierarchy>(heightfield_)),
+      edits_(std::make_unique<EditLayer>()),
+      base_hash_(heightfield_.content_hash()),
       inv_spacing_x_(1.0 / heightfield_.spacing_x()),
-      inv_spacing_z_(1.0 / heightfield_.spacing_z()) {}
+      inv_spacing_z_(1.0 / heightfield_.spacing_z()),
+      listeners_(std::make_unique<Listeners>()) {}
 
 Terrain::~Terrain() = default;
 

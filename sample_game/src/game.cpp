@@ -12,10 +12,7 @@
 
 #include "ridgeline/log.h"
 
-#if __has_include("ridgeline/edit.h")
 #include "ridgeline/edit.h"
-#define RIDGELINE_GAME_HAS_EDITS 1
-#endif
 
 namespace game {
 
@@ -42,11 +39,7 @@ Result<std::unique_ptr<Game>> Game::create(const GameOptions& options) {
     return Error{"game: time step " + std::to_string(options.dt) + " s; need 0 < dt <= 0.1"};
   auto hf = ridgeline::make_default_heightfield();
   if (!hf) return Error{hf.error().message};
-#ifdef RIDGELINE_GAME_HAS_EDITS
   g->terrain_ = ridgeline::Terrain::create(std::move(*hf));
-#else
-  g->terrain_ = ridgeline::Terrain::create(std::move(*hf));
-#endif
   auto land = ridgeline::Landscape::create(g->terrain_, {.patch_exponent = options.patch_exponent});
   if (!land) return Error{land.error().message};
   g->landscape_ = *land;
@@ -241,19 +234,10 @@ void Game::step() {
   ++frame_;
 }
 
-bool Game::deformation_available() noexcept {
-#ifdef RIDGELINE_GAME_HAS_EDITS
-  return true;
-#else
-  return false;
-#endif
-}
-
 Result<std::size_t> Game::crater(double x, double z, double radius, double depth) {
   if (!std::isfinite(x) || !std::isfinite(z) || !(radius > 0 && radius <= 200) ||
       !(depth > 0 && depth <= 100))
     return Error{"crater: radius in (0, 200] and depth in (0, 100] metres expected"};
-#ifdef RIDGELINE_GAME_HAS_EDITS
   ridgeline::Edit edit;
   edit.brush = ridgeline::Brush::kCrater;
   edit.x = x;
@@ -262,10 +246,10 @@ Result<std::size_t> Game::crater(double x, double z, double radius, double depth
   edit.depth = depth;
   edit.rim = 0.15;
   edit.strength = 1;
-  auto r = std::const_pointer_cast<ridgeline::Terrain>(terrain_)->apply_edit(edit);
+  auto r = terrain_->apply_edit(edit);
   if (!r) return Error{r.error().message};
   CraterRecord rec{x, z, radius, depth, frame_, 0};
-  if (!r->changed.empty()) {
+  if (!r->empty()) {
     for (auto& [id, e] : vehicles_) {
       const glm::dvec3 p = e.body.position();
       const double m = 6;  // a vehicle's half-length: bodies overlapping the box count
@@ -276,11 +260,6 @@ Result<std::size_t> Game::crater(double x, double z, double radius, double depth
   }
   craters_.push_back(rec);
   return r->samples_changed;
-#else
-  (void)x;
-  (void)z;
-  return Error{"crater: this build has no deformation (ridgeline/edit.h is not there yet)"};
-#endif
 }
 
 ridgeline::Camera Game::camera() const {

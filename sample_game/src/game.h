@@ -127,7 +127,6 @@ class Game {
   /// out of the surface. Returns the number of lattice samples changed.
   ridgeline::Result<std::size_t> crater(double x, double z, double radius, double depth);
   const std::vector<CraterRecord>& craters() const noexcept { return craters_; }
-  static bool deformation_available() noexcept;
 
   // ---- views, cameras, budget ----------------------------------------------------------------
   CameraRig& rig() noexcept { return rig_; }
@@ -150,7 +149,7 @@ class Game {
   const ViewFrame& last_view_frame() const noexcept { return last_view_; }
 
   const ridgeline::Terrain& terrain() const noexcept { return *terrain_; }
-  std::shared_ptr<const ridgeline::Terrain> terrain_ptr() const noexcept { return terrain_; }
+  const std::shared_ptr<ridgeline::Terrain>& terrain_ptr() const noexcept { return terrain_; }
   const GameOptions& options() const noexcept { return options_; }
   Input input;
   /// Wall-clock time of the last rendered frame, milliseconds (set by the frame loop).
@@ -177,7 +176,7 @@ class Game {
   void clamp_to_terrain(VehicleEntry& e);
 
   GameOptions options_;
-  std::shared_ptr<const ridgeline::Terrain> terrain_;
+  std::shared_ptr<ridgeline::Terrain> terrain_;
   std::shared_ptr<const ridgeline::Landscape> landscape_;
   std::unique_ptr<ridgeline::RoamView> views_[3];
   std::map<std::string, VehicleModel> models_;

@@ -556,11 +556,6 @@ int g_crater(lua_State* L) {
   return 1;
 }
 
-int g_can_deform(lua_State* L) {
-  lua_pushboolean(L, Game::deformation_available());
-  return 1;
-}
-
 int g_stats(lua_State* L) {
   Game& g = game_of(L);
   const ViewFrame& v = g.last_view_frame();
@@ -606,7 +601,6 @@ const luaL_Reg kGame[] = {{"spawn", g_spawn},
                           {"set_budget", g_set_budget},
                           {"burn_ms", g_burn_ms},
                           {"crater", g_crater},
-                          {"can_deform", g_can_deform},
                           {"stats", g_stats},
                           {"models", g_models},
                           {nullptr, nullptr}};

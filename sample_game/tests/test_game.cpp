@@ -75,11 +75,7 @@ TEST(Game, DefaultScenarioRuns600FramesWithWheelsOnTheSurface) {
     EXPECT_GT(e.distance_m, 60.0) << e.name;
     EXPECT_TRUE(e.autopilot.active);
   }
-  if (Game::deformation_available()) {
-    EXPECT_GE(g->craters().size(), 4u) << "the artillery made craters";
-  } else {
-    EXPECT_TRUE(g->craters().empty());
-  }
+  EXPECT_GE(g->craters().size(), 4u) << "the artillery made craters";
 }
 
 TEST(Game, AVehicleAtRestSettlesOnItsWheels) {
@@ -101,7 +97,6 @@ TEST(Game, AVehicleAtRestSettlesOnItsWheels) {
 }
 
 TEST(Game, ACraterUnderAVehicleNeverLetsItFallThrough) {
-  if (!Game::deformation_available()) GTEST_SKIP() << "no deformation in this build";
   auto g = make_game();
   auto id = g->spawn("buggy", 900, 900, 0, "b");
   ASSERT_TRUE(id.ok());

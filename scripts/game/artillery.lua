@@ -22,11 +22,6 @@ game.on("tick", function(dt, t)
   local angle = rand() * 2 * math.pi
   local dist = 18 + rand() * 27
   local cx, cz = x + dist * math.cos(angle), z + dist * math.sin(angle)
-  if not game.can_deform() then
-    if shells == 0 then game.log("artillery: no deformation in this build; shells are duds") end
-    shells = shells + 1
-    return
-  end
   local samples, err = game.crater{x = cx, z = cz, radius = 6 + rand() * 4, depth = 2 + rand() * 2}
   shells = shells + 1
   if not samples then game.log("artillery: " .. err) end

@@ -223,5 +223,40 @@ run bench queries --default-terrain --points 0; expect "bench points 0" 1 "--poi
 run bench queries --default-terrain --repetitions x; expect "bench bad repetitions" 1 "--repetitions"
 run bench queries --default-terrain --spacing nan; expect "bench bad terrain flag" 1 "--spacing"
 
+# ---- deform, --load, bench deform ----------------------------------------------------------------
+cat > "$T/edits.json" <<'JSON'
+{"edits": [{"brush": "crater", "x": 1000, "z": 1000, "radius": 20, "depth": 5},
+           {"brush": "flatten", "x": 300, "z": 400, "radius": 30, "height": 100},
+           {"brush": "raise", "x": 9000, "z": 9000, "radius": 5}]}
+JSON
+run query --default-terrain --points <(echo "1000,1000"); before="$out"
+run deform --default-terrain --edits "$T/edits.json" --save "$T/state.bin"
+expect "deform" 0
+contains "deform counts the no-op edit" '"edits_empty": 1'
+hash=$(sed -n 's/.*"heights_hash": "\([0-9a-f]*\)".*/\1/p' <<< "$out")
+[ -s "$T/state.bin" ] && ok || bad "deform --save wrote the state"
+run query --default-terrain --load "$T/state.bin" --points <(echo "1000,1000")
+expect "query --load" 0
+[ "$out" != "$before" ] && ok || bad "query --load sees the crater" "$out"
+echo '{"edits": []}' > "$T/none.json"
+run deform --default-terrain --load "$T/state.bin" --edits "$T/none.json"
+contains "deform --load restores the same heights hash" "\"heights_hash\": \"$hash\""
+run deform --default-terrain --spacing 3 --load "$T/state.bin" --edits "$T/none.json"
+expect "--load onto another terrain" 1 "another terrain"
+head -c 100 "$T/state.bin" > "$T/cut.bin"
+run info --default-terrain --load "$T/cut.bin"; expect "--load truncated" 1 "truncated"
+echo '{"edits": [{"brush": "crater", "x": 1, "z": 1}]}' > "$T/e1.json"
+run deform --default-terrain --edits "$T/e1.json"
+expect "deform edit without radius" 1 "edits[0]: 'radius' is missing"
+echo '{"edits": [{"brush": "dig", "x": 1, "z": 1, "radius": 2}]}' > "$T/e2.json"
+run deform --default-terrain --edits "$T/e2.json"
+expect "deform unknown brush" 1 "unknown brush 'dig'"
+echo '{"edits": [{"brush": "crater", "x": 1, "z": 1, "radius": 1e9}]}' > "$T/e3.json"
+run deform --default-terrain --edits "$T/e3.json"
+expect "deform radius larger than the terrain" 1 "larger than the terrain"
+run bench deform --default-terrain --count 5 --radii 5,20
+expect "bench deform" 0
+contains "bench deform reports medians" '"median_ms"'
+
 echo "$passed passed, $failed failed"
 [ "$failed" = 0 ]

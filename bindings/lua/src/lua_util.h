@@ -30,12 +30,12 @@ struct ConfigBox {
   bool confine_paths = false;
   std::uint64_t max_samples = 0;
   char root[4096] = {};
-  std::shared_ptr<const Terrain> default_terrain;  // built once, shared by default_terrain()
+  std::shared_ptr<Terrain> default_terrain;  // built once, shared by default_terrain()
 };
 
 /// A terrain userdata. Released: `terrain` is empty.
 struct TerrainBox {
-  std::shared_ptr<const Terrain> terrain;
+  std::shared_ptr<Terrain> terrain;
   std::shared_ptr<const Landscape> landscape;  // built on the first new_view
 };
 
@@ -90,5 +90,8 @@ void account_memory(lua_State* L, std::size_t bytes);
 /// Method tables, for `open_module`.
 int new_view(lua_State* L);  // terrain:new_view, defined in wrap_view.cpp
 int new_budget_controller(lua_State* L);  // ridgeline.budget_controller, wrap_budget.cpp
+int t_deform(lua_State* L);      // terrain:deform, wrap_edit.cpp
+int r_save_edits(lua_State* L);  // ridgeline.save_edits, wrap_edit.cpp
+int r_load_edits(lua_State* L);  // ridgeline.load_edits, wrap_edit.cpp
 
 }  // namespace ridgeline::lua::detail

@@ -321,7 +321,8 @@ const luaL_Reg kMethods[] = {
     {"height", t_height},   {"normal", t_normal},     {"smooth_normal", t_smooth_normal},
     {"sample", t_sample},   {"heights", t_heights},   {"raycast", t_raycast},
     {"place", t_place},     {"contacts", t_contacts}, {"bounds", t_bounds},
-    {"new_view", new_view}, {"release", t_release},   {nullptr, nullptr}};
+    {"new_view", new_view}, {"deform", t_deform},     {"release", t_release},
+    {nullptr, nullptr}};
 const luaL_Reg kMeta[] = {
     {"__gc", t_release}, {"__close", t_release}, {"__tostring", t_tostring}, {nullptr, nullptr}};
 

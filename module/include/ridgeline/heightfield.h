@@ -42,7 +42,8 @@ struct HeightfieldDesc {
 /// Loaders call it before allocating. Error messages name `desc.name` and the bad value.
 Status validate_heightfield_desc(const HeightfieldDesc& desc);
 
-/// A validated grid of heights. Immutable after creation; move-only; all const methods are safe
+/// A validated grid of heights. Immutable after creation except through a Terrain's edits
+/// (Terrain::apply_edit, which needs exclusive access); move-only; all const methods are safe
 /// from any number of threads. Heights are stored as float metres relative to `height_offset()`
 /// (so a terrain whose heights sit at 1e6 m keeps float precision); world heights are doubles.
 /// Row-major: index = i + j * width.
@@ -86,6 +87,8 @@ class Heightfield {
   /// All heights relative to height_offset(), row-major.
   std::span<const float> local_heights() const noexcept { return heights_; }
 
+  /// Lowest and highest height relative to height_offset(); after edits, a range that contains
+  /// every height (edits only widen it).
   float min_local() const noexcept { return min_local_; }
   float max_local() const noexcept { return max_local_; }
 
@@ -107,6 +110,20 @@ class Heightfield {
 
  private:
   Heightfield() = default;
+  friend class EditLayer;  // writes heights during an edit (terrain.h's exclusive access)
+  friend class Terrain;    // clone()
+  Heightfield duplicate() const {
+    Heightfield h;
+    h.heights_ = heights_;
+    h.materials_ = materials_;
+    h.width_ = width_, h.height_ = height_;
+    h.spacing_x_ = spacing_x_, h.spacing_z_ = spacing_z_;
+    h.origin_x_ = origin_x_, h.origin_z_ = origin_z_;
+    h.height_offset_ = height_offset_, h.height_scale_ = height_scale_;
+    h.min_local_ = min_local_, h.max_local_ = max_local_;
+    h.filled_samples_ = filled_samples_;
+    return h;
+  }
 
   std::vector<float> heights_;
   std::vector<std::uint8_t> materials_;

@@ -37,11 +37,19 @@ struct LatticeTriangle {
 /// lattice vertex under the node's triangle (the exact error), then made nested by taking the
 /// maximum with the children's bounds. Finest-level nodes (half cells) have bound 0.
 ///
-/// Threading: immutable after create(); every method may run concurrently.
+/// Edits: the landscape registers with its terrain; Terrain::apply_edit() recomputes the bounds
+/// of exactly the nodes whose triangles hold a changed sample (bottom-up, then nested) and tells
+/// the RoamViews on this landscape, inside the edit call.
+///
+/// Threading: read-only between edits; every method may run concurrently. Edits need exclusive
+/// access (terrain.h).
 class Landscape {
  public:
   static Result<std::shared_ptr<const Landscape>> create(std::shared_ptr<const Terrain> terrain,
                                                          const LandscapeDesc& desc = {});
+  ~Landscape();
+  Landscape(const Landscape&) = delete;
+  Landscape& operator=(const Landscape&) = delete;
 
   const Terrain& terrain() const noexcept { return *terrain_; }
   const std::shared_ptr<const Terrain>& terrain_ptr() const noexcept { return terrain_; }
@@ -112,6 +120,20 @@ class Landscape {
  private:
   Landscape() = default;
   float compute_exact(const LatticeTriangle& t) const noexcept;
+  // Edits (edit.cpp's transaction calls the hook; RoamViews register to hear of them).
+  friend class RoamView;
+  struct Hook;
+  struct Views;
+  std::unique_ptr<Hook> hook_;
+  std::unique_ptr<Views> views_;
+  void add_listener(detail::EditListener* l) const;
+  void remove_listener(detail::EditListener* l) const;
+  // The last lattice column and row an edit of samples up to (i1, j1) changes: the padding
+  // repeats the edge samples, so an edited edge sample moves the padding too.
+  std::int64_t edited_end_i(std::uint32_t i1) const noexcept;
+  std::int64_t edited_end_j(std::uint32_t j1) const noexcept;
+  // Recomputes the bounds over an edit's region; returns the entries recomputed.
+  std::uint64_t update_bounds(std::int64_t i0, std::int64_t j0, std::int64_t i1, std::int64_t j1);
 
   std::shared_ptr<const Terrain> terrain_;
   std::uint32_t exponent_ = 6, patches_x_ = 0, patches_z_ = 0;

@@ -6,6 +6,8 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/vec2.hpp>
@@ -17,6 +19,13 @@
 namespace ridgeline {
 
 class RayHierarchy;
+class EditLayer;
+struct Edit;
+struct EditLimits;
+struct EditResult;
+namespace detail {
+class EditListener;
+}
 
 /// Height, both normals and the material at a point of the surface.
 struct SurfaceSample {
@@ -56,9 +65,13 @@ struct Box {
 };
 
 /// The terrain shared by every view and every physics query. Created once from a Heightfield;
-/// immutable afterwards in this version (deformation arrives with the edit layer).
+/// changed afterwards only by edits (apply_edit, load_edits in edit.h).
 ///
-/// Threading: every const method may run concurrently from any number of threads.
+/// Threading: every const method may run concurrently from any number of threads. An edit needs
+/// exclusive access, as in Jolt's HeightFieldShape: no query, Landscape or RoamView call on this
+/// terrain may run during apply_edit() or load_edits() (querying while modifying is a race). An
+/// engine whose physics thread must keep querying during edits queries a clone() (a snapshot)
+/// and swaps it after the edit.
 ///
 /// Queries take world coordinates in double precision. Points outside the sampled area (including
 /// the padding that patches add), and NaN or infinite input, give an empty optional or no hit;
@@ -68,7 +81,7 @@ class Terrain {
  public:
   /// Builds the query acceleration structures (a max-height pyramid for rays). Never fails for a
   /// valid Heightfield.
-  static std::shared_ptr<const Terrain> create(Heightfield heightfield);
+  static std::shared_ptr<Terrain> create(Heightfield heightfield);
 
   ~Terrain();
   Terrain(const Terrain&) = delete;
@@ -128,6 +141,34 @@ class Terrain {
   std::size_t triangles_in_box(const Box& box, std::vector<SurfaceTriangle>& out,
                                std::size_t max_triangles = 0) const;
 
+  // ---- deformation (edit.h, docs/deformation.md) -------------------------------------------
+
+  /// Applies one brush as one transaction: changes the heights (clamped to the edit limits),
+  /// refreshes the ray pyramid over the changed blocks, recomputes the error bounds of exactly
+  /// the bintree nodes of every attached Landscape whose triangles hold a changed sample
+  /// (bottom-up), and in every RoamView on those landscapes refreshes the nodes over the changed
+  /// region, requeues the queued ones with fresh priorities and marks the patches dirty. Queries
+  /// see the new surface when it returns. Cost follows the edited area (plus a rescan of the
+  /// top levels of the touched patches), never the terrain size.
+  /// Errors (nothing changes): a field fails validate_edit(), the radius exceeds the terrain's
+  /// larger extent, or the area cap is exceeded with EditLimits::refuse_oversize. A brush wholly
+  /// outside the terrain is a no-op with an empty result. Exclusive access (see above).
+  Result<EditResult> apply_edit(const Edit& edit);
+  /// Limits for later edits (validated: finite, area > 0, min < max; else an error and no change).
+  Status set_edit_limits(const EditLimits& limits);
+  const EditLimits& edit_limits() const noexcept;
+  /// Number of 32 x 32-sample chunks the edit layer holds (0 when unedited).
+  std::size_t edited_chunks() const noexcept;
+  /// Hash of the heightfield as created, before any edit (what save files record).
+  std::uint64_t base_hash() const noexcept { return base_hash_; }
+  /// Hash of the current heights (base + edits): equal hashes, equal surfaces.
+  std::uint64_t heights_hash() const noexcept { return heightfield_.content_hash(); }
+  /// Increases by one with every edit or load that changed something.
+  std::uint64_t edit_version() const noexcept { return edit_version_; }
+  /// A deep copy (heights, ray pyramid, edit layer, limits), not attached to any Landscape: a
+  /// snapshot a physics thread can query while this terrain is being edited.
+  std::shared_ptr<Terrain> clone() const;
+
   /// Bytes held: heights, materials, ray hierarchy.
   std::size_t memory_bytes() const noexcept;
   /// Bytes held by the ray hierarchy alone (the min/max pyramid over 4 x 4-cell blocks, about
@@ -139,8 +180,21 @@ class Terrain {
 
   Heightfield heightfield_;
   std::unique_ptr<RayHierarchy> rays_;
+  std::unique_ptr<EditLayer> edits_;
+  std::uint64_t base_hash_ = 0;
+  std::uint64_t edit_version_ = 0;
   // Cached for the query fast path.
   double inv_spacing_x_ = 1, inv_spacing_z_ = 1;
+
+  // Landscapes register here to hear of edits (internal; Landscape and edit.cpp only).
+  friend class Landscape;
+  friend class EditLayer;
+  friend Result<EditResult> load_edits_from_memory(Terrain&, std::string_view);
+  friend Status save_edits(const Terrain&, const std::string&);
+  void add_listener(detail::EditListener* l) const;
+  void remove_listener(detail::EditListener* l) const;
+  struct Listeners;
+  std::unique_ptr<Listeners> listeners_;
 };
 
 }  // namespace ridgeline

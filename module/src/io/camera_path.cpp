@@ -2,36 +2,17 @@
 #include "ridgeline/camera_path.h"
 
 #include <cmath>
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "format.h"
+#include "json_util.h"
 
 namespace ridgeline::io {
 
 namespace {
 
 using nlohmann::json;
-
-// Reads a finite number; false (with `err` set) when missing or wrong.
-bool number(const json& o, const char* key, double& out, bool required, std::string& err) {
-  auto it = o.find(key);
-  if (it == o.end()) {
-    if (required) err = fmt("'%s' is missing", key);
-    return !required;
-  }
-  if (!it->is_number()) {
-    err = fmt("'%s' is %s; need a number", key, it->type_name());
-    return false;
-  }
-  out = it->get<double>();
-  if (!std::isfinite(out)) {
-    err = fmt("'%s' is not finite", key);
-    return false;
-  }
-  return true;
-}
+using detail::json_number;
 
 bool vec(const json& o, const char* key, std::size_t n, double* out, bool required,
          std::string& err) {
@@ -87,7 +68,7 @@ Result<std::vector<PathFrame>> parse_camera_path(std::string_view text, std::siz
     v3[0] = 0, v3[1] = 1, v3[2] = 0;
     ok = ok && vec(f, "up", 3, v3, false, err);
     if (ok) c.up = {v3[0], v3[1], v3[2]};
-    ok = ok && number(f, "fov_y", fov, true, err);
+    ok = ok && json_number(f, "fov_y", fov, true, err);
     c.fov_y_deg = fov;
     ok = ok && vec(f, "viewport", 2, v2, true, err);
     if (ok) {
@@ -99,9 +80,9 @@ Result<std::vector<PathFrame>> parse_camera_path(std::string_view text, std::siz
         c.viewport = {int(v2[0]), int(v2[1])};
       }
     }
-    ok = ok && number(f, "near", c.near_m, false, err);
-    ok = ok && number(f, "far", c.far_m, false, err);
-    ok = ok && number(f, "dt", pf.dt, false, err);
+    ok = ok && json_number(f, "near", c.near_m, false, err);
+    ok = ok && json_number(f, "far", c.far_m, false, err);
+    ok = ok && json_number(f, "dt", pf.dt, false, err);
     if (ok && !(pf.dt > 0)) {
       err = "'dt' must be > 0";
       ok = false;
@@ -119,19 +100,9 @@ Result<std::vector<PathFrame>> parse_camera_path(std::string_view text, std::siz
 }
 
 Result<std::vector<PathFrame>> load_camera_path(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{fmt("camera path '%s': cannot open", path.c_str())};
-  in.seekg(0, std::ios::end);
-  const auto size = static_cast<std::int64_t>(in.tellg());
-  if (size < 0) return Error{fmt("camera path '%s': cannot read", path.c_str())};
-  if (size > (std::int64_t{512} << 20))
-    return Error{fmt("camera path '%s': %lld bytes; at most 512 MiB", path.c_str(),
-                     static_cast<long long>(size))};
-  in.seekg(0);
-  std::string text(static_cast<std::size_t>(size), '\0');
-  in.read(text.data(), size);
-  if (!in) return Error{fmt("camera path '%s': read failed", path.c_str())};
-  auto r = parse_camera_path(text);
+  auto text = detail::read_text_file(path, std::size_t{512} << 20, "camera path");
+  if (!text) return Error{text.error().message};
+  auto r = parse_camera_path(*text);
   if (!r) return Error{fmt("%s (in '%s')", r.error().message.c_str(), path.c_str())};
   return r;
 }

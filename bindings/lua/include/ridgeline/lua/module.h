@@ -44,7 +44,7 @@ int open_module(lua_State* L, const ModuleConfig& config);
 
 /// Pushes a `ridgeline.terrain` userdata that shares `terrain` with the engine (the engine's own
 /// terrain, so that scripts query what the game simulates). May raise a Lua error (memory).
-void push_terrain(lua_State* L, std::shared_ptr<const Terrain> terrain);
+void push_terrain(lua_State* L, std::shared_ptr<Terrain> terrain);
 
 }  // namespace ridgeline::lua
 

@@ -1,0 +1,172 @@
+// Deformation from Lua: terrain:deform{...} (a terrain method) and the module functions
+// ridgeline.save_edits / ridgeline.load_edits (they need the module's path rules).
+#include <cstring>
+#include <exception>
+
+#include "lua_util.h"
+#include "ridgeline/edit.h"
+
+namespace ridgeline::lua::detail {
+namespace {
+
+Terrain& editable_terrain(lua_State* L, int arg) {
+  auto* box = static_cast<TerrainBox*>(luaL_checkudata(L, arg, kTerrainMeta));
+  if (!box->terrain) luaL_error(L, "attempt to use a released ridgeline.terrain");
+  return *box->terrain;
+}
+
+// Reads the edit table at `arg` (SPEC.md's schema) into plain data; raises on a bad field.
+Edit check_edit(lua_State* L, int arg) {
+  luaL_checktype(L, arg, LUA_TTABLE);
+  static const char* const kFields[] = {"brush", "x",   "z",      "radius",      "strength",
+                                        "depth", "rim", "height", "keep_detail", nullptr};
+  check_fields(L, arg, kFields);
+  Edit e;
+  lua_getfield(L, arg, "brush");
+  const char* name = lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : nullptr;
+  const std::optional<Brush> brush = name ? parse_brush(name) : std::nullopt;
+  if (!brush)
+    luaL_argerror(L, arg, "field 'brush': \"crater\", \"raise\", \"lower\", \"flatten\" or \"smooth\" expected");
+  lua_pop(L, 1);
+  e.brush = *brush;
+  if (!get_number_field(L, arg, "x", &e.x)) luaL_argerror(L, arg, "field 'x': number expected");
+  if (!get_number_field(L, arg, "z", &e.z)) luaL_argerror(L, arg, "field 'z': number expected");
+  if (!get_number_field(L, arg, "radius", &e.radius))
+    luaL_argerror(L, arg, "field 'radius': number expected");
+  get_number_field(L, arg, "strength", &e.strength);
+  get_number_field(L, arg, "depth", &e.depth);
+  get_number_field(L, arg, "rim", &e.rim);
+  get_number_field(L, arg, "height", &e.height);
+  if (lua_getfield(L, arg, "keep_detail") != LUA_TNIL) {
+    if (!lua_isboolean(L, -1)) luaL_argerror(L, arg, "field 'keep_detail': boolean expected");
+    e.keep_detail = lua_toboolean(L, -1);
+  }
+  lua_pop(L, 1);
+  char err[kErrSize];
+  bool ok = true;
+  try {
+    if (auto s = validate_edit(e); !s) {
+      copy_error(err, s.message().c_str());
+      ok = false;
+    }
+  } catch (const std::exception& ex) {
+    copy_error(err, ex.what());
+    ok = false;
+  }
+  if (!ok) luaL_argerror(L, arg, err);
+  return e;
+}
+
+bool do_edit(Terrain& t, const Edit& e, EditResult* out, char* err) noexcept {
+  try {
+    auto r = t.apply_edit(e);
+    if (!r) {
+      copy_error(err, r.error().message.c_str());
+      return false;
+    }
+    *out = *r;
+    return true;
+  } catch (const std::exception& ex) {
+    copy_error(err, ex.what());
+    return false;
+  }
+}
+
+void set_field(lua_State* L, const char* key, double v) {
+  lua_pushnumber(L, v);
+  lua_setfield(L, -2, key);
+}
+
+void push_edit_result(lua_State* L, const EditResult& r) {
+  lua_createtable(L, 0, 11);
+  lua_pushinteger(L, static_cast<lua_Integer>(r.samples_changed));
+  lua_setfield(L, -2, "samples");
+  if (!r.empty()) {
+    set_field(L, "min_x", r.changed.min.x);
+    set_field(L, "min_y", r.changed.min.y);
+    set_field(L, "min_z", r.changed.min.z);
+    set_field(L, "max_x", r.changed.max.x);
+    set_field(L, "max_y", r.changed.max.y);
+    set_field(L, "max_z", r.changed.max.z);
+  }
+  lua_pushboolean(L, r.clipped);
+  lua_setfield(L, -2, "clipped");
+  lua_pushboolean(L, r.clamped);
+  lua_setfield(L, -2, "clamped");
+  set_field(L, "radius", r.radius_used);
+}
+
+ConfigBox* config_of(lua_State* L) {
+  return static_cast<ConfigBox*>(lua_touserdata(L, lua_upvalueindex(1)));
+}
+
+enum class FileOp { kSave, kLoad };
+
+bool do_file(const ConfigBox& config, Terrain& t, const char* name, FileOp op, EditResult* out,
+             char* err) noexcept {
+  try {
+    char path[4096];
+    if (!resolve_path(config, name, path, sizeof path, err)) return false;
+    if (op == FileOp::kSave) {
+      if (auto s = save_edits(t, path); !s) {
+        copy_error(err, s.message().c_str());
+        return false;
+      }
+      return true;
+    }
+    auto r = load_edits(t, path);
+    if (!r) {
+      copy_error(err, r.error().message.c_str());
+      return false;
+    }
+    *out = *r;
+    return true;
+  } catch (const std::exception& ex) {
+    copy_error(err, ex.what());
+    return false;
+  }
+}
+
+int file_op(lua_State* L, FileOp op) {
+  Terrain& t = editable_terrain(L, 1);
+  const char* name = luaL_checkstring(L, 2);
+  if (std::strlen(name) != lua_rawlen(L, 2)) luaL_argerror(L, 2, "file name holds a NUL byte");
+  char err[kErrSize];
+  EditResult r;
+  if (!do_file(*config_of(L), t, name, op, &r, err)) {
+    lua_pushnil(L);
+    lua_pushstring(L, err);
+    return 2;
+  }
+  if (op == FileOp::kSave) {
+    lua_pushboolean(L, 1);
+    return 1;
+  }
+  push_edit_result(L, r);
+  return 1;
+}
+
+}  // namespace
+
+// terrain:deform{brush=, x=, z=, radius=, strength=, depth=, rim=, height=, keep_detail=}
+//   -> {samples=, min_x=, ..., max_z=, clipped=, clamped=, radius=} or nil, message
+int t_deform(lua_State* L) {
+  Terrain& t = editable_terrain(L, 1);
+  const Edit e = check_edit(L, 2);
+  char err[kErrSize];
+  EditResult r;
+  if (!do_edit(t, e, &r, err)) {
+    lua_pushnil(L);
+    lua_pushstring(L, err);
+    return 2;
+  }
+  push_edit_result(L, r);
+  return 1;
+}
+
+// ridgeline.save_edits(terrain, file) -> true or nil, message
+int r_save_edits(lua_State* L) { return file_op(L, FileOp::kSave); }
+// ridgeline.load_edits(terrain, file) -> result table (as deform) or nil, message
+int r_load_edits(lua_State* L) { return file_op(L, FileOp::kLoad); }
+
+}  // namespace ridgeline::lua::detail

@@ -1,0 +1,62 @@
+-- terrain:deform and ridgeline.save_edits / load_edits (docs/lua_api.md, "Deformation").
+local t = ridgeline.default_terrain()  -- 1025 x 1025 samples, 2 m apart
+local x0, z0 = 1024, 1024                -- a sample in the middle
+
+T.case("crater lowers the surface by its depth at the centre", function()
+  local before = t:height(x0, z0)
+  local r = assert(t:deform{brush = "crater", x = x0, z = z0, radius = 6, depth = 2, rim = 0.25})
+  T.near(t:height(x0, z0), before - 2, 1e-4, "bowl bottom")
+  T.truthy(r.samples > 0, "samples changed")
+  T.truthy(r.min_x <= x0 - 6 and r.max_x >= x0 + 6, "changed box holds the crater")
+  T.truthy(r.min_y <= before - 2 + 1e-4, "changed box spans the new heights")
+  T.eq(r.clipped, false); T.eq(r.clamped, false)
+  -- raycasts see it at once
+  local d, hx, hy, hz = t:raycast(x0, 1000, z0, 0, -1, 0, 5000)
+  T.near(hy, t:height(x0, z0), 1e-4, "ray hits the crater floor")
+end)
+
+T.case("every brush, and a brush outside the terrain", function()
+  for _, b in ipairs{"raise", "lower", "flatten", "smooth"} do
+    local r = assert(t:deform{brush = b, x = x0, z = z0, radius = 5, strength = 0.5, depth = 1, height = 100})
+    T.truthy(r.samples >= 0, b)
+  end
+  local r = assert(t:deform{brush = "crater", x = -5000, z = 0, radius = 3})
+  T.eq(r.samples, 0, "outside: nothing changed"); T.eq(r.min_x, nil, "no box")
+end)
+
+T.case("bad edits are refused with the field named", function()
+  T.raises("field 'brush'", t.deform, t, {brush = "nuke", x = 0, z = 0, radius = 1})
+  T.raises("field 'radius': number expected", t.deform, t, {brush = "crater", x = 0, z = 0})
+  T.raises("finite number expected", t.deform, t, {brush = "crater", x = 0 / 0, z = 0, radius = 1})
+  T.raises("strength is 3", t.deform, t, {brush = "raise", x = 0, z = 0, radius = 1, strength = 3})
+  T.raises("unknown field 'radius_m'", t.deform, t, {brush = "raise", x = 0, z = 0, radius_m = 1})
+  T.raises("field 'keep_detail': boolean expected", t.deform, t,
+           {brush = "raise", x = 0, z = 0, radius = 1, keep_detail = 1})
+  local r, err = t:deform{brush = "crater", x = x0, z = z0, radius = 1e6}
+  T.eq(r, nil); T.truthy(err:find("larger than the terrain", 1, true), err)
+end)
+
+T.case("save and load paths", function()
+  if os and os.tmpname then  -- the stock interpreter: unconfined paths
+    local f = os.tmpname()
+    local h = t:height(x0, z0)
+    assert(ridgeline.save_edits(t, f))
+    assert(t:deform{brush = "raise", x = x0, z = z0, radius = 8, depth = 3})
+    T.truthy(t:height(x0, z0) > h + 1, "raised")
+    local r = assert(ridgeline.load_edits(t, f))
+    T.near(t:height(x0, z0), h, 0, "undone by loading the save")
+    local other = assert(ridgeline.load{heightmap = DATA .. "ramp16.png"})
+    local ok, err = ridgeline.load_edits(other, f)
+    T.eq(ok, nil); T.truthy(err:find("another terrain", 1, true), err)
+    os.remove(f)
+  else  -- the sandbox: confined to the data folder
+    local ok, err = ridgeline.save_edits(t, "/tmp/x.bin")
+    T.eq(ok, nil); T.truthy(err:find("absolute paths are not allowed", 1, true), err)
+    ok, err = ridgeline.load_edits(t, "../x.bin")
+    T.eq(ok, nil); T.truthy(err:find("'..' is not allowed", 1, true), err)
+    ok, err = ridgeline.load_edits(t, "no_such_state.bin")
+    T.eq(ok, nil); T.truthy(err:find("No such file", 1, true), err)
+  end
+  T.raises("NUL", ridgeline.save_edits, t, "a\0b")
+  T.raises("ridgeline.terrain expected", ridgeline.save_edits, {}, "x.bin")
+end)

@@ -1,0 +1,51 @@
+// Helpers shared by the ROAM and deformation tests.
+#pragma once
+
+#include <map>
+#include <string>
+
+#include "ridgeline/roam_view.h"
+
+namespace ridgeline::test {
+
+inline Camera camera_at(glm::dvec3 eye, glm::dvec3 target, double fov = 60.0) {
+  Camera c;
+  c.eye = eye;
+  c.target = target;
+  c.fov_y_deg = fov;
+  c.viewport = {640, 480};
+  return c;
+}
+
+struct EdgeKey {
+  std::int64_t a, b;
+  bool operator<(const EdgeKey& o) const { return a != o.a ? a < o.a : b < o.b; }
+};
+
+// Geometric crack check, independent of the view's neighbour links: every leaf edge is shared by
+// exactly two leaves, unless it lies on the landscape border (then exactly one).
+inline std::string check_crack_free(const RoamView& view) {
+  const Landscape& l = view.landscape();
+  const std::int64_t W = l.patches_x() * l.patch_cells(), H = l.patches_z() * l.patch_cells();
+  std::map<EdgeKey, int> edges;
+  auto id = [&](std::int64_t i, std::int64_t j) { return i + j * (W + 1); };
+  view.for_each_leaf([&](std::uint32_t, std::uint64_t, const LatticeTriangle& t) {
+    const std::int64_t v[3] = {id(t.ax, t.az), id(t.lx, t.lz), id(t.rx, t.rz)};
+    for (int e = 0; e < 3; ++e) {
+      std::int64_t a = v[e], b = v[(e + 1) % 3];
+      if (a > b) std::swap(a, b);
+      ++edges[{a, b}];
+    }
+  });
+  for (const auto& [k, n] : edges) {
+    const std::int64_t ai = k.a % (W + 1), aj = k.a / (W + 1), bi = k.b % (W + 1),
+                       bj = k.b / (W + 1);
+    const bool border = (ai == bi && (ai == 0 || ai == W)) || (aj == bj && (aj == 0 || aj == H));
+    if (n != (border ? 1 : 2))
+      return "edge (" + std::to_string(ai) + "," + std::to_string(aj) + ")-(" + std::to_string(bi) +
+             "," + std::to_string(bj) + ") used by " + std::to_string(n) + " triangles";
+  }
+  return "";
+}
+
+}  // namespace ridgeline::test
