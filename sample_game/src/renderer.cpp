@@ -64,12 +64,14 @@ void main() {
   vec3 n = normalize(v_nrm);
   float slope = 1.0 - n.y;                       // 0 flat .. 1 vertical
   float h = clamp((v_height - u_height_range.x) / max(u_height_range.y - u_height_range.x, 1.0), 0.0, 1.0);
-  vec3 sand = vec3(0.76, 0.70, 0.50), grass = vec3(0.30, 0.50, 0.20);
-  vec3 dry = vec3(0.55, 0.52, 0.32), rock = vec3(0.45, 0.42, 0.40), snow = vec3(0.95, 0.96, 0.98);
-  vec3 c = mix(sand, grass, smoothstep(0.04, 0.12, h));
-  c = mix(c, dry, smoothstep(0.45, 0.7, h));
-  c = mix(c, snow, smoothstep(0.82, 0.9, h) * (1.0 - smoothstep(0.3, 0.5, slope)));
-  c = mix(c, rock, smoothstep(0.18, 0.32, slope));
+  vec3 sand = vec3(0.76, 0.70, 0.50), grass = vec3(0.28, 0.48, 0.18);
+  vec3 meadow = vec3(0.42, 0.55, 0.22), dry = vec3(0.58, 0.53, 0.33);
+  vec3 rock = vec3(0.47, 0.44, 0.42), snow = vec3(0.95, 0.96, 0.98);
+  vec3 c = mix(sand, grass, smoothstep(0.03, 0.08, h));
+  c = mix(c, meadow, smoothstep(0.15, 0.35, h));
+  c = mix(c, dry, smoothstep(0.45, 0.65, h));
+  c = mix(c, snow, smoothstep(0.8, 0.88, h) * (1.0 - smoothstep(0.25, 0.45, slope)));
+  c = mix(c, rock, smoothstep(0.10, 0.22, slope));
   float diffuse = max(dot(n, u_sun), 0.0);
   float sky = 0.5 + 0.5 * n.y;
   vec3 lit = c * (0.85 * diffuse * vec3(1.0, 0.96, 0.88) + 0.32 * sky * vec3(0.6, 0.7, 0.9));
@@ -84,7 +86,7 @@ out vec2 v_ndc;
 void main() {
   vec2 p = vec2((gl_VertexID == 1) ? 3.0 : -1.0, (gl_VertexID == 2) ? 3.0 : -1.0);
   v_ndc = p;
-  gl_Position = vec4(p, 1.0, 1.0);
+  gl_Position = vec4(p, 1.0, 1.0);  // z = w: depth 1, the far plane
 }
 )";
 
@@ -197,6 +199,18 @@ ridgeline::Result<std::unique_ptr<Renderer>> Renderer::create(Game& game, int wi
   auto mp = program(kModelVs, kModelFs, "model");
   if (!mp) return Error{mp.error().message};
   r->terrain_prog_ = *tp;
+  {  // height range for the colouring, from the terrain's samples
+    const ridgeline::Heightfield& hf = game.terrain().heightfield();
+    float lo = 1e30f, hi = -1e30f;
+    for (std::uint32_t j = 0; j < hf.height(); j += 4)
+      for (std::uint32_t i = 0; i < hf.width(); i += 4) {
+        const float v = float(hf.world(i, j));
+        lo = std::min(lo, v);
+        hi = std::max(hi, v);
+      }
+    r->height_min_ = lo;
+    r->height_max_ = hi > lo ? hi : lo + 1;
+  }
   r->sky_prog_ = *sp;
   r->model_prog_ = *mp;
   glGenVertexArrays(1, &r->sky_vao_);
@@ -343,17 +357,6 @@ RenderStats Renderer::draw(Game& game, const RenderSettings& settings) {
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
 
-  // Sky (depth test off, drawn first).
-  glDisable(GL_DEPTH_TEST);
-  glDisable(GL_CULL_FACE);
-  glUseProgram(sky_prog_);
-  const glm::mat4 inv = glm::inverse(vp);
-  glUniformMatrix4fv(loc(sky_prog_, "u_inv_view_proj"), 1, GL_FALSE, glm::value_ptr(inv));
-  glUniform3fv(loc(sky_prog_, "u_sun"), 1, glm::value_ptr(kSun));
-  glUniform3fv(loc(sky_prog_, "u_fog_colour"), 1, glm::value_ptr(kFog));
-  glBindVertexArray(sky_vao_);
-  glDrawArrays(GL_TRIANGLES, 0, 3);
-
   // Terrain.
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
@@ -370,7 +373,7 @@ RenderStats Renderer::draw(Game& game, const RenderSettings& settings) {
   glUniform3fv(loc(terrain_prog_, "u_sun"), 1, glm::value_ptr(kSun));
   glUniform3fv(loc(terrain_prog_, "u_fog_colour"), 1, glm::value_ptr(kFog));
   glUniform1f(loc(terrain_prog_, "u_fog_density"), settings.fog_density);
-  glUniform2f(loc(terrain_prog_, "u_height_range"), 10.0f, 260.0f);
+  glUniform2f(loc(terrain_prog_, "u_height_range"), height_min_, height_max_);
   const int u_offset = loc(terrain_prog_, "u_offset"), u_oy = loc(terrain_prog_, "u_origin_y");
   for (const PatchGpu& p : set) {
     if (p.count == 0) continue;
@@ -412,6 +415,22 @@ RenderStats Renderer::draw(Game& game, const RenderSettings& settings) {
       glDrawElements(GL_TRIANGLES, it->second.second.count, GL_UNSIGNED_INT, nullptr);
     }
   }
+  // Sky last, at the far plane with depth test LEQUAL: only pixels no terrain or vehicle
+  // covered run its shader (llvmpipe is fill bound at 1280 x 720).
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LEQUAL);
+  glDepthMask(GL_FALSE);
+  glDisable(GL_CULL_FACE);
+  glUseProgram(sky_prog_);
+  const glm::mat4 inv = glm::inverse(vp);
+  glUniformMatrix4fv(loc(sky_prog_, "u_inv_view_proj"), 1, GL_FALSE, glm::value_ptr(inv));
+  glUniform3fv(loc(sky_prog_, "u_sun"), 1, glm::value_ptr(kSun));
+  glUniform3fv(loc(sky_prog_, "u_fog_colour"), 1, glm::value_ptr(kFog));
+  glBindVertexArray(sky_vao_);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+
+  glDepthMask(GL_TRUE);
+  glDepthFunc(GL_LESS);
   glBindVertexArray(0);
   st.draw_ms = ms_since(t0);
   return st;

@@ -16,7 +16,7 @@ namespace game {
 struct RenderSettings {
   bool wireframe = false;
   bool geomorph = true;
-  float fog_density = 0.0009f;  ///< per metre (exponential fog)
+  float fog_density = 0.0005f;  ///< per metre (exponential fog)
 };
 
 struct RenderStats {
@@ -57,6 +57,7 @@ class Renderer {
   MeshGpu upload_model(const ModelMesh& mesh);
 
   int width_ = 0, height_ = 0;
+  float height_min_ = 0, height_max_ = 1;  ///< metres, for the height colouring
   unsigned fbo_ = 0, colour_ = 0, depth_ = 0;
   unsigned terrain_prog_ = 0, sky_prog_ = 0, model_prog_ = 0, sky_vao_ = 0;
   std::vector<PatchGpu> patches_[3];  ///< per camera mode: each view has its own mesh
