@@ -420,8 +420,13 @@ int g_camera(lua_State* L) {
   check_fields(L, 1, kFields);
   CameraRig r = g.rig();
   if (lua_getfield(L, 1, "mode") != LUA_TNIL) {
-    static const char* const kModes[] = {"free", "follow", "map", nullptr};
-    r.mode = static_cast<CameraMode>(luaL_checkoption(L, -1, nullptr, kModes));
+    const char* m = lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : "";
+    if (std::strcmp(m, "free") == 0) r.mode = CameraMode::kFree;
+    else if (std::strcmp(m, "follow") == 0) r.mode = CameraMode::kFollow;
+    else if (std::strcmp(m, "map") == 0) r.mode = CameraMode::kMap;
+    else
+      luaL_argerror(L, 1, lua_pushfstring(L, "field 'mode': 'free', 'follow' or 'map' expected, "
+                                             "got '%s'", luaL_tolstring(L, -1, nullptr)));
   }
   lua_pop(L, 1);
   if (lua_getfield(L, 1, "vehicle") != LUA_TNIL) {

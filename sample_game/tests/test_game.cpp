@@ -205,7 +205,7 @@ TEST(Game, ApiErrorsNameTheProblem) {
   expect_error("game.set_budget{threshold=-1}", "'threshold': 0.25 .. 256");
   expect_error("game.set_budget{min=8, max=2}", "0.25 <= min <= max");
   expect_error("game.burn_ms(1000)", "0 .. 100 milliseconds");
-  expect_error("game.camera{mode='orbit'}", "invalid option 'orbit'");
+  expect_error("game.camera{mode='orbit'}", "'free', 'follow' or 'map' expected, got 'orbit'");
   expect_error("game.crater{x=1, z=1, radius=0}", "'radius'");
   // Nothing half-applied: the budget is unchanged after the failed calls.
   EXPECT_DOUBLE_EQ(g->controller().desc().min_threshold, 1.0);
