@@ -16,6 +16,7 @@ out=out/bench_game
 mkdir -p "$out"
 export LP_NUM_THREADS=${LP_NUM_THREADS:-2}
 S=scripts/game
+load_before=$(cut -d' ' -f1-3 /proc/loadavg)
 run() {  # name frames extra-args...
   local name=$1 frames=$2; shift 2
   echo "--- $name ($frames frames)"
@@ -25,7 +26,7 @@ run() {  # name frames extra-args...
 run steady 1200 --steady-from 600
 run spike 1500 --script $S/default.lua --script $S/artillery.lua --script $S/budget.lua \
   --script $S/load_spike.lua
-python3 - "$out" docs/benchmarks/game.json <<'PY'
+python3 - "$out" docs/benchmarks/game.json "$load_before" "$(cut -d' ' -f1-3 /proc/loadavg)" <<'PY'
 import json, statistics, subprocess, sys
 out, dest = sys.argv[1], sys.argv[2]
 def load(n): return json.load(open(f"{out}/{n}.json"))
@@ -47,6 +48,7 @@ def phase(a, b):
 doc = {
   "command": "scripts/bench_game.sh",
   "machine": "2 cores shared with other builds; Mesa llvmpipe (no GPU); LP_NUM_THREADS=2",
+  "load_average_before_after": [sys.argv[3], sys.argv[4]],
   "viewport": [1280, 720], "dt_s": steady["dt_s"], "target_ms": steady["summary"]["target_ms"],
   "steady": {
     "scenario": "default.lua + artillery.lua + budget.lua (controller on, 1..12 px, 60000 triangles)",
