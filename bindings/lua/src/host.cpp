@@ -464,6 +464,30 @@ Status Host::call_global(const char* name) {
   return call(1, 0);
 }
 
+Status Host::set_global(const char* name) {
+  lua_State* L = L_;
+  if (lua_gettop(L) < 1) return Error{"lua host: set_global: no value on the stack"};
+  if (!lua_checkstack(L, 4)) return Error{"lua host: stack overflow"};
+  // rawset on a table with a string key cannot raise except for memory: do it protected.
+  lua_pushcfunction(L, [](lua_State* S) -> int {
+    lua_rawgetp(S, LUA_REGISTRYINDEX, &kSandboxKey);
+    lua_pushvalue(S, 1);
+    lua_pushvalue(S, 2);
+    lua_rawset(S, -3);
+    return 0;
+  });
+  lua_pushstring(L, name);
+  lua_pushvalue(L, -3);
+  const int rc = lua_pcall(L, 2, 0, 0);
+  if (rc != LUA_OK) {
+    std::string msg = lua_tostring(L, -1) != nullptr ? lua_tostring(L, -1) : "error";
+    lua_pop(L, 2);
+    return Error{"lua host: set_global '" + std::string(name) + "': " + msg};
+  }
+  lua_pop(L, 1);
+  return {};
+}
+
 std::size_t Host::memory_used() const noexcept {
   return owned_ ? limits_->used : 0;
 }

@@ -22,6 +22,7 @@ namespace ridgeline::lua::detail {
 inline constexpr char kTerrainMeta[] = "ridgeline.terrain";
 inline constexpr char kViewMeta[] = "ridgeline.view";
 inline constexpr char kConfigMeta[] = "ridgeline.config";
+inline constexpr char kBudgetMeta[] = "ridgeline.budget_controller";
 inline constexpr std::size_t kErrSize = 512;
 
 /// Per-module-table settings and caches: a userdata (with __gc) that module functions reach as
@@ -97,6 +98,7 @@ void account_memory(lua_State* L, std::size_t bytes);
 
 /// Method tables, for `open_module`.
 int new_view(lua_State* L);  // terrain:new_view, defined in wrap_view.cpp
+int new_budget_controller(lua_State* L);  // ridgeline.budget_controller, wrap_budget.cpp
 int t_deform(lua_State* L);      // terrain:deform, wrap_edit.cpp
 int r_save_edits(lua_State* L);  // ridgeline.save_edits, wrap_edit.cpp
 int r_load_edits(lua_State* L);  // ridgeline.load_edits, wrap_edit.cpp

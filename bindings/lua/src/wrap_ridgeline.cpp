@@ -173,6 +173,7 @@ int config_gc(lua_State* L) {
 const luaL_Reg kFunctions[] = {
     {"load", r_load},
     {"default_terrain", r_default_terrain},
+    {"budget_controller", new_budget_controller},
     {"save_edits", r_save_edits},
     {"load_edits", r_load_edits},
     {nullptr, nullptr}};
@@ -181,6 +182,11 @@ const luaL_Reg kFunctions[] = {
 }  // namespace ridgeline::lua::detail
 
 namespace ridgeline::lua {
+
+void push_terrain(lua_State* L, std::shared_ptr<Terrain> terrain) {
+  detail::TerrainBox* box = detail::push_terrain_box(L);
+  box->terrain = std::move(terrain);  // no Lua call after the push: nothing can longjmp here
+}
 
 int open_module(lua_State* L, const ModuleConfig& config) {
   using namespace detail;

@@ -71,6 +71,11 @@ class Host {
   /// Calls global function `name` with no arguments and no results (a game callback).
   Status call_global(const char* name);
 
+  /// Pops the value on top of the stack and stores it as global `name` of the scripts'
+  /// environment (the sandbox table, or the real globals without the sandbox): how an engine
+  /// hands its own API (a `game` table) to its scripts. Fails only for memory or an empty stack.
+  Status set_global(const char* name);
+
   /// Bytes held by an owned state (0 for an attached one).
   std::size_t memory_used() const noexcept;
   /// Instructions counted during the last call (in steps of 1000).
