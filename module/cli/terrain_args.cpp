@@ -22,6 +22,11 @@ void TerrainArgs::add_to(CLI::App& app) {
                           "Use the built-in default terrain (1025 x 1025 samples, 2 m spacing, "
                           "seed 1337)")
                  ->group(g);
+  app.add_option("--default-size", default_size_,
+                 "Samples per side of the default terrain, 2..65536 (default 1025; the same "
+                 "landscape, stretched)")
+      ->type_name("N")
+      ->group(g);
   hm->excludes(dt);
   dt->excludes(hm);
   app.add_option("--raw-size", raw_size_, "Size of a raw heightmap in samples")
@@ -145,11 +150,18 @@ Result<Heightfield> TerrainArgs::load_heightfield() const {
   auto desc = placement();
   if (!desc) return desc.error();
 
+  if (given("--default-size") && !default_terrain_)
+    return Error{"--default-size applies to --default-terrain"};
   if (default_terrain_) {
     for (const char* flag : {"--raw-size", "--raw-type", "--channel", "--materials"})
       if (given(flag))
         return Error{std::string(flag) + " applies to --heightmap, not to --default-terrain"};
-    const DefaultTerrainParams params;
+    DefaultTerrainParams params;
+    if (given("--default-size")) {
+      auto n = parse_count(default_size_, "--default-size", 2, 65536);
+      if (!n) return n.error();
+      params.size = static_cast<std::uint32_t>(*n);
+    }
     HeightfieldDesc d = *desc;
     d.width = d.height = params.size;
     d.name = "default terrain";

@@ -19,7 +19,8 @@ namespace ridgeline::cli {
 class TerrainArgs {
  public:
   /// Adds --heightmap, --default-terrain, --raw-size, --raw-type, --spacing, --height-scale,
-  /// --height-offset, --origin, --nodata, --fill, --max-samples, --channel, --materials and --load to
+  /// --height-offset, --origin, --nodata, --fill, --max-samples, --channel, --materials, --load and
+  /// --default-size to
   /// `app`, in an option group "Terrain". The object must outlive the parse.
   void add_to(CLI::App& app);
 
@@ -40,7 +41,7 @@ class TerrainArgs {
   std::string heightmap_;
   bool default_terrain_ = false;
   std::string raw_size_, raw_type_, spacing_, height_scale_, height_offset_, origin_, nodata_,
-      fill_, max_samples_, channel_, materials_, load_;
+      fill_, max_samples_, channel_, materials_, load_, default_size_;
   CLI::App* app_ = nullptr;
 };
 

@@ -18,6 +18,37 @@ double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
+// Tiles this fine (stored cells per side) are checked against the stored heights under them.
+constexpr std::int64_t kLocalRangeCells = 16;
+
+// Vertical distance from the eye to the height range of tile (level, tx, tz): the stored samples
+// of every cell the tile overlaps (the stored surface there lies within their range) widened by
+// the bound of the detail over the tile.
+template <class Vertical>
+double vertical_to_tile(const DetailField& field, std::uint32_t level, std::int64_t tx,
+                        std::int64_t tz, const Vertical& vertical) {
+  const Heightfield& hf = field.terrain().heightfield();
+  const std::int64_t li0 = tx * kDetailTileCells, lj0 = tz * kDetailTileCells;
+  const std::int64_t li1 = li0 + kDetailTileCells, lj1 = lj0 + kDetailTileCells;
+  // Stored sample indices covering [li0, li1] / 2^level (floor and ceiling), clamped.
+  const std::int64_t w = hf.width() - 1, h = hf.height() - 1;
+  const std::int64_t i0 = std::clamp<std::int64_t>(li0 >> level, 0, w);
+  const std::int64_t j0 = std::clamp<std::int64_t>(lj0 >> level, 0, h);
+  const std::int64_t i1 =
+      std::clamp<std::int64_t>((li1 + (std::int64_t{1} << level) - 1) >> level, 0, w);
+  const std::int64_t j1 =
+      std::clamp<std::int64_t>((lj1 + (std::int64_t{1} << level) - 1) >> level, 0, h);
+  float lo = hf.local(std::uint32_t(i0), std::uint32_t(j0)), hi = lo;
+  for (std::int64_t j = j0; j <= j1; ++j)
+    for (std::int64_t i = i0; i <= i1; ++i) {
+      const float v = hf.local(std::uint32_t(i), std::uint32_t(j));
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+    }
+  const double amp = field.contribution_bound(1, level, li0, lj0, li1, lj1);
+  return vertical(hf.height_offset() + double(lo) - amp, hf.height_offset() + double(hi) + amp);
+}
+
 }  // namespace
 
 Status validate_detail_view_rule(const DetailViewRule& rule) {
@@ -44,18 +75,24 @@ Status detail_tiles_for_view(const DetailField& field, const Camera& camera,
   if (auto s = validate_detail_view_rule(rule); !s) return s;
   if (auto s = validate_camera(camera); !s) return s;
   const Heightfield& hf = field.terrain().heightfield();
-  // The height range any surface point can have: a lower bound of the distance to a tile.
+  // The height range any surface point can have: a lower bound of the vertical distance.
   const double amp = field.contribution_bound(1);
-  const double top = hf.height_offset() + double(hf.max_local()) + amp;
-  const double bottom = hf.height_offset() + double(hf.min_local()) - amp;
-  const double dy = std::max({0.0, camera.eye.y - top, bottom - camera.eye.y});
-  const double ex = camera.eye.x, ez = camera.eye.z;
+  const double global_top = hf.height_offset() + double(hf.max_local()) + amp;
+  const double global_bottom = hf.height_offset() + double(hf.min_local()) - amp;
+  const double ex = camera.eye.x, ey = camera.eye.y, ez = camera.eye.z;
+  auto vertical = [ey](double bottom, double top) {
+    return std::max({0.0, ey - top, bottom - ey});
+  };
+  const double global_dy = vertical(global_bottom, global_top);
 
   for (std::uint32_t level = 1; level <= field.levels(); ++level) {
     const double radius = detail_level_radius(field, camera, level, rule);
     const double reach = (1.0 + rule.prefetch) * radius;
-    if (!(dy <= reach)) continue;
-    const double horizontal = std::sqrt(reach * reach - dy * dy);
+    if (!(global_dy <= reach)) continue;
+    const double horizontal = std::sqrt(reach * reach - global_dy * global_dy);
+    // Tiles of at most kLocalRangeCells stored cells per side get the height range of the stored
+    // samples under them (plus the detail bound there); coarser tiles the global range.
+    const bool local_range = (kDetailTileCells >> level) <= kLocalRangeCells;
     // Tile sides in metres, and the footprint's tiles: lattice indices 0 .. (w - 1) * 2^level.
     const double side_x = std::ldexp(hf.spacing_x(), -int(level)) * kDetailTileCells;
     const double side_z = std::ldexp(hf.spacing_z(), -int(level)) * kDetailTileCells;
@@ -85,7 +122,11 @@ Status detail_tiles_for_view(const DetailField& field, const Camera& camera,
       for (std::int64_t tx = tx0; tx <= tx1; ++tx) {
         const double x0 = hf.origin_x() + double(tx) * side_x;
         const double dx = std::max({0.0, x0 - ex, ex - (x0 + side_x)});
-        const double d = std::sqrt(dx * dx + dz * dz + dy * dy);
+        const double dxz2 = dx * dx + dz * dz;
+        if (dxz2 + global_dy * global_dy > reach * reach) continue;
+        const double dy =
+            local_range ? vertical_to_tile(field, level, tx, tz, vertical) : global_dy;
+        const double d = std::sqrt(dxz2 + dy * dy);
         if (d > reach) continue;
         if (out.size() >= rule.max_tiles) {
           out.clear();

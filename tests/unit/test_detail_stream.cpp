@@ -64,25 +64,40 @@ Camera camera_at(double x, double z, double y, double heading_x = 1, double head
   return c;
 }
 
-// Brute force: every tile of every level over the footprint, with the distance as documented.
+// Brute force: every tile of every level over the footprint, with the distance as documented
+// (the vertical part from every stored sample under tiles of at most 16 cells per side).
 std::set<std::tuple<std::uint32_t, int, int, bool>> brute_force(const DetailField& f,
                                                                 const Camera& c,
                                                                 const DetailViewRule& rule) {
   const Heightfield& hf = f.terrain().heightfield();
+  auto vertical = [&](double lo, double hi) { return std::max({0.0, c.eye.y - hi, lo - c.eye.y}); };
   const double amp = f.contribution_bound(1);
-  const double top = hf.height_offset() + hf.max_local() + amp;
-  const double bottom = hf.height_offset() + hf.min_local() - amp;
-  const double dy = std::max({0.0, c.eye.y - top, bottom - c.eye.y});
+  const double global_dy = vertical(hf.height_offset() + hf.min_local() - amp,
+                                    hf.height_offset() + hf.max_local() + amp);
   std::set<std::tuple<std::uint32_t, int, int, bool>> out;
   for (std::uint32_t l = 1; l <= f.levels(); ++l) {
     const double r = detail_level_radius(f, c, l, rule);
     const int n = int(((kSize - 1) << l) / kDetailTileCells);
     const double side = kSpacing / double(1 << l) * kDetailTileCells;
+    const int cells = kDetailTileCells >> l;  // stored cells per tile side
     for (int tz = 0; tz < n; ++tz)
       for (int tx = 0; tx < n; ++tx) {
         const double x0 = hf.origin_x() + tx * side, z0 = hf.origin_z() + tz * side;
         const double dx = std::max({0.0, x0 - c.eye.x, c.eye.x - x0 - side});
         const double dz = std::max({0.0, z0 - c.eye.z, c.eye.z - z0 - side});
+        double dy = global_dy;
+        if (cells <= 16) {
+          double lo = 1e300, hi = -1e300;
+          for (int j = tz * cells; j <= (tz + 1) * cells; ++j)
+            for (int i = tx * cells; i <= (tx + 1) * cells; ++i) {
+              lo = std::min(lo, hf.world(std::uint32_t(i), std::uint32_t(j)));
+              hi = std::max(hi, hf.world(std::uint32_t(i), std::uint32_t(j)));
+            }
+          const std::int64_t li = std::int64_t{tx} * kDetailTileCells;
+          const std::int64_t lj = std::int64_t{tz} * kDetailTileCells;
+          const double a = f.contribution_bound(1, l, li, lj, li + 128, lj + 128);
+          dy = vertical(lo - a, hi + a);
+        }
         const double d = std::sqrt(dx * dx + dz * dz + dy * dy);
         if (d <= (1 + rule.prefetch) * r) out.insert({l, tx, tz, d <= r});
       }

@@ -43,8 +43,11 @@ struct DetailTileNeed {
   DetailTileKey key;
   /// Distance from the eye to the tile, metres: sqrt(dxz^2 + dy^2), dxz the horizontal distance
   /// to the tile's xz rectangle and dy the vertical distance from the eye to the height range the
-  /// surface can reach anywhere (stored range widened by the detail's amplitude bound), so it
-  /// never exceeds the distance to any surface point of the tile.
+  /// surface can reach over the tile: for a tile spanning at most 16 stored cells per side (level
+  /// >= 3), the range of the stored samples of the cells it overlaps widened by the detail's
+  /// amplitude bound there (DetailField::contribution_bound); for coarser tiles, the whole
+  /// terrain's range widened by the global bound. So it never exceeds the distance to any surface
+  /// point of the tile.
   double distance_m = 0;
   /// Within R_l (false: requested for prefetch only).
   bool needed = false;
