@@ -94,14 +94,20 @@ class Landscape {
   static LatticeTriangle child_triangle(const LatticeTriangle& parent, int child) noexcept;
 
   /// Nested error bound of node `heap` of root `root` whose triangle is `t`, metres. Levels of
-  /// the stored lattice: the stored exact nested bound, plus (with detail) twice the detail
-  /// field's amplitude bound over the triangle's box. Levels below: twice the bound of the
-  /// contribution of the detail levels the node does not resolve (docs/detail.md, "Bounds").
+  /// the stored lattice: the stored exact nested bound, plus (with detail) the detail field's
+  /// amplitude bound over the triangle's box, and at least twice that bound. Levels below: twice
+  /// the bound of the contribution of the detail levels the node does not resolve
+  /// (docs/detail.md, "Bounds").
   float bound(std::uint32_t root, std::uint64_t heap, const LatticeTriangle& t) const noexcept {
     const float stored = heap < nodes_per_root_plus_one_
                              ? bounds_[root * (nodes_per_root_plus_one_ - 1) + heap - 1]
                              : 0.0f;
-    return detail_ == 0 ? stored : stored + detail_bound(63 - __builtin_clzll(heap), t);
+    if (detail_ == 0) return stored;
+    const int level = 63 - __builtin_clzll(heap);
+    const float d = detail_bound(level, t);  // twice the bound of the detail's contribution
+    // Stored levels: the plane is the stored surface's, so |detail| (half of d) adds to the
+    // stored error; at least d keeps the bound nested over the levels below.
+    return level < int(base_level()) ? std::max(stored + 0.5f * d, d) : d;
   }
   float bound(std::uint32_t root, std::uint64_t heap) const noexcept {
     return bound(root, heap, triangle(root, heap));
