@@ -9,6 +9,8 @@ RIDGELINE_PACKAGES=(
   libglm-dev libopenimageio-dev libtinygltf-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libbenchmark-dev liblua5.4-dev lua5.4
 )
+# Only for scripts/report.sh (the speed-versus-error report): plots and the CSV-to-plot step.
+RIDGELINE_REPORT_PACKAGES=(gnuplot-nox python3)
 
 # Installs the given Debian packages that are missing, through sudo when not root.
 ensure_packages() {

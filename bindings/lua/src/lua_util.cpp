@@ -154,7 +154,12 @@ bool resolve_path(bool confine_paths, const char* config_root, const char* name,
       std::strcpy(out, name);
       return true;
     }
-    std::string msg = std::string("file '") + name + "': ";
+    // The name as given, shortened so that the reason still fits the error buffer.
+    const std::string_view given(name);
+    std::string msg = "file '" +
+                      (given.size() > 160 ? std::string(given.substr(0, 160)) + "..."
+                                          : std::string(given)) +
+                      "': ";
     if (config_root[0] == '\0') {
       copy_error(err, (msg + "file access is not granted to scripts").c_str());
       return false;
