@@ -22,6 +22,8 @@ Command add_profile_command(CLI::App& parent);
 Command add_mesh_command(CLI::App& parent);
 /// `ridge bench lod`: per-frame ROAM cost and error along a camera path (cmd_roam.cpp).
 Command add_bench_lod_command(CLI::App& bench);
+/// `ridge report`: speed versus error of ROAM and two comparators (cmd_report.cpp).
+Command add_report_command(CLI::App& parent);
 /// `ridge deform --edits EDITS.json [--save STATE.bin]`: apply edits, save the state (JSON report).
 Command add_deform_command(CLI::App& parent);
 /// `ridge bench deform`: ms per crater edit for several radii (JSON).

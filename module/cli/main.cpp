@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   commands.push_back(add_query_command(app));
   commands.push_back(add_profile_command(app));
   commands.push_back(add_mesh_command(app));
+  commands.push_back(add_report_command(app));
   commands.push_back(add_deform_command(app));
   auto* bench = app.add_subcommand("bench", "Benchmarks that print JSON");
   bench->require_subcommand(1);

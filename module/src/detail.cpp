@@ -757,10 +757,22 @@ bool DetailCache::request(const DetailTileKey& key, bool urgent) {
   else
     s.queue.push_back(key);
   lock.unlock();
-  if (s.executor)
-    s.executor([st = state_] { State::run_one(st); });
-  else
+  if (!s.executor) {
     s.work_cv.notify_one();
+    return false;
+  }
+  try {
+    s.executor([st = state_] { State::run_one(st); });
+  } catch (...) {
+    // The engine's job system refused the job: withdraw the request, or every later job would
+    // drain the queue one key behind (each job takes the front key) and one tile would never come.
+    lock.lock();
+    if (auto q = std::find(s.queue.begin(), s.queue.end(), key); q != s.queue.end()) {
+      s.queue.erase(q);
+      s.pending.erase(key);
+    }
+    throw;
+  }
   return false;
 }
 

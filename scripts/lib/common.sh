@@ -13,6 +13,8 @@ RIDGELINE_PACKAGES=(
   libglfw3-dev libimgui-dev libegl-dev libgl1-mesa-dri libegl-mesa0 libglx-mesa0
   xvfb xauth
 )
+# Only for scripts/report.sh (the speed-versus-error report): plots and the CSV-to-plot step.
+RIDGELINE_REPORT_PACKAGES=(gnuplot-nox python3)
 
 # Installs the given Debian packages that are missing, through sudo when not root.
 ensure_packages() {

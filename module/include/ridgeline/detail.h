@@ -213,7 +213,9 @@ struct DetailCacheDesc {
   std::uint32_t worker_threads = 2;
   /// Optional job system of the embedding engine: called from request(), after the cache's lock
   /// is released, with a job to run once on any thread (it may also run it inline). The job is
-  /// self-contained and safe to run after the cache is destroyed (it then does nothing).
+  /// self-contained and safe to run after the cache is destroyed (it then does nothing). If the
+  /// executor throws, request() withdraws the request (as if it had not been made) and lets the
+  /// exception propagate; a job the executor accepts but never runs leaves its tile pending.
   std::function<void(std::function<void()>)> executor;
 };
 

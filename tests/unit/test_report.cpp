@@ -1,0 +1,277 @@
+// The comparators and the measurement of `ridge report` (module/cli/report/meshes.h): the uniform
+// grid and the CDLOD quadtree are crack-free and cover the terrain, the error measurement agrees
+// with a brute-force reference and with RoamView::measure_error, triangle counts match.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "report/meshes.h"
+#include "ridgeline/edit.h"
+#include "ridgeline/landscape.h"
+
+namespace ridgeline::report {
+namespace {
+
+std::shared_ptr<const Terrain> field(std::uint32_t w, std::uint32_t h, double sx = 1.0,
+                                     double sz = 1.0, double origin = 0.0) {
+  HeightfieldDesc d;
+  d.width = w;
+  d.height = h;
+  d.spacing_x = sx;
+  d.spacing_z = sz;
+  d.origin_x = d.origin_z = origin;
+  std::vector<float> v(std::size_t(w) * h);
+  for (std::uint32_t j = 0; j < h; ++j)
+    for (std::uint32_t i = 0; i < w; ++i)
+      v[i + std::size_t(j) * w] = static_cast<float>(
+          20 * std::sin(0.21 * i) * std::cos(0.17 * j) + 7 * std::sin(0.9 * i + 1.3 * j) + 30);
+  auto hf = Heightfield::create(d, v);
+  EXPECT_TRUE(hf.ok()) << hf.error().message;
+  return Terrain::create(std::move(*hf));
+}
+
+Camera look(const glm::dvec3& eye, const glm::dvec3& target) {
+  Camera c;
+  c.eye = eye;
+  c.target = target;
+  return c;
+}
+
+TEST(ReportSurface, HeightsAtSamplesAreExactAndBetweenFollowTheDiagonalRule) {
+  auto t = field(9, 7, 2.0, 3.0, 100.0);
+  const Heightfield& hf = t->heightfield();
+  for (std::uint32_t j = 0; j < 7; ++j)
+    for (std::uint32_t i = 0; i < 9; ++i) EXPECT_EQ(surface_height(hf, i, j), hf.world(i, j));
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0, 8), v(0, 6);
+  for (int k = 0; k < 500; ++k) {
+    const double a = u(rng), b = v(rng);
+    const auto q = t->height(100 + 2 * a, 100 + 3 * b);
+    ASSERT_TRUE(q.has_value());
+    EXPECT_NEAR(surface_height(hf, a, b), *q, 1e-4);  // the query interpolates in float
+  }
+}
+
+TEST(ReportUniformGrid, IsWatertightAndCoversTheTerrain) {
+  for (auto [w, h] : {std::pair{33u, 33u}, {40u, 27u}, {2u, 2u}}) {
+    auto t = field(w, h, 1.5, 0.7);
+    for (double n : {2.0, 50.0, 700.0, 5000.0}) {
+      const UniformGrid g = UniformGrid::for_triangles(t->heightfield(), n);
+      const DrawnMesh m = g.mesh(t->heightfield());
+      EXPECT_EQ(m.triangles(), g.triangles());
+      EXPECT_EQ(check_watertight(t->heightfield(), m), "") << w << "x" << h << " n=" << n;
+    }
+  }
+}
+
+TEST(ReportUniformGrid, MatchesTriangleCountsWithinFivePercent) {
+  auto t = field(1025, 700, 1.0, 2.0);
+  for (double n : {100.0, 999.0, 5000.0, 24583.0, 123071.0}) {
+    const UniformGrid g = UniformGrid::for_triangles(t->heightfield(), n);
+    EXPECT_NEAR(double(g.triangles()) / n, 1.0, 0.05) << n;
+  }
+}
+
+// Cameras all over a 129 x 129 field: high, low, looking along and down.
+std::vector<Camera> cameras() {
+  std::vector<Camera> c;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> xz(-20, 150), y(35, 300), t(0, 128);
+  for (int k = 0; k < 12; ++k)
+    c.push_back(look({xz(rng), y(rng), xz(rng)}, {t(rng), 20, t(rng)}));
+  c.push_back(look({64, 400, 64}, {64.1, 0, 64}));
+  return c;
+}
+
+TEST(ReportCdlod, MorphedSelectionIsWatertightAndCoversTheTerrain) {
+  auto t = field(129, 129);
+  for (std::uint32_t g : {4u, 8u}) {
+    const Cdlod cd(t->heightfield(), g);
+    int multi_level = 0;
+    for (double scale : {1.0, 1.7, 4.0}) {
+      for (const Camera& c : cameras()) {
+        const auto s = cd.select(c, cd.min_r0() * scale, /*cull=*/false);
+        std::uint32_t lo = 99, hi = 0;
+        for (const auto& ch : s.chunks) {
+          lo = std::min(lo, ch.level);
+          hi = std::max(hi, ch.level);
+        }
+        multi_level += hi > lo;
+        EXPECT_EQ(check_watertight(t->heightfield(), cd.mesh(s, c, true)), "")
+            << "grid " << g << " r0 x" << scale << " eye " << c.eye.x << "," << c.eye.y << ","
+            << c.eye.z;
+      }
+    }
+    EXPECT_GT(multi_level, 3) << "few cameras mixed levels: the test would prove little";
+  }
+}
+
+TEST(ReportCdlod, WithoutMorphingLevelsMeetWithTJunctions) {
+  // The check must be able to fail: unmorphed chunks of two levels leave cracks.
+  auto t = field(129, 129);
+  const Cdlod cd(t->heightfield(), 8);
+  int cracked = 0;
+  for (const Camera& c : cameras()) {
+    const auto s = cd.select(c, cd.min_r0(), false);
+    cracked += !check_watertight(t->heightfield(), cd.mesh(s, c, false)).empty();
+  }
+  EXPECT_GT(cracked, 0);
+}
+
+TEST(ReportCdlod, NonSquareFieldNotAPowerOfTwoIsCovered) {
+  auto t = field(95, 90, 598, 927);  // elev.tif's shape and cell size
+  const Cdlod cd(t->heightfield(), 8);
+  const Camera c = look({20000, 3000, 30000}, {40000, 0, 60000});
+  const auto s = cd.select(c, cd.min_r0() * 1.3, false);
+  EXPECT_EQ(check_watertight(t->heightfield(), cd.mesh(s, c, true)), "");
+}
+
+TEST(ReportCdlod, MatchesAFeasibleTriangleTargetWithinTenPercent) {
+  auto t = field(1025, 1025);
+  const Cdlod cd(t->heightfield(), 8);
+  std::vector<Camera> path;
+  for (int k = 0; k < 30; ++k) {
+    const double a = 0.2 * k;
+    path.push_back(look({512 + 300 * std::cos(a), 120, 512 + 300 * std::sin(a)}, {512, 20, 512}));
+  }
+  // Feasible targets lie between the shortest ranges the morph allows and full detail in view.
+  const double least = cd.match(path, 0).median, most = cd.match(path, 1e12).median;
+  ASSERT_LT(least * 4, most);
+  for (double target : {least * 1.3, std::sqrt(least * most), most * 0.7}) {
+    const auto m = cd.match(path, target);
+    EXPECT_GE(m.r0, cd.min_r0());
+    EXPECT_NEAR(m.median / target, 1.0, 0.10) << target;
+  }
+}
+
+TEST(ReportCdlod, RefreshAfterAnEditEqualsARebuiltQuadtree) {
+  HeightfieldDesc d;
+  d.width = d.height = 129;
+  std::vector<float> v(129 * 129);
+  for (std::size_t k = 0; k < v.size(); ++k) v[k] = float(30 + 10 * std::sin(0.1 * double(k % 129)));
+  auto hf = Heightfield::create(d, v);
+  ASSERT_TRUE(hf.ok());
+  auto t = Terrain::create(std::move(*hf));
+  Cdlod cd(t->heightfield(), 8);
+  Edit e;
+  e.brush = Brush::kCrater;
+  e.x = 70;
+  e.z = 40;
+  e.radius = 12;
+  e.depth = 30;  // deep: the node boxes around it must grow
+  auto r = t->apply_edit(e);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  ASSERT_FALSE(r->empty());
+  cd.refresh(std::int64_t(r->changed.min.x) - 1, std::int64_t(r->changed.min.z) - 1,
+             std::int64_t(r->changed.max.x) + 1, std::int64_t(r->changed.max.z) + 1);
+  const Cdlod rebuilt(t->heightfield(), 8);
+  EXPECT_EQ(cd.min_r0(), rebuilt.min_r0());
+  for (const Camera& c : cameras()) {
+    const auto a = cd.select(c, rebuilt.min_r0() * 1.2, false);
+    const auto b = rebuilt.select(c, rebuilt.min_r0() * 1.2, false);
+    ASSERT_EQ(a.chunks.size(), b.chunks.size());
+    EXPECT_EQ(a.triangles, b.triangles);
+    EXPECT_EQ(check_watertight(t->heightfield(), cd.mesh(a, c, true)), "");
+  }
+}
+
+// Brute force: for each lattice vertex in view, search every triangle of the mesh.
+MeshError brute_force(const Heightfield& hf, const DrawnMesh& m, const Camera& c) {
+  const ViewFrustum f(c);
+  MeshError out;
+  double sum2 = 0;
+  for (std::uint32_t j = 0; j < hf.height(); ++j)
+    for (std::uint32_t i = 0; i < hf.width(); ++i) {
+      const glm::dvec3 p(hf.origin_x() + i * hf.spacing_x(), hf.world(i, j),
+                         hf.origin_z() + j * hf.spacing_z());
+      double d;
+      if (!f.contains(p, &d)) continue;
+      ++out.vertices;
+      bool found = false;
+      for (std::size_t t = 0; t < m.triangles() && !found; ++t) {
+        const glm::dvec3 *a = &m.corners[3 * t], *b = a + 1, *cc = a + 2;
+        const double area = (b->x - a->x) * (cc->z - a->z) - (b->z - a->z) * (cc->x - a->x);
+        if (std::abs(area) < 1e-12) continue;
+        const double w1 = ((i - a->x) * (cc->z - a->z) - (j - a->z) * (cc->x - a->x)) / area;
+        const double w2 = ((b->x - a->x) * (j - a->z) - (b->z - a->z) * (i - a->x)) / area;
+        if (w1 < -1e-9 || w2 < -1e-9 || w1 + w2 > 1 + 1e-9) continue;
+        const double h = a->y + w1 * (b->y - a->y) + w2 * (cc->y - a->y);
+        const double e = std::abs(h - p.y);
+        out.max_m = std::max(out.max_m, e);
+        out.max_px = std::max(out.max_px, e * f.scale / d);
+        sum2 += e * e;
+        found = true;
+      }
+      out.uncovered += !found;
+    }
+  out.rms_m = std::sqrt(sum2 / double(out.vertices - out.uncovered));
+  return out;
+}
+
+TEST(ReportMeasure, AgreesWithBruteForceOnASmallField) {
+  auto t = field(33, 33, 2.0, 1.0);
+  const Heightfield& hf = t->heightfield();
+  const Cdlod cd(hf, 4);
+  for (const Camera& c : {look({-10, 60, -10}, {40, 0, 20}), look({33, 25, 16}, {0, 20, 16}),
+                          look({32, 200, 16}, {32.1, 0, 16})}) {
+    const DrawnMesh meshes[2] = {UniformGrid::for_triangles(hf, 150).mesh(hf),
+                                 cd.mesh(cd.select(c, cd.min_r0(), false), c, true)};
+    for (const DrawnMesh& m : meshes) {
+      DisplayedHeights shown(hf, 1);
+      shown.rasterize(m);
+      const MeshError a = measure(hf, shown, c), b = brute_force(hf, m, c);
+      ASSERT_GT(a.vertices, 50u);
+      EXPECT_EQ(a.vertices, b.vertices);
+      EXPECT_EQ(a.uncovered, 0u);
+      EXPECT_EQ(b.uncovered, 0u);
+      if (&m == &meshes[0]) {
+        EXPECT_GT(b.max_m, 0.1);  // coarse: the comparison is not of zeros
+      }
+      EXPECT_NEAR(a.max_m, b.max_m, 1e-4);
+      EXPECT_NEAR(a.rms_m, b.rms_m, 1e-4);
+      EXPECT_NEAR(a.max_px, b.max_px, 1e-3 * std::max(1.0, b.max_px));
+    }
+  }
+}
+
+TEST(ReportMeasure, AgreesWithRoamViewOnItsOwnMesh) {
+  auto t = field(129, 129, 1.0, 1.0, 1e6);
+  auto l = Landscape::create(t, {.patch_exponent = 5});
+  ASSERT_TRUE(l.ok());
+  auto v = RoamView::create(*l, {.threshold = 3.0});
+  ASSERT_TRUE(v.ok());
+  const Camera c = look({1e6 - 20, 90, 1e6 - 20}, {1e6 + 64, 10, 1e6 + 64});
+  ASSERT_TRUE((*v)->converge(c).ok());
+  const auto ref = (*v)->measure_error(c);
+  DisplayedHeights shown(t->heightfield(), 1);
+  shown.rasterize(roam_mesh(**v, c, false));
+  const MeshError e = measure(t->heightfield(), shown, c);
+  EXPECT_EQ(e.vertices, ref.vertices);
+  EXPECT_EQ(e.uncovered, 0u);
+  EXPECT_GT(ref.max_m, 0.1);
+  EXPECT_NEAR(e.max_m, ref.max_m, 1e-4);
+  EXPECT_NEAR(e.rms_m, ref.rms_m, 1e-4);
+  EXPECT_NEAR(e.max_px, ref.max_px, 1e-3);
+  EXPECT_EQ(check_watertight(t->heightfield(), roam_mesh(**v, c, false)), "");
+}
+
+TEST(ReportMeasure, PoppingIsZeroForAnUnchangedMeshAndTheHeightJumpOtherwise) {
+  auto t = field(33, 33);
+  const Heightfield& hf = t->heightfield();
+  const Camera c = look({16, 40, -30}, {16, 20, 16});
+  DisplayedHeights a(hf, 1), b(hf, 1);
+  a.rasterize(UniformGrid{4, 4}.mesh(hf));
+  b.rasterize(UniformGrid{4, 4}.mesh(hf));
+  EXPECT_EQ(popping_px(hf, a, c, b, c), 0.0);
+  DrawnMesh raised = UniformGrid{4, 4}.mesh(hf);
+  for (auto& p : raised.corners) p.y += 0.5;
+  b.rasterize(raised);
+  const double pop = popping_px(hf, a, c, b, c);
+  // 0.5 m at the nearest vertex in view: between 0.5 * scale / far-most and / near-most.
+  EXPECT_GT(pop, 0.5 * projection_scale(c) / 100.0);
+  EXPECT_LT(pop, 0.5 * projection_scale(c) / 20.0);
+}
+
+}  // namespace
+}  // namespace ridgeline::report

@@ -1,0 +1,136 @@
+// `ridge report --smoke` end to end: the JSON and CSV are complete and sane (what CI runs of the
+// report; the full report is scripts/report.sh).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+namespace {
+
+using nlohmann::json;
+
+std::string slurp(const std::string& p) {
+  std::ifstream f(p);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+bool finite_number(const json& j) { return j.is_number() && std::isfinite(j.get<double>()); }
+
+TEST(ReportSmoke, JsonAndCsvAreCompleteAndSane) {
+  const std::string out = std::string(RIDGELINE_TEST_TMP) + "/report_smoke";
+  const std::string cmd = std::string(RIDGE) + " report --smoke --out " + out + " --work " + out +
+                          "/work 2> " + out + ".log";
+  std::system(("mkdir -p " + out).c_str());
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << slurp(out + ".log");
+  const json r = json::parse(slurp(out + "/report.json"));
+  ASSERT_TRUE(r["smoke"].get<bool>());
+
+  // Every scene, path and setting has the four modes with finite figures.
+  std::size_t rows = 0;
+  auto check_scene = [&](const json& sc, bool all_paths, bool storm = false) {
+    SCOPED_TRACE(sc["name"].get<std::string>());
+    ASSERT_EQ(sc["paths"].size(), all_paths ? 6u : 2u);
+    for (const json& p : sc["paths"]) {
+      SCOPED_TRACE(p["name"].get<std::string>());
+      for (const json& st : p["settings"]) {
+        const std::string kind = st["kind"];
+        const double value = st["value"];
+        ASSERT_EQ(st["modes"].size(), 4u);
+        std::map<std::string, json> m;
+        for (const json& x : st["modes"]) m[x["mode"]] = x;
+        for (const char* name : {"roam_coherent", "roam_rebuild", "uniform_grid", "cdlod"}) {
+          SCOPED_TRACE(name);
+          ASSERT_TRUE(m.count(name));
+          const json& x = m[name];
+          ++rows;
+          for (const char* f : {"triangles_median", "update_ms_median", "update_ms_p99",
+                                "changes_per_frame_median", "error_max_m", "error_rms_m",
+                                "screen_error_max_px", "screen_error_p99_px", "popping_max_px",
+                                "memory_bytes"})
+            EXPECT_TRUE(finite_number(x[f])) << f << " = " << x[f];
+          EXPECT_GT(x["measured_frames"].get<int>(), 0);
+          EXPECT_GT(x["measured_vertices_median"].get<double>(), 0);
+          EXPECT_EQ(x["uncovered_vertices"].get<int>(), 0) << "holes in the drawn mesh";
+          EXPECT_GE(x["error_max_m"].get<double>(), x["error_rms_m"].get<double>());
+          EXPECT_GE(x["screen_error_max_px"].get<double>(),
+                    x["screen_error_p99_px"].get<double>());
+          EXPECT_GE(x["update_ms_p99"].get<double>(), x["update_ms_median"].get<double>());
+          EXPECT_GT(x["memory_bytes"].get<double>(), 0);
+        }
+        // ROAM converges to the threshold every frame: its screen error is at most the threshold.
+        if (kind == "threshold") {
+          EXPECT_LE(m["roam_coherent"]["screen_error_max_px"].get<double>(), value + 1e-9);
+        }
+        if (kind == "triangles") {
+          EXPECT_LE(m["roam_coherent"]["triangles_median"].get<double>(), value);
+        }
+        // The uniform grid is matched to ROAM's median count within 10 % (5 % stated in tests).
+        const double target = m["roam_coherent"]["triangles_median"];
+        if (target >= 50) {
+          EXPECT_NEAR(m["uniform_grid"]["triangles_median"].get<double>() / target, 1.0, 0.10);
+        }
+        EXPECT_TRUE(finite_number(m["cdlod"]["matched_ratio"]));
+        // A static grid never pops, except where the storm's craters change the surface.
+        if (storm) {
+          EXPECT_GT(m["uniform_grid"]["popping_max_px"].get<double>(), 0.0);
+        } else {
+          EXPECT_EQ(m["uniform_grid"]["popping_max_px"].get<double>(), 0.0);
+        }
+      }
+    }
+  };
+  ASSERT_EQ(r["scenes"].size(), 2u);
+  check_scene(r["scenes"][0], true);
+  // The deformation storm: craters every frame, flyover and drive; apply_edit timed per mode.
+  const json& storm = r["scenes"][1];
+  ASSERT_EQ(storm["name"], "storm_synthetic129");
+  check_scene(storm, false, true);
+  for (const json& p : storm["paths"])
+    for (const json& st : p["settings"])
+      for (const json& m : st["modes"]) EXPECT_TRUE(finite_number(m["edit_ms_median"])) << m;
+
+  // Hard cases: all present; the far origins give the same mesh and errors as origin 0.
+  std::map<std::string, json> hard;
+  for (const json& h : r["hard_cases"]) hard[h["name"]] = h;
+  for (const char* n : {"origin_0", "origin_1e6", "origin_1e7", "cliff_1000m", "flat",
+                        "saturated_u16", "nonfinite_f32_refuse", "nonfinite_f32_fill_nearest",
+                        "huge_f32"})
+    ASSERT_TRUE(hard.count(n)) << n;
+  for (const char* n : {"origin_0", "origin_1e6", "origin_1e7", "cliff_1000m", "flat",
+                        "saturated_u16", "nonfinite_f32_fill_nearest"})
+    check_scene(hard[n], false);
+  auto coherent = [&](const char* n, const char* f) {
+    return hard[n]["paths"][0]["settings"][0]["modes"][0][f].get<double>();
+  };
+  for (const char* far : {"origin_1e6", "origin_1e7"}) {
+    EXPECT_EQ(coherent(far, "triangles_median"), coherent("origin_0", "triangles_median"));
+    EXPECT_NEAR(coherent(far, "error_rms_m"), coherent("origin_0", "error_rms_m"), 1e-6);
+    EXPECT_NEAR(coherent(far, "error_max_m"), coherent("origin_0", "error_max_m"), 1e-6);
+  }
+  EXPECT_EQ(coherent("flat", "error_max_m"), 0.0);
+  EXPECT_EQ(coherent("flat", "triangles_median"), 2.0);
+  EXPECT_FALSE(hard["nonfinite_f32_refuse"]["loaded"].get<bool>());
+  EXPECT_NE(hard["nonfinite_f32_refuse"]["loader_messages"].dump().find("nan"), std::string::npos);
+  EXPECT_NE(hard["nonfinite_f32_fill_nearest"]["loader_messages"].dump().find("3 samples filled"),
+            std::string::npos);
+  EXPECT_EQ(r["not_done"].size(), 1u);  // the detail world
+
+  // CSV: one row per scene, path, setting and mode, 17 fields, no header.
+  std::ifstream csv(out + "/report.csv");
+  std::size_t lines = 0;
+  for (std::string line; std::getline(csv, line); ++lines) {
+    EXPECT_EQ(std::count(line.begin(), line.end(), ','), 16) << line;
+    if (lines == 0) {
+      EXPECT_EQ(line.rfind("synthetic129,flyover,threshold,2,roam_coherent,", 0), 0u) << line;
+    }
+  }
+  EXPECT_EQ(lines, rows);
+}
+
+}  // namespace
