@@ -61,4 +61,12 @@ import json, sys
 print(json.dumps([json.loads(l) for l in open(sys.argv[1])], indent=1))
 PY
 python3 docs/benchmarks/tables.py "$out" > "$out/tables.md"
-echo "wrote $out/queries_*.json, $out/lod_summary.json, $out/tables.md (per-frame JSON in $work)"
+
+# Detail streaming (issue 4): a 100 km x 100 km world (the default terrain stretched to
+# 3126 x 3126 samples at 32 m, heights x 4) with 7 detail levels (0.25 m, 1.6e11 virtual
+# samples), flown over at 300 m/s, 50 m above the ground, with 2 workers, all terrain data
+# (base, detail field, tiles) within 256 MiB.
+"$ridge" bench detail --default-terrain --default-size 3126 --spacing 32 --height-scale 4 \
+  --detail-levels 7 --terrain-budget-mb 256 --workers 2 --speed 300 --altitude 50 --prefill \
+  --json "$out/detail_flight.json"
+echo "wrote $out/queries_*.json, $out/lod_summary.json, $out/tables.md, $out/detail_flight.json (per-frame JSON in $work)"

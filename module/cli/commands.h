@@ -28,6 +28,8 @@ Command add_report_command(CLI::App& parent);
 Command add_deform_command(CLI::App& parent);
 /// `ridge bench deform`: ms per crater edit for several radii (JSON).
 Command add_bench_deform_command(CLI::App& bench);
+/// `ridge bench detail`: detail tile generation and the detail cache along a flight (JSON).
+Command add_bench_detail_command(CLI::App& bench);
 /// `ridge bench queries`: query speed (JSON), measured by bench_queries.h.
 Command add_bench_queries_command(CLI::App& bench);
 

@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   commands.push_back(add_bench_queries_command(*bench));
   commands.push_back(add_bench_lod_command(*bench));
   commands.push_back(add_bench_deform_command(*bench));
+  commands.push_back(add_bench_detail_command(*bench));
 
   try {
     app.parse(argc, argv);

@@ -23,6 +23,11 @@ void TerrainArgs::add_to(CLI::App& app) {
                           "Use the built-in default terrain (1025 x 1025 samples, 2 m spacing, "
                           "seed 1337)")
                  ->group(g);
+  app.add_option("--default-size", default_size_,
+                 "Samples per side of the default terrain, 2..65536 (default 1025; the same "
+                 "landscape, stretched)")
+      ->type_name("N")
+      ->group(g);
   hm->excludes(dt);
   dt->excludes(hm);
   app.add_option("--raw-size", raw_size_, "Size of a raw heightmap in samples")
@@ -89,6 +94,23 @@ void TerrainArgs::add_to(CLI::App& app) {
                  "Amplitude ratio between successive detail levels, (0, 1] (default 0.5)")
       ->type_name("G")
       ->group(gd);
+  const struct {
+    const char* flag;
+    std::string* value;
+    const char* help;
+  } shape_flags[] = {
+      {"--detail-flat-shape", &detail_flat_shape_,
+       "Detail shape (amplitude factor) on flat ground, 0..1 (default 0.25)"},
+      {"--detail-steep-shape", &detail_steep_shape_,
+       "Detail shape on steep ground, 0..1 (default 1)"},
+      {"--detail-flat-slope", &detail_flat_slope_,
+       "Slope (rise/run) at or below which ground is flat for the detail (default 0.05)"},
+      {"--detail-steep-slope", &detail_steep_slope_,
+       "Slope at or above which ground is steep for the detail (default 0.6)"},
+      {"--detail-blur-radius", &detail_blur_radius_,
+       "Box-blur radius of the slope map in stored samples, 0..64 (default 2)"}};
+  for (const auto& f : shape_flags)
+    app.add_option(f.flag, *f.value, f.help)->type_name("X")->group(gd);
   app.add_option("--detail-budget-mb", detail_budget_mb_,
                  "Memory budget of the detail tile cache in MiB (default 256)")
       ->type_name("MB")
@@ -167,11 +189,18 @@ Result<Heightfield> TerrainArgs::load_heightfield() const {
   auto desc = placement();
   if (!desc) return desc.error();
 
+  if (given("--default-size") && !default_terrain_)
+    return Error{"--default-size applies to --default-terrain"};
   if (default_terrain_) {
     for (const char* flag : {"--raw-size", "--raw-type", "--channel", "--materials"})
       if (given(flag))
         return Error{std::string(flag) + " applies to --heightmap, not to --default-terrain"};
-    const DefaultTerrainParams params;
+    DefaultTerrainParams params;
+    if (given("--default-size")) {
+      auto n = parse_count(default_size_, "--default-size", 2, 65536);
+      if (!n) return n.error();
+      params.size = static_cast<std::uint32_t>(*n);
+    }
     HeightfieldDesc d = *desc;
     d.width = d.height = params.size;
     d.name = "default terrain";
@@ -223,9 +252,7 @@ Result<Heightfield> TerrainArgs::load_heightfield() const {
   return io::load_heightmap(heightmap_, options);
 }
 
-Result<std::shared_ptr<Terrain>> TerrainArgs::load_terrain() const {
-  auto hf = load_heightfield();
-  if (!hf) return hf.error();
+Result<DetailParams> TerrainArgs::detail_params() const {
   DetailParams detail;
   detail.levels = 0;
   if (given("--detail-levels")) {
@@ -234,24 +261,47 @@ Result<std::shared_ptr<Terrain>> TerrainArgs::load_terrain() const {
     detail.levels = static_cast<std::uint32_t>(*n);
   }
   if (detail.levels == 0) {
-    for (const char* flag : {"--detail-seed", "--detail-amplitude", "--detail-gain", "--detail-budget-mb"})
+    for (const char* flag : {"--detail-seed", "--detail-amplitude", "--detail-gain",
+                             "--detail-budget-mb", "--detail-flat-shape", "--detail-steep-shape",
+                             "--detail-flat-slope", "--detail-steep-slope", "--detail-blur-radius"})
       if (given(flag)) return Error{std::string(flag) + " needs --detail-levels N (N >= 1)"};
   }
   if (given("--detail-seed")) {
-    auto v = parse_count(detail_seed_, "--detail-seed", 0, std::numeric_limits<std::uint64_t>::max());
+    auto v =
+        parse_count(detail_seed_, "--detail-seed", 0, std::numeric_limits<std::uint64_t>::max());
     if (!v) return v.error();
     detail.seed = *v;
   }
-  if (given("--detail-amplitude")) {
-    auto v = parse_finite(detail_amplitude_, "--detail-amplitude");
+  if (given("--detail-blur-radius")) {
+    auto v = parse_count(detail_blur_radius_, "--detail-blur-radius", 0, 64);
     if (!v) return v.error();
-    detail.amplitude = *v;
+    detail.blur_radius = static_cast<std::uint32_t>(*v);
   }
-  if (given("--detail-gain")) {
-    auto v = parse_finite(detail_gain_, "--detail-gain");
+  const struct {
+    const char* flag;
+    const std::string& text;
+    double* field;
+  } reals[] = {{"--detail-amplitude", detail_amplitude_, &detail.amplitude},
+               {"--detail-gain", detail_gain_, &detail.gain},
+               {"--detail-flat-shape", detail_flat_shape_, &detail.flat_shape},
+               {"--detail-steep-shape", detail_steep_shape_, &detail.steep_shape},
+               {"--detail-flat-slope", detail_flat_slope_, &detail.flat_slope},
+               {"--detail-steep-slope", detail_steep_slope_, &detail.steep_slope}};
+  for (const auto& r : reals) {
+    if (!given(r.flag)) continue;
+    auto v = parse_finite(r.text, r.flag);
     if (!v) return v.error();
-    detail.gain = *v;
+    *r.field = *v;
   }
+  if (auto s = validate_detail_params(detail); !s) return Error{s.message()};
+  return detail;
+}
+
+Result<std::shared_ptr<Terrain>> TerrainArgs::load_terrain() const {
+  auto hf = load_heightfield();
+  if (!hf) return hf.error();
+  auto detail = detail_params();
+  if (!detail) return detail.error();
   DetailCacheDesc cache;
   cache.worker_threads = 0;  // tools: synchronous, reproducible
   if (given("--detail-budget-mb")) {
@@ -259,7 +309,7 @@ Result<std::shared_ptr<Terrain>> TerrainArgs::load_terrain() const {
     if (!v) return v.error();
     cache.budget_bytes = std::size_t(*v) << 20;
   }
-  auto created = Terrain::create(std::move(*hf), detail, cache);
+  auto created = Terrain::create(std::move(*hf), *detail, cache);
   if (!created) return Error{created.error().message};
   std::shared_ptr<Terrain> terrain = std::move(*created);
   if (given("--load")) {

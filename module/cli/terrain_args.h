@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 
+#include "ridgeline/detail.h"
 #include "ridgeline/heightfield.h"
 #include "ridgeline/result.h"
 #include "ridgeline/terrain.h"
@@ -20,8 +21,9 @@ class TerrainArgs {
  public:
   /// Adds --heightmap, --default-terrain, --raw-size, --raw-type, --spacing, --height-scale,
   /// --height-offset, --origin, --nodata, --fill, --max-samples, --channel, --materials, --load and
-  /// the detail flags (--detail-levels, --detail-seed, --detail-amplitude, --detail-gain,
-  /// --detail-budget-mb) to
+  /// --default-size and the detail flags (--detail-levels, --detail-seed, --detail-amplitude,
+  /// --detail-gain, --detail-flat-shape, --detail-steep-shape, --detail-flat-slope,
+  /// --detail-steep-slope, --detail-blur-radius, --detail-budget-mb) to
   /// `app`, in an option group "Terrain". The object must outlive the parse.
   void add_to(CLI::App& app);
 
@@ -32,19 +34,26 @@ class TerrainArgs {
   /// state of --load STATE.bin applied when given.
   Result<std::shared_ptr<Terrain>> load_terrain() const;
 
+  /// The DetailParams of the detail flags (levels 0 without --detail-levels), validated; the
+  /// other detail flags without --detail-levels N >= 1 are refused.
+  Result<DetailParams> detail_params() const;
+
   /// "default terrain" or the heightmap path: for reports.
   std::string source() const;
+  /// True when `flag` (e.g. "--detail-budget-mb") was given.
+  bool given(const char* flag) const;
 
  private:
   Result<HeightfieldDesc> placement() const;
-  bool given(const char* flag) const;
 
   std::string heightmap_;
   bool default_terrain_ = false;
   std::string raw_size_, raw_type_, spacing_, height_scale_, height_offset_, origin_, nodata_,
-      fill_, max_samples_, channel_, materials_, load_;
+      fill_, max_samples_, channel_, materials_, load_, default_size_;
   // Procedural detail (docs/detail.md): --detail-levels N --detail-seed S and the shape flags.
-  std::string detail_levels_, detail_seed_, detail_amplitude_, detail_gain_, detail_budget_mb_;
+  std::string detail_levels_, detail_seed_, detail_amplitude_, detail_gain_, detail_budget_mb_,
+      detail_flat_shape_, detail_steep_shape_, detail_flat_slope_, detail_steep_slope_,
+      detail_blur_radius_;
   CLI::App* app_ = nullptr;
 };
 

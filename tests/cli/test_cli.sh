@@ -258,6 +258,62 @@ run bench deform --default-terrain --count 5 --radii 5,20
 expect "bench deform" 0
 contains "bench deform reports medians" '"median_ms"'
 
+# ---- bench detail --------------------------------------------------------------------------------
+# A short synchronous flight over the default terrain (2 km), 3 levels: the JSON's figures.
+run bench detail --default-terrain --detail-levels 3 --tile-reps 3 --workers 0 --distance 200 \
+  --frames-every 10 --json "$T/detail.json"
+expect "bench detail" 0
+out=$(cat "$T/detail.json")
+[ "$(grep -c '"level":' "$T/detail.json")" = 3 ] && ok || bad "bench detail: one tile figure per level"
+contains "bench detail tile bytes" '"tile_bytes": 72948'
+contains "bench detail frames" '"frames": 41,'
+contains "bench detail virtual samples" '"virtual_samples": 67125249.0'
+# Synchronous: every needed tile is there every frame, within the budget.
+contains "bench detail needed tiles resident" '"needed_resident_fraction_min": 1.0'
+contains "bench detail no late tile" '"worst_late_frames": 0,'
+contains "bench detail within budget" '"resident_within_budget": true'
+run bench detail --default-terrain --detail-levels 2 --tile-reps 3 --workers 2 --no-pace \
+  --distance 100 --frames-every 0 --budget-mb 8
+expect "bench detail asynchronous" 0
+contains "bench detail asynchronous mode" '"mode": "asynchronous"'
+run bench detail --default-terrain --detail-levels 2 --detail-gain 1.5
+expect "bench detail bad gain" 1 "gain is 1.5"
+run bench detail --default-terrain --detail-levels 13
+expect "bench detail too many levels" 1 "--detail-levels"
+run bench detail --default-terrain --detail-levels 0
+expect "bench detail no levels" 1 "--detail-levels must be >= 1"
+run bench detail --default-terrain --detail-levels 2 --detail-seed -1
+expect "bench detail bad seed" 1 "--detail-seed"
+run bench detail --default-terrain --detail-levels 2 --pixels 0
+expect "bench detail bad pixels" 1 "pixels is 0"
+run bench detail --default-terrain --detail-levels 2 --budget-mb 0.1
+expect "bench detail budget below one tile per level" 1 "budget"
+run bench detail --default-terrain --detail-levels 2 --budget-mb 8 --terrain-budget-mb 8
+expect "bench detail two budgets" 1 "exclude each other"
+run bench detail --default-terrain --detail-levels 2 --terrain-budget-mb 4
+expect "bench detail terrain budget below the base" 1 "already take"
+run bench detail --default-terrain --detail-levels 2 --from 5000,5000
+expect "bench detail start off the terrain" 1 "off the terrain"
+run bench detail --default-terrain --detail-levels 2 --speed 0
+expect "bench detail speed 0" 1 "--speed"
+run bench detail --default-terrain --detail-levels 2 --path "$T/missing.json"
+expect "bench detail missing path" 1 "missing.json"
+run bench detail --default-terrain --detail-levels 2 --path "$T/missing.json" --distance 5
+expect "bench detail path with built-in flight flags" 1 "not with --path"
+run bench detail --default-terrain --detail-levels 2 --detail-budget-mb 8
+expect "bench detail refuses the query cache budget" 1 "--budget-mb"
+run bench detail --default-terrain --detail-levels 2 --detail-flat-shape 2
+expect "bench detail bad flat shape" 1 "flat shape is 2"
+run info --default-terrain --detail-blur-radius 3
+expect "detail shape flag without levels" 1 "--detail-blur-radius needs --detail-levels"
+run info --heightmap "$PNG" --default-size 9
+expect "default size without the default terrain" 1 "--default-size applies"
+run info --default-terrain --default-size 1
+expect "default size 1" 1 "--default-size"
+run info --default-terrain --default-size 65
+expect "default size 65" 0
+contains "default size 65 gives 65 samples" '"width": 65'
+
 # ---- procedural detail flags -----------------------------------------------------------------------
 run info --heightmap "$PNG" --spacing 8 --detail-levels 3 --detail-seed 4
 expect "info with detail" 0

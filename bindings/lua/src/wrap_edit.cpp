@@ -57,15 +57,19 @@ Edit check_edit(lua_State* L, int arg) {
   return e;
 }
 
+// Copies a transaction's result or its error (no Lua calls).
+bool take_result(const Result<EditResult>& r, EditResult* out, char* err) noexcept {
+  if (!r) {
+    copy_error(err, r.error().message.c_str());
+    return false;
+  }
+  *out = *r;
+  return true;
+}
+
 bool do_edit(Terrain& t, const Edit& e, EditResult* out, char* err) noexcept {
   try {
-    auto r = t.apply_edit(e);
-    if (!r) {
-      copy_error(err, r.error().message.c_str());
-      return false;
-    }
-    *out = *r;
-    return true;
+    return take_result(t.apply_edit(e), out, err);
   } catch (const std::exception& ex) {
     copy_error(err, ex.what());
     return false;
@@ -114,13 +118,7 @@ bool do_file(bool confine, const char* root, Terrain& t, const char* name, FileO
       }
       return true;
     }
-    auto r = load_edits(t, path);
-    if (!r) {
-      copy_error(err, r.error().message.c_str());
-      return false;
-    }
-    *out = *r;
-    return true;
+    return take_result(load_edits(t, path), out, err);
   } catch (const std::exception& ex) {
     copy_error(err, ex.what());
     return false;
