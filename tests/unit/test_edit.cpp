@@ -160,7 +160,7 @@ TEST(Transaction, ViewsStayCrackFreeAndHonestAndQueriesSeeTheEdit) {
   for (int k = 0; k < 24; ++k) {
     const double x = u(rng), z = u(rng);
     auto r = t->apply_edit({.brush = k % 2 ? Brush::kCrater : Brush::kRaise, .x = x, .z = z,
-                            .radius = 6 + k % 13, .depth = 3});
+                            .radius = 6.0 + k % 13, .depth = 3});
     ASSERT_TRUE(r);
     if (r->empty()) continue;
     EXPECT_GT(r->view_nodes_updated, 0u);
