@@ -1,4 +1,5 @@
 // `ridge info`: what a terrain is, as JSON.
+#include <cmath>
 #include <cstdio>
 #include <memory>
 
@@ -41,6 +42,10 @@ int run_info(const InfoOptions& o) {
       {"memory_bytes", bytes},
       {"bytes_per_sample", double(bytes) / double(samples)},
       {"content_hash", hash},
+      {"detail_levels", (*terrain)->detail_levels()},
+      {"finest_spacing",
+       {std::ldexp(hf.spacing_x(), -int((*terrain)->detail_levels())),
+        std::ldexp(hf.spacing_z(), -int((*terrain)->detail_levels()))}},
   };
   if (auto s = write_json(j, o.json_path); !s) return report_error(s.message());
   return 0;

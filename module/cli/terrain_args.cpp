@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "cli_util.h"
+#include "ridgeline/detail.h"
 #include "ridgeline/edit.h"
 #include "ridgeline/io.h"
 
@@ -71,6 +72,27 @@ void TerrainArgs::add_to(CLI::App& app) {
                  "sample")
       ->type_name("FILE")
       ->group(g);
+  const std::string gd = "Procedural detail";
+  app.add_option("--detail-levels", detail_levels_,
+                 "Detail levels below the stored resolution, 0..12, each halving the spacing "
+                 "(default 0: none)")
+      ->type_name("N")
+      ->group(gd);
+  app.add_option("--detail-seed", detail_seed_, "Seed of the detail function (default 1)")
+      ->type_name("S")
+      ->group(gd);
+  app.add_option("--detail-amplitude", detail_amplitude_,
+                 "Amplitude of the first detail octave in metres where the shape is 1 (default 2)")
+      ->type_name("M")
+      ->group(gd);
+  app.add_option("--detail-gain", detail_gain_,
+                 "Amplitude ratio between successive detail levels, (0, 1] (default 0.5)")
+      ->type_name("G")
+      ->group(gd);
+  app.add_option("--detail-budget-mb", detail_budget_mb_,
+                 "Memory budget of the detail tile cache in MiB (default 256)")
+      ->type_name("MB")
+      ->group(gd);
   app.add_option("--load", load_,
                  "Apply the edit state saved by `ridge deform --save` (refused when it belongs to "
                  "another terrain)")
@@ -204,7 +226,42 @@ Result<Heightfield> TerrainArgs::load_heightfield() const {
 Result<std::shared_ptr<Terrain>> TerrainArgs::load_terrain() const {
   auto hf = load_heightfield();
   if (!hf) return hf.error();
-  std::shared_ptr<Terrain> terrain = Terrain::create(std::move(*hf));
+  DetailParams detail;
+  detail.levels = 0;
+  if (given("--detail-levels")) {
+    auto n = parse_count(detail_levels_, "--detail-levels", 0, kMaxDetailLevels);
+    if (!n) return n.error();
+    detail.levels = static_cast<std::uint32_t>(*n);
+  }
+  if (detail.levels == 0) {
+    for (const char* flag : {"--detail-seed", "--detail-amplitude", "--detail-gain", "--detail-budget-mb"})
+      if (given(flag)) return Error{std::string(flag) + " needs --detail-levels N (N >= 1)"};
+  }
+  if (given("--detail-seed")) {
+    auto v = parse_count(detail_seed_, "--detail-seed", 0, std::numeric_limits<std::uint64_t>::max());
+    if (!v) return v.error();
+    detail.seed = *v;
+  }
+  if (given("--detail-amplitude")) {
+    auto v = parse_finite(detail_amplitude_, "--detail-amplitude");
+    if (!v) return v.error();
+    detail.amplitude = *v;
+  }
+  if (given("--detail-gain")) {
+    auto v = parse_finite(detail_gain_, "--detail-gain");
+    if (!v) return v.error();
+    detail.gain = *v;
+  }
+  DetailCacheDesc cache;
+  cache.worker_threads = 0;  // tools: synchronous, reproducible
+  if (given("--detail-budget-mb")) {
+    auto v = parse_count(detail_budget_mb_, "--detail-budget-mb", 1, 1u << 20);
+    if (!v) return v.error();
+    cache.budget_bytes = std::size_t(*v) << 20;
+  }
+  auto created = Terrain::create(std::move(*hf), detail, cache);
+  if (!created) return Error{created.error().message};
+  std::shared_ptr<Terrain> terrain = std::move(*created);
   if (given("--load")) {
     auto r = load_edits(*terrain, load_);
     if (!r) return Error{"--load: " + r.error().message};

@@ -19,7 +19,9 @@ namespace ridgeline::cli {
 class TerrainArgs {
  public:
   /// Adds --heightmap, --default-terrain, --raw-size, --raw-type, --spacing, --height-scale,
-  /// --height-offset, --origin, --nodata, --fill, --max-samples, --channel, --materials and --load to
+  /// --height-offset, --origin, --nodata, --fill, --max-samples, --channel, --materials, --load and
+  /// the detail flags (--detail-levels, --detail-seed, --detail-amplitude, --detail-gain,
+  /// --detail-budget-mb) to
   /// `app`, in an option group "Terrain". The object must outlive the parse.
   void add_to(CLI::App& app);
 
@@ -41,6 +43,8 @@ class TerrainArgs {
   bool default_terrain_ = false;
   std::string raw_size_, raw_type_, spacing_, height_scale_, height_offset_, origin_, nodata_,
       fill_, max_samples_, channel_, materials_, load_;
+  // Procedural detail (docs/detail.md): --detail-levels N --detail-seed S and the shape flags.
+  std::string detail_levels_, detail_seed_, detail_amplitude_, detail_gain_, detail_budget_mb_;
   CLI::App* app_ = nullptr;
 };
 

@@ -5,6 +5,7 @@
 #include "ridgeline/detail.h"
 
 #include <algorithm>
+#include <atomic>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -241,9 +242,24 @@ std::size_t DetailTile::memory_bytes() const noexcept {
 Result<std::shared_ptr<const DetailField>> DetailField::create(
     std::shared_ptr<const Terrain> terrain, const DetailParams& params) {
   if (!terrain) return Error{"detail: no terrain given"};
+  auto f = build(*terrain, params);
+  if (!f) return f.error();
+  (*f)->keep_ = std::move(terrain);
+  return std::shared_ptr<const DetailField>(std::move(*f));
+}
+
+Result<std::shared_ptr<const DetailField>> DetailField::create_for(const Terrain& terrain,
+                                                                   const DetailParams& params) {
+  auto f = build(terrain, params);
+  if (!f) return f.error();
+  return std::shared_ptr<const DetailField>(std::move(*f));
+}
+
+Result<std::shared_ptr<DetailField>> DetailField::build(const Terrain& terrain,
+                                                        const DetailParams& params) {
   if (auto s = validate_detail_params(params); !s) return Error{s.message()};
   std::shared_ptr<DetailField> f(new DetailField());
-  f->terrain_ = std::move(terrain);
+  f->base_ = &terrain;
   f->params_ = params;
   f->seed_mix_ = fmix64(params.seed ^ 0x5851F42D4C957F2Dull);
 
@@ -266,7 +282,7 @@ Result<std::shared_ptr<const DetailField>> DetailField::create(
   // Shape field: slope magnitude (central differences), box-blurred three times, smoothstepped
   // between the flat and steep slopes. Only +, -, *, / and sqrt (correctly rounded in IEEE 754),
   // in a fixed order, so it is the same on every platform; then quantised to Q15.
-  const Heightfield& hf = f->terrain_->heightfield();
+  const Heightfield& hf = f->base_->heightfield();
   const std::int64_t W = hf.width(), H = hf.height();
   f->shape_w_ = W;
   f->shape_h_ = H;
@@ -340,7 +356,7 @@ Result<std::shared_ptr<const DetailField>> DetailField::create(
     ph = nh;
   }
   f->shape_max_all_ = f->shape_max_.back()[0];
-  return std::shared_ptr<const DetailField>(std::move(f));
+  return f;
 }
 
 std::int32_t DetailField::detail_raw(std::uint32_t level, std::int64_t i,
@@ -374,19 +390,19 @@ void DetailField::detail_window(std::uint32_t level, std::int64_t i0, std::int64
 }
 
 double DetailField::lattice_x(std::uint32_t level, std::int64_t i) const noexcept {
-  const Heightfield& hf = terrain_->heightfield();
+  const Heightfield& hf = base_->heightfield();
   return hf.origin_x() + std::ldexp(double(i) * hf.spacing_x(), -int(level));
 }
 
 double DetailField::lattice_z(std::uint32_t level, std::int64_t j) const noexcept {
-  const Heightfield& hf = terrain_->heightfield();
+  const Heightfield& hf = base_->heightfield();
   return hf.origin_z() + std::ldexp(double(j) * hf.spacing_z(), -int(level));
 }
 
 std::optional<double> DetailField::height(std::uint32_t level, std::int64_t i,
                                           std::int64_t j) const noexcept {
   if (level > params_.levels) return std::nullopt;
-  const Heightfield& hf = terrain_->heightfield();
+  const Heightfield& hf = base_->heightfield();
   const std::int64_t max_i = std::int64_t(hf.width() - 1) << level;
   const std::int64_t max_j = std::int64_t(hf.height() - 1) << level;
   if (i < 0 || j < 0 || i > max_i || j > max_j) return std::nullopt;
@@ -549,11 +565,15 @@ struct DetailCache::State {
 
   // Swaps in a new snapshot; the old one is released outside snapshot_mu.
   void publish(std::shared_ptr<const DetailSnapshot> next) {
+    static std::atomic<std::uint64_t> next_generation{1};
     {
       std::lock_guard<std::mutex> lock(snapshot_mu);
       snapshot.swap(next);
+      generation.store(next_generation.fetch_add(1, std::memory_order_relaxed),
+                       std::memory_order_release);
     }
   }
+  std::atomic<std::uint64_t> generation{0};
 
   void touch(Entry& e) { lru.splice(lru.begin(), lru, e.lru); }
 
@@ -737,10 +757,22 @@ bool DetailCache::request(const DetailTileKey& key, bool urgent) {
   else
     s.queue.push_back(key);
   lock.unlock();
-  if (s.executor)
-    s.executor([st = state_] { State::run_one(st); });
-  else
+  if (!s.executor) {
     s.work_cv.notify_one();
+    return false;
+  }
+  try {
+    s.executor([st = state_] { State::run_one(st); });
+  } catch (...) {
+    // The engine's job system refused the job: withdraw the request, or every later job would
+    // drain the queue one key behind (each job takes the front key) and one tile would never come.
+    lock.lock();
+    if (auto q = std::find(s.queue.begin(), s.queue.end(), key); q != s.queue.end()) {
+      s.queue.erase(q);
+      s.pending.erase(key);
+    }
+    throw;
+  }
   return false;
 }
 
@@ -791,6 +823,10 @@ bool DetailCache::wait_idle(double timeout_seconds) {
   std::unique_lock<std::mutex> lock(s.mu);
   return s.idle_cv.wait_for(lock, std::chrono::duration<double>(timeout_seconds),
                             [&] { return s.queue.empty() && s.in_flight == 0; });
+}
+
+std::uint64_t DetailCache::generation() const noexcept {
+  return state_->generation.load(std::memory_order_acquire);
 }
 
 DetailCacheStats DetailCache::stats() const {

@@ -17,6 +17,7 @@
 #include "edit_listener.h"
 #include "format.h"
 #include "ray_hierarchy.h"
+#include "ridgeline/detail.h"
 
 namespace ridgeline {
 
@@ -288,6 +289,18 @@ std::size_t Terrain::edited_chunks() const noexcept { return edits_->chunks(); }
 
 std::shared_ptr<Terrain> Terrain::clone() const {
   std::shared_ptr<Terrain> t(new Terrain(heightfield_.duplicate()));
+  if (detail_) {
+    // The same detail function (the shape field is copied, not re-derived from edited heights),
+    // bound to the clone, with a cache of its own.
+    auto field = std::shared_ptr<DetailField>(new DetailField(*detail_));
+    field->keep_.reset();
+    field->base_ = t.get();
+    t->detail_ = field;
+    auto cache = DetailCache::create(t->detail_, {.budget_bytes = std::size_t{64} << 20, .worker_threads = 0});
+    if (cache) t->cache_ = std::move(*cache);
+    t->detail_levels_ = t->cache_ ? detail_levels_ : 0;
+    t->detail_hash_ = detail_hash_;
+  }
   *t->edits_ = *edits_;
   t->base_hash_ = base_hash_;
   t->edit_version_ = edit_version_;
@@ -324,8 +337,6 @@ T get(std::string_view in, std::size_t at) {
   return v;
 }
 
-// Detail parameters are not part of the terrain yet: their hash is 0 (docs/deformation.md).
-constexpr std::uint64_t kNoDetailHash = 0;
 
 }  // namespace
 
@@ -339,7 +350,7 @@ Status save_edits(const Terrain& terrain, const std::string& path) {
   put(out, kVersion);
   put(out, EditLayer::kChunk);
   put(out, terrain.base_hash());
-  put(out, kNoDetailHash);
+  put(out, terrain.detail_hash());
   put(out, hf.width());
   put(out, hf.height());
   put(out, std::uint64_t{keys.size()});
@@ -414,7 +425,7 @@ static Status check_edit_header(const Terrain& terrain, std::string_view in) {
                      "%016llx)",
                      what.c_str(), static_cast<unsigned long long>(get<std::uint64_t>(in, 16)),
                      static_cast<unsigned long long>(terrain.base_hash()))};
-  if (get<std::uint64_t>(in, 24) != kNoDetailHash)
+  if (get<std::uint64_t>(in, 24) != terrain.detail_hash())
     return Error{what + ": saved with other detail parameters (detail hash differs)"};
   if (get<std::uint32_t>(in, 32) != hf.width() || get<std::uint32_t>(in, 36) != hf.height())
     return Error{fmt("%s: saved for a %u x %u terrain; this one is %u x %u", what.c_str(),

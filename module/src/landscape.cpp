@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "edit_listener.h"
+#include "ridgeline/detail.h"
 #include "format.h"
 
 namespace ridgeline {
@@ -42,11 +43,11 @@ struct Landscape::Hook final : detail::EditListener {
 };
 
 std::int64_t Landscape::edited_end_i(std::uint32_t i1) const noexcept {
-  return i1 + 1 >= terrain_->heightfield().width() ? std::int64_t(patches_x_) * patch_cells() : i1;
+  return i1 + 1 >= terrain_->heightfield().width() ? std::int64_t(patches_x_) * (std::int64_t{1} << exponent_) : i1;
 }
 
 std::int64_t Landscape::edited_end_j(std::uint32_t j1) const noexcept {
-  return j1 + 1 >= terrain_->heightfield().height() ? std::int64_t(patches_z_) * patch_cells() : j1;
+  return j1 + 1 >= terrain_->heightfield().height() ? std::int64_t(patches_z_) * (std::int64_t{1} << exponent_) : j1;
 }
 
 Landscape::~Landscape() {
@@ -66,7 +67,7 @@ void Landscape::remove_listener(detail::EditListener* l) const {
 
 std::uint64_t Landscape::update_bounds(std::int64_t i0, std::int64_t j0, std::int64_t i1,
                                        std::int64_t j1) {
-  const std::int64_t p = patch_cells();
+  const std::int64_t p = std::int64_t{1} << exponent_;
   // Patches whose closed square holds part of the region.
   const std::int64_t px0 = std::max<std::int64_t>(0, (i0 + p - 1) / p - 1),
                      px1 = std::min<std::int64_t>(patches_x_ - 1, i1 / p);
@@ -86,7 +87,7 @@ std::uint64_t Landscape::update_bounds(std::int64_t i0, std::int64_t j0, std::in
         // Pre-order over the stored nodes whose triangle's box meets the region; recomputed in
         // reverse (children before parents) so that nesting reads fresh children.
         order.clear();
-        stack.push_back({1, triangle(root, 1)});
+        stack.push_back({1, base_triangle(root, 1)});
         while (!stack.empty()) {
           const Item it = stack.back();
           stack.pop_back();
@@ -125,7 +126,8 @@ Result<std::shared_ptr<const Landscape>> Landscape::create(std::shared_ptr<const
   const Heightfield& hf = terrain->heightfield();
   l->terrain_ = std::move(terrain);
   l->exponent_ = desc.patch_exponent;
-  const std::int64_t p = l->patch_cells();
+  l->detail_ = l->terrain_->detail_levels();
+  const std::int64_t p = std::int64_t{1} << l->exponent_;  // stored cells per patch
   l->patches_x_ = static_cast<std::uint32_t>((hf.width() - 1 + p - 1) / p);
   l->patches_z_ = static_cast<std::uint32_t>((hf.height() - 1 + p - 1) / p);
   const std::uint64_t roots = std::uint64_t{2} * l->patches_x_ * l->patches_z_;
@@ -136,19 +138,21 @@ Result<std::shared_ptr<const Landscape>> Landscape::create(std::shared_ptr<const
                      static_cast<unsigned long long>(total))};
   l->origin_x_ = hf.origin_x();
   l->origin_z_ = hf.origin_z();
-  l->spacing_x_ = hf.spacing_x();
-  l->spacing_z_ = hf.spacing_z();
+  l->spacing_x_ = std::ldexp(hf.spacing_x(), -int(l->detail_));
+  l->spacing_z_ = std::ldexp(hf.spacing_z(), -int(l->detail_));
+  l->last_i_ = std::int64_t(hf.width() - 1) << l->detail_;
+  l->last_j_ = std::int64_t(hf.height() - 1) << l->detail_;
   l->bounds_.assign(total, 0.0f);
 
   // Roots are independent: split them over the hardware threads.
   const std::uint64_t npr = l->nodes_per_root_plus_one_;
-  const std::uint32_t max_level = l->max_level();
+  const std::uint32_t max_level = l->base_level();  // stored levels: 0 .. base_level - 1
   auto work = [&](std::uint64_t first, std::uint64_t last) {
     for (std::uint64_t root = first; root < last; ++root) {
       float* b = l->bounds_.data() + root * (npr - 1);
       // Exact error per stored node (levels 0 .. max_level - 1), walking levels top-down so each
       // node's triangle comes from its parent's.
-      std::vector<LatticeTriangle> level{l->triangle(static_cast<std::uint32_t>(root), 1)};
+      std::vector<LatticeTriangle> level{l->base_triangle(static_cast<std::uint32_t>(root), 1)};
       std::vector<LatticeTriangle> next;
       std::uint64_t first_heap = 1;
       for (std::uint32_t lv = 0; lv < max_level; ++lv) {
@@ -192,8 +196,33 @@ LatticeTriangle Landscape::child_triangle(const LatticeTriangle& t, int child) n
 }
 
 LatticeTriangle Landscape::triangle(std::uint32_t root, std::uint64_t heap) const noexcept {
+  LatticeTriangle t = base_triangle(root, 1);
+  const int d = int(detail_);
+  t = {t.ax << d, t.az << d, t.lx << d, t.lz << d, t.rx << d, t.rz << d};
+  const int depth = 63 - __builtin_clzll(heap);
+  for (int bit = depth - 1; bit >= 0; --bit) t = child_triangle(t, int((heap >> bit) & 1));
+  return t;
+}
+
+float Landscape::detail_bound(int level, const LatticeTriangle& t) const noexcept {
+  // Stored levels: the whole detail (from level 1). Level 2k + 2(m - 1) and 2k + 2m - 1 resolve
+  // detail levels below m; their error is at most twice the contribution of levels >= m
+  // (docs/detail.md, "Bounds"), non-increasing down the tree, so the sum stays nested.
+  const int base = int(base_level());
+  const int from = level < base ? 1 : (level - base) / 2 + 1;
+  if (from > int(detail_)) return 0.0f;
+  const DetailField& f = *terrain_->detail();
+  const double b = 2.0 * f.contribution_bound(std::uint32_t(from), detail_,
+                                              std::min({t.ax, t.lx, t.rx}), std::min({t.az, t.lz, t.rz}),
+                                              std::max({t.ax, t.lx, t.rx}), std::max({t.az, t.lz, t.rz}));
+  float r = static_cast<float>(b);
+  if (double(r) < b) r = std::nextafter(r, INFINITY);
+  return r;
+}
+
+LatticeTriangle Landscape::base_triangle(std::uint32_t root, std::uint64_t heap) const noexcept {
   const std::uint32_t patch = root / 2;
-  const std::int64_t p = patch_cells();
+  const std::int64_t p = std::int64_t{1} << exponent_;
   const std::int64_t ox = std::int64_t(patch % patches_x_) * p;
   const std::int64_t oz = std::int64_t(patch / patches_x_) * p;
   LatticeTriangle t = (root & 1) == 0 ? LatticeTriangle{ox + p, oz, ox, oz, ox + p, oz + p}
@@ -206,8 +235,8 @@ LatticeTriangle Landscape::triangle(std::uint32_t root, std::uint64_t heap) cons
 float Landscape::compute_exact(const LatticeTriangle& t) const noexcept {
   const std::int64_t x0 = std::min({t.ax, t.lx, t.rx}), x1 = std::max({t.ax, t.lx, t.rx});
   const std::int64_t z0 = std::min({t.az, t.lz, t.rz}), z1 = std::max({t.az, t.lz, t.rz});
-  const double ha = lattice_height(t.ax, t.az), hl = lattice_height(t.lx, t.lz),
-               hr = lattice_height(t.rx, t.rz);
+  const double ha = base_height(t.ax, t.az), hl = base_height(t.lx, t.lz),
+               hr = base_height(t.rx, t.rz);
   // Edge functions in integer arithmetic; w is twice the signed area.
   auto cross = [](std::int64_t ux, std::int64_t uz, std::int64_t vx, std::int64_t vz) {
     return ux * vz - uz * vx;
@@ -260,7 +289,7 @@ float Landscape::compute_exact(const LatticeTriangle& t) const noexcept {
 }
 
 float Landscape::exact_error(std::uint32_t root, std::uint64_t heap) const noexcept {
-  return compute_exact(triangle(root, heap));
+  return heap < nodes_per_root_plus_one_ ? compute_exact(base_triangle(root, heap)) : 0.0f;
 }
 
 }  // namespace ridgeline

@@ -17,6 +17,7 @@
 #include <glm/geometric.hpp>
 #include <limits>
 
+#include "ridgeline/detail.h"
 #include "surface_eval.h"
 
 namespace ridgeline {
@@ -136,8 +137,10 @@ std::size_t RayHierarchy::memory_bytes() const noexcept {
 
 namespace {
 
-// Fills a hit at distance t on the triangle with plane `plane` in cell (i, j).
-void fill_hit(const Heightfield& hf, double inv_sx, double inv_sz, const glm::dvec3& origin,
+// Fills a hit at distance t on the triangle with plane `plane` in cell (i, j) of `hf` (a
+// Heightfield or a grid view with material(i, j)).
+template <class Grid>
+void fill_hit(const Grid& hf, double inv_sx, double inv_sz, const glm::dvec3& origin,
               const glm::dvec3& dir, std::uint32_t i, std::uint32_t j,
               const detail::CellPlane& plane, double t, bool started_below, RayHit& hit) noexcept {
   hit.distance = t;
@@ -147,15 +150,90 @@ void fill_hit(const Heightfield& hf, double inv_sx, double inv_sz, const glm::dv
   hit.started_below = started_below;
 }
 
+
+// The stored lattice and the finest lattice of a terrain with detail, as grids for the walks.
+struct BaseGrid {
+  const Heightfield& hf;
+  double isx, isz;
+  float local(std::uint32_t i, std::uint32_t j) const noexcept { return hf.local(i, j); }
+  std::uint8_t material(std::uint32_t i, std::uint32_t j) const noexcept { return hf.material(i, j); }
+};
+struct FineGrid {
+  const Terrain& t;
+  int L;
+  double isx, isz;  // 1 / finest spacing
+  double local(std::uint32_t i, std::uint32_t j) const noexcept { return t.fine_local_height(i, j); }
+  std::uint8_t material(std::uint32_t i, std::uint32_t j) const noexcept {
+    const Heightfield& hf = t.heightfield();
+    return hf.material(std::min(i >> L, hf.width() - 2), std::min(j >> L, hf.height() - 2));
+  }
+};
+
+// The surface under a point: its cell, the point's fractions in it, the triangle's plane.
+struct PointPlane {
+  std::uint32_t i = 0, j = 0;
+  double fu = 0, fv = 0;
+  detail::CellPlane plane{};
+};
+
+template <class Grid>
+PointPlane point_plane(const Grid& g, double u, double v, std::int64_t cells_x,
+                       std::int64_t cells_z) noexcept {
+  PointPlane p;
+  p.i = static_cast<std::uint32_t>(std::min<std::int64_t>(static_cast<std::int64_t>(u), cells_x - 1));
+  p.j = static_cast<std::uint32_t>(std::min<std::int64_t>(static_cast<std::int64_t>(v), cells_z - 1));
+  p.fu = u - p.i;
+  p.fv = v - p.j;
+  const CellTriangle tri =
+      locate_in_cell(p.i, p.j, static_cast<float>(p.fu), static_cast<float>(p.fv));
+  p.plane = detail::cell_plane(g, p.i, p.j, tri);
+  return p;
+}
+
 }  // namespace
 
-// Tests the cells of leaf block (bx, bz) that the ray crosses during [ta, tb], in ray order.
-bool RayHierarchy::leaf_hit(const Heightfield& hf, const Ray& r, std::uint32_t bx, std::uint32_t bz,
-                            double ta, double tb, RayHit& hit) const noexcept {
-  const std::int64_t ci0 = std::int64_t{bx} << kLeafShift;
-  const std::int64_t cj0 = std::int64_t{bz} << kLeafShift;
-  const std::int64_t ci1 = std::min<std::int64_t>(ci0 + kLeafCells, hf.width() - 1) - 1;
-  const std::int64_t cj1 = std::min<std::int64_t>(cj0 + kLeafCells, hf.height() - 1) - 1;
+struct RayHierarchy::BaseMode {
+  BaseGrid grid;
+  std::int64_t cells_x, cells_z;
+  double inflate() const noexcept { return 0.0; }
+  // (u, v) in stored-lattice units, inside the footprint.
+  PointPlane point(double u, double v) const noexcept { return point_plane(grid, u, v, cells_x, cells_z); }
+  bool leaf(const RayHierarchy& rh, const Ray& r, std::uint32_t bx, std::uint32_t bz, double ta,
+            double tb, RayHit& hit) const noexcept {
+    const std::int64_t ci0 = std::int64_t{bx} << kLeafShift, cj0 = std::int64_t{bz} << kLeafShift;
+    const std::int64_t ci1 = std::min<std::int64_t>(ci0 + kLeafCells, cells_x) - 1;
+    const std::int64_t cj1 = std::min<std::int64_t>(cj0 + kLeafCells, cells_z) - 1;
+    return rh.walk_cells(grid, r, ci0, cj0, ci1, cj1, ta, tb, hit);
+  }
+};
+
+struct RayHierarchy::FineMode {
+  FineGrid grid;
+  std::int64_t cells_x, cells_z;  // stored cells
+  double widen;                   // detail amplitude bound, metres
+  double inflate() const noexcept { return widen; }
+  PointPlane point(double u, double v) const noexcept {
+    return point_plane(grid, std::ldexp(u, grid.L), std::ldexp(v, grid.L), cells_x << grid.L,
+                       cells_z << grid.L);
+  }
+  bool leaf(const RayHierarchy& rh, const Ray& r, std::uint32_t bx, std::uint32_t bz, double ta,
+            double tb, RayHit& hit) const noexcept {
+    const int L = grid.L;
+    Ray f = r;  // the same ray in finest-lattice units
+    f.u0 = std::ldexp(r.u0, L), f.v0 = std::ldexp(r.v0, L);
+    f.du = std::ldexp(r.du, L), f.dv = std::ldexp(r.dv, L);
+    f.inv_du = std::ldexp(r.inv_du, -L), f.inv_dv = std::ldexp(r.inv_dv, -L);
+    const std::int64_t ci0 = std::int64_t{bx} << kLeafShift, cj0 = std::int64_t{bz} << kLeafShift;
+    const std::int64_t ci1 = std::min<std::int64_t>(ci0 + kLeafCells, cells_x);
+    const std::int64_t cj1 = std::min<std::int64_t>(cj0 + kLeafCells, cells_z);
+    return rh.walk_cells(grid, f, ci0 << L, cj0 << L, (ci1 << L) - 1, (cj1 << L) - 1, ta, tb, hit);
+  }
+};
+
+template <class Grid>
+bool RayHierarchy::walk_cells(const Grid& grid, const Ray& r, std::int64_t ci0, std::int64_t cj0,
+                              std::int64_t ci1, std::int64_t cj1, double ta, double tb,
+                              RayHit& hit) const noexcept {
   // Truncation acts as floor here: anything below 0 is clamped up to ci0 >= 0 anyway.
   std::int64_t ci = std::clamp<std::int64_t>(
       static_cast<std::int64_t>(std::max(r.u0 + r.du * ta, -1.0)), ci0, ci1);
@@ -177,8 +255,8 @@ bool RayHierarchy::leaf_hit(const Heightfield& hf, const Ray& r, std::uint32_t b
 
     // The cell: skip it when the ray stays above its highest corner.
     const auto i = static_cast<std::uint32_t>(ci), j = static_cast<std::uint32_t>(cj);
-    const float h00 = hf.local(i, j), h10 = hf.local(i + 1, j);
-    const float h01 = hf.local(i, j + 1), h11 = hf.local(i + 1, j + 1);
+    const double h00 = grid.local(i, j), h10 = grid.local(i + 1, j);
+    const double h01 = grid.local(i, j + 1), h11 = grid.local(i + 1, j + 1);
     const double cmax = std::max(std::max(h00, h10), std::max(h01, h11));
     const double ylow = r.y0 + r.dy * (r.dy < 0 ? tc : t);
     if (ylow <= cmax + touch_) {
@@ -202,7 +280,7 @@ bool RayHierarchy::leaf_hit(const Heightfield& hf, const Ray& r, std::uint32_t b
         const CellTriangle tri =
             locate_in_cell(ci, cj, static_cast<float>(std::clamp(ou + r.du * pm, 0.0, 1.0)),
                            static_cast<float>(std::clamp(ov + r.dv * pm, 0.0, 1.0)));
-        const detail::CellPlane plane = detail::cell_plane(hf, i, j, tri);
+        const detail::CellPlane plane = detail::cell_plane(grid, i, j, tri);
         const double ha = plane.at(ou + r.du * pa, ov + r.dv * pa);
         const double fa = (r.y0 + r.dy * pa) - ha;
         double th;
@@ -214,7 +292,7 @@ bool RayHierarchy::leaf_hit(const Heightfield& hf, const Ray& r, std::uint32_t b
           if (fb > touch_) continue;
           th = fb <= 0 ? std::clamp(pa + (pb - pa) * (fa / (fa - fb)), pa, pb) : pb;
         }
-        fill_hit(hf, inv_sx_, inv_sz_, r.origin, r.dir, i, j, plane, th, false, hit);
+        fill_hit(grid, grid.isx, grid.isz, r.origin, r.dir, i, j, plane, th, false, hit);
         return true;
       }
     }
@@ -234,6 +312,27 @@ bool RayHierarchy::leaf_hit(const Heightfield& hf, const Ray& r, std::uint32_t b
 std::optional<RayHit> RayHierarchy::raycast(const Heightfield& hf, const glm::dvec3& origin,
                                             const glm::dvec3& direction,
                                             double max_distance) const noexcept {
+  const BaseMode mode{{hf, inv_sx_, inv_sz_}, hf.width() - 1, hf.height() - 1};
+  return raycast_impl(mode, hf, origin, direction, max_distance);
+}
+
+std::optional<RayHit> RayHierarchy::raycast_fine(const Terrain& t, const glm::dvec3& origin,
+                                                 const glm::dvec3& direction,
+                                                 double max_distance) const noexcept {
+  const Heightfield& hf = t.heightfield();
+  const int L = int(t.detail_levels());
+  const FineMode mode{{t, L, std::ldexp(inv_sx_, L), std::ldexp(inv_sz_, L)},
+                      hf.width() - 1,
+                      hf.height() - 1,
+                      t.detail()->contribution_bound(1)};
+  return raycast_impl(mode, hf, origin, direction, max_distance);
+}
+
+template <class Mode>
+std::optional<RayHit> RayHierarchy::raycast_impl(const Mode& mode, const Heightfield& hf,
+                                                 const glm::dvec3& origin,
+                                                 const glm::dvec3& direction,
+                                                 double max_distance) const noexcept {
   if (!(max_distance > 0.0)) return std::nullopt;  // also NaN
   for (int a = 0; a < 3; ++a)
     if (!std::isfinite(origin[a]) || !std::isfinite(direction[a])) return std::nullopt;
@@ -264,18 +363,14 @@ std::optional<RayHit> RayHierarchy::raycast(const Heightfield& hf, const glm::dv
   if (r.du == 0.0 && r.dv == 0.0) {
     // Vertical: only the surface under the origin can be hit.
     if (!(r.u0 >= 0.0 && r.u0 <= umax && r.v0 >= 0.0 && r.v0 <= vmax)) return std::nullopt;
-    const auto i = std::min(static_cast<std::uint32_t>(r.u0), hf.width() - 2);
-    const auto j = std::min(static_cast<std::uint32_t>(r.v0), hf.height() - 2);
-    const double fu = r.u0 - i, fv = r.v0 - j;
-    const CellTriangle tri = locate_in_cell(i, j, static_cast<float>(fu), static_cast<float>(fv));
-    const detail::CellPlane plane = detail::cell_plane(hf, i, j, tri);
-    const double f = r.y0 - plane.at(fu, fv);  // height above the surface
+    const PointPlane p = mode.point(r.u0, r.v0);
+    const double f = r.y0 - p.plane.at(p.fu, p.fv);  // height above the surface
     if (f <= touch_) {
-      fill_hit(hf, inv_sx_, inv_sz_, origin, d, i, j, plane, 0.0, f < 0.0, hit);
+      fill_hit(mode.grid, mode.grid.isx, mode.grid.isz, origin, d, p.i, p.j, p.plane, 0.0, f < 0.0, hit);
       return hit;
     }
     if (r.dy > 0.0 || f > max_distance) return std::nullopt;
-    fill_hit(hf, inv_sx_, inv_sz_, origin, d, i, j, plane, f, false, hit);
+    fill_hit(mode.grid, mode.grid.isx, mode.grid.isz, origin, d, p.i, p.j, p.plane, f, false, hit);
     return hit;
   }
 
@@ -292,14 +387,11 @@ std::optional<RayHit> RayHierarchy::raycast(const Heightfield& hf, const glm::dv
     const double t = r.t_enter;
     const double u = std::clamp(r.u0 + r.du * t, 0.0, umax);
     const double v = std::clamp(r.v0 + r.dv * t, 0.0, vmax);
-    const auto i = std::min(static_cast<std::uint32_t>(u), hf.width() - 2);
-    const auto j = std::min(static_cast<std::uint32_t>(v), hf.height() - 2);
-    const double fu = u - i, fv = v - j;
-    const CellTriangle tri = locate_in_cell(i, j, static_cast<float>(fu), static_cast<float>(fv));
-    const detail::CellPlane plane = detail::cell_plane(hf, i, j, tri);
-    const double f = (r.y0 + r.dy * t) - plane.at(fu, fv);
+    const PointPlane p = mode.point(u, v);
+    const double f = (r.y0 + r.dy * t) - p.plane.at(p.fu, p.fv);
     if (f <= touch_) {
-      fill_hit(hf, inv_sx_, inv_sz_, origin, d, i, j, plane, t, t == 0.0 && f < 0.0, hit);
+      fill_hit(mode.grid, mode.grid.isx, mode.grid.isz, origin, d, p.i, p.j, p.plane, t,
+               t == 0.0 && f < 0.0, hit);
       return hit;
     }
   }
@@ -339,7 +431,7 @@ std::optional<RayHit> RayHierarchy::raycast(const Heightfield& hf, const glm::dv
     const double t_out = std::max(t, std::min(std::min(tnu, tnv), r.t_exit));
     const float node_max = level.max[level.index(x, z)];
     const double ylow = r.y0 + r.dy * (r.dy < 0 ? t_out : t);
-    if (ylow <= double(node_max) + touch_) {
+    if (ylow <= double(node_max) + mode.inflate() + touch_) {
       if (l > 0) {
         // Descend into the child that holds the ray at t (ties go the way the ray moves).
         --l;
@@ -351,7 +443,7 @@ std::optional<RayHit> RayHierarchy::raycast(const Heightfield& hf, const glm::dv
         z = std::min<std::int64_t>(z, levels_[l].nz - 1);
         continue;
       }
-      if (leaf_hit(hf, r, std::uint32_t(x), std::uint32_t(z), t, t_out, hit)) return hit;
+      if (mode.leaf(*this, r, std::uint32_t(x), std::uint32_t(z), t, t_out, hit)) return hit;
     }
     // Step to the next node along the ray.
     if (t_out >= r.t_exit) return std::nullopt;
@@ -377,14 +469,31 @@ std::optional<RayHit> RayHierarchy::raycast(const Heightfield& hf, const glm::dv
 std::size_t RayHierarchy::triangles_in_box(const Heightfield& hf, const Box& box,
                                            std::vector<SurfaceTriangle>& out,
                                            std::size_t max_triangles) const {
+  return boxes_impl(BaseGrid{hf, inv_sx_, inv_sz_}, hf, 0, 0.0, box, out, max_triangles);
+}
+
+std::size_t RayHierarchy::triangles_in_box_fine(const Terrain& t, const Box& box,
+                                                std::vector<SurfaceTriangle>& out,
+                                                std::size_t max_triangles) const {
+  const int L = int(t.detail_levels());
+  return boxes_impl(FineGrid{t, L, std::ldexp(inv_sx_, L), std::ldexp(inv_sz_, L)},
+                    t.heightfield(), L, t.detail()->contribution_bound(1), box, out,
+                    max_triangles);
+}
+
+template <class Grid>
+std::size_t RayHierarchy::boxes_impl(const Grid& g, const Heightfield& hf, int L, double widen,
+                                     const Box& box, std::vector<SurfaceTriangle>& out,
+                                     std::size_t max_triangles) const {
   for (int a = 0; a < 3; ++a)
     if (!std::isfinite(box.min[a]) || !std::isfinite(box.max[a]) || !(box.min[a] <= box.max[a]))
       return 0;
-  const double sx = hf.spacing_x(), sz = hf.spacing_z();
+  // Cells of `g` (the stored lattice, or the finest one: 2^L per stored cell).
+  const double sx = std::ldexp(hf.spacing_x(), -L), sz = std::ldexp(hf.spacing_z(), -L);
   const double ua = (box.min.x - hf.origin_x()) / sx, ub = (box.max.x - hf.origin_x()) / sx;
   const double va = (box.min.z - hf.origin_z()) / sz, vb = (box.max.z - hf.origin_z()) / sz;
   const double ylo = box.min.y - hf.height_offset(), yhi = box.max.y - hf.height_offset();
-  const double umax = hf.width() - 1.0, vmax = hf.height() - 1.0;
+  const double umax = std::ldexp(hf.width() - 1.0, L), vmax = std::ldexp(hf.height() - 1.0, L);
   if (ub < 0.0 || vb < 0.0 || ua > umax || va > vmax) return 0;
   // Closed cell ranges: a box touching a cell's edge overlaps that cell.
   const auto cell_lo = [](double a, double cells) {
@@ -397,50 +506,48 @@ std::size_t RayHierarchy::triangles_in_box(const Heightfield& hf, const Box& box
   const std::int64_t j0 = cell_lo(va, vmax), j1 = cell_hi(vb, vmax);
 
   const Level& leaf = levels_.front();
+  const int shift = L + int(kLeafShift);  // cell -> leaf block of the pyramid
   std::size_t added = 0;
-  for (std::int64_t bz = j0 >> kLeafShift; bz <= (j1 >> kLeafShift); ++bz) {
-    for (std::int64_t bx = i0 >> kLeafShift; bx <= (i1 >> kLeafShift); ++bx) {
-      const std::size_t block = leaf.index(bx, bz);
-      if (double(leaf.max[block]) < ylo || double(leaf.min[block]) > yhi) continue;
-      const std::int64_t ci_end = std::min(i1, ((bx + 1) << kLeafShift) - 1);
-      const std::int64_t cj_end = std::min(j1, ((bz + 1) << kLeafShift) - 1);
-      for (std::int64_t cj = std::max(j0, bz << kLeafShift); cj <= cj_end; ++cj) {
-        for (std::int64_t ci = std::max(i0, bx << kLeafShift); ci <= ci_end; ++ci) {
-          const auto i = static_cast<std::uint32_t>(ci), j = static_cast<std::uint32_t>(cj);
-          // The box in this cell's fractional coordinates.
-          const double bu0 = ua - double(ci), bu1 = ub - double(ci);
-          const double bv0 = va - double(cj), bv1 = vb - double(cj);
-          for (int which = 0; which < 2; ++which) {
-            const CellTriangle t = detail::cell_triangle(ci, cj, which);
-            float h[3];
-            for (int k = 0; k < 3; ++k) h[k] = hf.local(i + t.di[k], j + t.dj[k]);
-            const double hmin = std::min({h[0], h[1], h[2]}), hmax = std::max({h[0], h[1], h[2]});
-            if (hmax < ylo || hmin > yhi) continue;
-            // Separating axes: the box's axes hold (the cell overlaps the box and the triangle
-            // spans the cell); test the triangle's edge normals.
-            bool separated = false;
-            for (int e = 0; e < 3 && !separated; ++e) {
-              const int a = e, b = (e + 1) % 3, c = (e + 2) % 3;
-              // Normal of edge a-b, turned towards the opposite corner c.
-              double nx = -(double(t.dj[b]) - t.dj[a]), nz = double(t.di[b]) - t.di[a];
-              if (nx * (t.di[c] - t.di[a]) + nz * (t.dj[c] - t.dj[a]) < 0) nx = -nx, nz = -nz;
-              // Separated when even the box corner furthest along the normal lies strictly
-              // behind the edge.
-              const double box_max = nx * (nx >= 0 ? bu1 : bu0) + nz * (nz >= 0 ? bv1 : bv0);
-              separated = box_max < nx * t.di[a] + nz * t.dj[a];
-            }
-            if (separated) continue;
-            if (max_triangles != 0 && added == max_triangles) return added;
-            SurfaceTriangle st;
-            for (int k = 0; k < 3; ++k)
-              st.v[k] = {hf.origin_x() + double(ci + t.di[k]) * sx,
-                         hf.height_offset() + double(h[k]),
-                         hf.origin_z() + double(cj + t.dj[k]) * sz};
-            st.material = hf.material(i, j);
-            out.push_back(st);
-            ++added;
-          }
+  for (std::int64_t cj = j0; cj <= j1; ++cj) {
+    for (std::int64_t ci = i0; ci <= i1; ++ci) {
+      // Blocks whose height range (widened by the detail bound) misses the box are skipped.
+      const std::size_t block = leaf.index(ci >> shift, cj >> shift);
+      if (double(leaf.max[block]) + widen < ylo || double(leaf.min[block]) - widen > yhi) {
+        ci |= (std::int64_t{1} << shift) - 1;  // to the block's last cell
+        continue;
+      }
+      const auto i = static_cast<std::uint32_t>(ci), j = static_cast<std::uint32_t>(cj);
+      // The box in this cell's fractional coordinates.
+      const double bu0 = ua - double(ci), bu1 = ub - double(ci);
+      const double bv0 = va - double(cj), bv1 = vb - double(cj);
+      for (int which = 0; which < 2; ++which) {
+        const CellTriangle t = detail::cell_triangle(ci, cj, which);
+        double h[3];
+        for (int k = 0; k < 3; ++k) h[k] = g.local(i + t.di[k], j + t.dj[k]);
+        const double hmin = std::min({h[0], h[1], h[2]}), hmax = std::max({h[0], h[1], h[2]});
+        if (hmax < ylo || hmin > yhi) continue;
+        // Separating axes: the box's axes hold (the cell overlaps the box and the triangle
+        // spans the cell); test the triangle's edge normals.
+        bool separated = false;
+        for (int e = 0; e < 3 && !separated; ++e) {
+          const int a = e, b = (e + 1) % 3, c = (e + 2) % 3;
+          // Normal of edge a-b, turned towards the opposite corner c.
+          double nx = -(double(t.dj[b]) - t.dj[a]), nz = double(t.di[b]) - t.di[a];
+          if (nx * (t.di[c] - t.di[a]) + nz * (t.dj[c] - t.dj[a]) < 0) nx = -nx, nz = -nz;
+          // Separated when even the box corner furthest along the normal lies strictly
+          // behind the edge.
+          const double box_max = nx * (nx >= 0 ? bu1 : bu0) + nz * (nz >= 0 ? bv1 : bv0);
+          separated = box_max < nx * t.di[a] + nz * t.dj[a];
         }
+        if (separated) continue;
+        if (max_triangles != 0 && added == max_triangles) return added;
+        SurfaceTriangle st;
+        for (int k = 0; k < 3; ++k)
+          st.v[k] = {hf.origin_x() + double(ci + t.di[k]) * sx, hf.height_offset() + h[k],
+                     hf.origin_z() + double(cj + t.dj[k]) * sz};
+        st.material = g.material(i, j);
+        out.push_back(st);
+        ++added;
       }
     }
   }
@@ -449,11 +556,13 @@ std::size_t RayHierarchy::triangles_in_box(const Heightfield& hf, const Box& box
 
 std::optional<RayHit> Terrain::raycast(const glm::dvec3& origin, const glm::dvec3& direction,
                                        double max_distance) const noexcept {
+  if (detail_levels_ != 0) return rays_->raycast_fine(*this, origin, direction, max_distance);
   return rays_->raycast(heightfield_, origin, direction, max_distance);
 }
 
 std::size_t Terrain::triangles_in_box(const Box& box, std::vector<SurfaceTriangle>& out,
                                       std::size_t max_triangles) const {
+  if (detail_levels_ != 0) return rays_->triangles_in_box_fine(*this, box, out, max_triangles);
   return rays_->triangles_in_box(heightfield_, box, out, max_triangles);
 }
 

@@ -31,7 +31,9 @@ struct CellPlane {
   double at(double fu, double fv) const noexcept { return h0 + gu * (fu - c0u) + gv * (fv - c0v); }
 };
 
-inline CellPlane cell_plane(const Heightfield& hf, std::uint32_t i, std::uint32_t j,
+/// `Grid` is a Heightfield or a finest-lattice view with the same local(i, j).
+template <class Grid>
+inline CellPlane cell_plane(const Grid& hf, std::uint32_t i, std::uint32_t j,
                             const CellTriangle& t) noexcept {
   const double h0 = hf.local(i + t.di[0], j + t.dj[0]);
   const double h1 = hf.local(i + t.di[1], j + t.dj[1]);
@@ -103,6 +105,17 @@ class RayHierarchy {
   std::optional<RayHit> raycast(const Heightfield& hf, const glm::dvec3& origin,
                                 const glm::dvec3& direction, double max_distance) const noexcept;
 
+  /// See Terrain::raycast, on a terrain with procedural detail: the pyramid of the stored heights
+  /// is widened by the detail field's amplitude bound, and leaf blocks are walked cell by cell on
+  /// the finest lattice (heights from Terrain::fine_local_height).
+  std::optional<RayHit> raycast_fine(const Terrain& terrain, const glm::dvec3& origin,
+                                     const glm::dvec3& direction, double max_distance) const noexcept;
+
+  /// See Terrain::triangles_in_box, on a terrain with detail (finest triangles).
+  std::size_t triangles_in_box_fine(const Terrain& terrain, const Box& box,
+                                    std::vector<SurfaceTriangle>& out,
+                                    std::size_t max_triangles) const;
+
   /// See Terrain::triangles_in_box.
   std::size_t triangles_in_box(const Heightfield& hf, const Box& box,
                                std::vector<SurfaceTriangle>& out, std::size_t max_triangles) const;
@@ -129,8 +142,24 @@ class RayHierarchy {
   void leaf_block(const Heightfield& hf, std::uint32_t bx, std::uint32_t bz);
   void parent_node(std::size_t level, std::uint32_t x, std::uint32_t z);
 
-  bool leaf_hit(const Heightfield& hf, const Ray& ray, std::uint32_t bx, std::uint32_t bz,
-                double ta, double tb, RayHit& hit) const noexcept;
+  // The ray walk shared by both surfaces; `Mode` (BaseMode, FineMode in ray_hierarchy.cpp)
+  // evaluates the surface under a point, widens node maxima and walks leaf blocks.
+  struct BaseMode;
+  struct FineMode;
+  template <class Mode>
+  std::optional<RayHit> raycast_impl(const Mode& mode, const Heightfield& hf,
+                                     const glm::dvec3& origin, const glm::dvec3& direction,
+                                     double max_distance) const noexcept;
+  template <class Grid>
+  std::size_t boxes_impl(const Grid& g, const Heightfield& hf, int L, double widen,
+                         const Box& box, std::vector<SurfaceTriangle>& out,
+                         std::size_t max_triangles) const;
+  // Tests the cells [ci0, ci1] x [cj0, cj1] of `grid` that the ray (in grid units) crosses
+  // during [ta, tb], in ray order.
+  template <class Grid>
+  bool walk_cells(const Grid& grid, const Ray& r, std::int64_t ci0, std::int64_t cj0,
+                  std::int64_t ci1, std::int64_t cj1, double ta, double tb,
+                  RayHit& hit) const noexcept;
 
   std::vector<Level> levels_;
   double inv_sx_ = 1, inv_sz_ = 1;  // 1 / spacing

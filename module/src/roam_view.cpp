@@ -28,6 +28,7 @@
 #include "format.h"
 #include "ridgeline/log.h"
 #include "edit_listener.h"
+#include "ridgeline/detail.h"
 #include "surface_eval.h"
 
 namespace ridgeline {
@@ -46,18 +47,18 @@ struct Node {
   std::uint32_t child = kNone;  // first of the pair (child, child + 1); kNone for a leaf
   std::uint32_t base = kNone, left = kNone, right = kNone;
   std::uint32_t qslot = kNone;  // position in the split heap (leaf) or merge heap (internal)
-  std::uint32_t root = 0;
-  std::uint32_t heap = 1;
+  std::uint32_t root : 31 = 0;
+  std::uint32_t visible : 1 = 1;  // in view at the last culling pass (levels <= kCullDepth)
   // When the node's key must be recomputed: eye odometer (metres) and accumulated rotation
   // (radians), rounded down to float; infinity when it never expires that way. An expiry record
   // whose key rounds to a different value is stale.
   float due_d = std::numeric_limits<float>::infinity();
+  std::uint64_t heap = 1;  // path from the root, one bit per level (64 bits: detail levels)
   float due_a = std::numeric_limits<float>::infinity();
-  std::int32_t ax = 0, az = 0;  // apex in global lattice coordinates (geometry in O(1))
+  std::int32_t ax = 0, az = 0;  // apex in global finest-lattice coordinates (geometry in O(1))
   // Cached at creation so a priority reads no height or bound arrays (cache misses dominated):
-  float bound = 0;           // nested error bound, metres
-  float ylo = 0, yhi = 0;    // bounding box y range relative to the height offset, metres
-  std::uint8_t visible = 1;  // in view at the last culling pass (levels <= kCullDepth)
+  float bound = 0;         // nested error bound, metres
+  float ylo = 0, yhi = 0;  // bounding box y range relative to the height offset, metres
 };
 
 static_assert(sizeof(Node) == 64, "docs/architecture.md and docs/roam.md quote the node size");
@@ -349,6 +350,11 @@ struct RoamView::Impl {
   std::vector<std::uint64_t> mesh_built_version;
   std::vector<std::uint32_t> scratch_index;
 
+  // Procedural detail: the terrain's tile cache (null without detail), and the leaves whose
+  // split waits for a tile (held at the coarser level; re-queued at the next update).
+  DetailCache* cache = land.terrain().detail_cache();
+  std::vector<std::uint32_t> waiting;
+
   // Per-update counters and the time budget.
   RoamStats st;
   bool has_deadline = false;
@@ -359,7 +365,7 @@ struct RoamView::Impl {
   // ---- structure ---------------------------------------------------------------------------
 
   bool is_leaf(std::uint32_t n) const { return nodes[n].child == kNone; }
-  std::uint32_t level(std::uint32_t n) const { return 31 - __builtin_clz(nodes[n].heap); }
+  std::uint32_t level(std::uint32_t n) const { return 63 - __builtin_clzll(nodes[n].heap); }
   bool splittable(std::uint32_t n) const { return level(n) < land.max_level(); }
 
   void mark_dirty(std::uint32_t n) {
@@ -396,6 +402,7 @@ struct RoamView::Impl {
   }
 
   void reset_to_roots() {
+    waiting.clear();
     split.clear();
     merge.clear();
     by_distance.clear(odometer);
@@ -609,8 +616,8 @@ struct RoamView::Impl {
   // within [lowest corner - bound, highest corner + bound]).
   void cache_box(std::uint32_t n) {
     Node& nd = nodes[n];
-    nd.bound = land.bound(nd.root, nd.heap);
     const LatticeTriangle t = land.triangle_at(nd.ax, nd.az, nd.root, nd.heap);
+    nd.bound = land.bound(nd.root, nd.heap, t);
     const float ha = land.lattice_height(t.ax, t.az), hl = land.lattice_height(t.lx, t.lz),
                 hr = land.lattice_height(t.rx, t.rz);
     nd.ylo = std::min({ha, hl, hr}) - nd.bound;
@@ -652,6 +659,50 @@ struct RoamView::Impl {
     nodes[c1].right = c0;
     replace_link(p.left, n, c0);
     replace_link(p.right, n, c1);
+  }
+
+  // True when the vertex a split of n creates (its hypotenuse midpoint) has its detail: a vertex
+  // of the stored lattice, or one whose tile is resident (requested otherwise: no waiting).
+  bool midpoint_ready(std::uint32_t n) {
+    if (level(n) < land.base_level()) return true;
+    const Node& nd = nodes[n];
+    const LatticeTriangle t = land.triangle_at(nd.ax, nd.az, nd.root, nd.heap);
+    const std::int64_t mx = std::clamp<std::int64_t>((t.lx + t.rx) / 2, 0, land.last_i());
+    const std::int64_t mz = std::clamp<std::int64_t>((t.lz + t.rz) / 2, 0, land.last_j());
+    const int L = int(land.detail_levels());
+    const int z = std::min({mx ? __builtin_ctzll(std::uint64_t(mx)) : 64,
+                            mz ? __builtin_ctzll(std::uint64_t(mz)) : 64, L});
+    if (z == L) return true;  // a stored vertex
+    const DetailTileKey key{std::uint32_t(L - z), std::int32_t((mx >> z) / kDetailTileCells),
+                            std::int32_t((mz >> z) / kDetailTileCells)};
+    return cache->request(key);
+  }
+
+  // True when every vertex that splitting leaf n (with its forced splits) creates has its detail.
+  bool chain_ready(std::uint32_t n) {
+    if (cache == nullptr) return true;
+    bool ready = true;
+    for (std::uint32_t x = n;;) {
+      ready = midpoint_ready(x) && ready;  // request every missing tile of the chain at once
+      const std::uint32_t b = nodes[x].base;
+      if (b == kNone || nodes[b].base == x) break;
+      x = b;
+    }
+    return ready;
+  }
+
+  // Takes leaf n out of the split queue until its tiles arrive.
+  void park(std::uint32_t n) {
+    split.remove(n);
+    waiting.push_back(n);
+  }
+
+  // Re-queues the parked leaves that are still leaves (their tiles may have arrived).
+  void unpark() {
+    std::vector<std::uint32_t> w;
+    w.swap(waiting);
+    for (std::uint32_t n : w)
+      if (n < nodes.size() && is_leaf(n) && nodes[n].qslot == kNone) push_split(n);
   }
 
   void split_leaf(std::uint32_t t, bool forced) {
@@ -961,8 +1012,15 @@ struct RoamView::EditHook final : detail::EditListener {
   explicit EditHook(RoamView& v) : view(v) {}
   void on_edit(const detail::EditRegion& r, EditResult& result) override {
     const Landscape& l = *view.landscape_;
-    result.view_nodes_updated +=
-        view.impl_->on_edit(r.i0, r.j0, l.edited_end_i(r.i1), l.edited_end_j(r.j1));
+    const int d = int(l.detail_levels());
+    std::int64_t i0 = r.i0, j0 = r.j0, i1 = l.edited_end_i(r.i1), j1 = l.edited_end_j(r.j1);
+    if (d > 0) {
+      // Finest-lattice vertices inside the cells around the changed samples moved too (the stored
+      // surface is interpolated there).
+      i0 = std::max<std::int64_t>(i0 - 1, 0) << d, j0 = std::max<std::int64_t>(j0 - 1, 0) << d;
+      i1 = (i1 + 1) << d, j1 = (j1 + 1) << d;
+    }
+    result.view_nodes_updated += view.impl_->on_edit(i0, j0, i1, j1);
   }
   RoamView& view;
 };
@@ -1036,6 +1094,7 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   };
 
+  if (m.cache != nullptr) m.cache->update();  // integrate tiles generated since the last frame
   m.has_deadline = budget > 0.0;
   m.deadline = t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                         std::chrono::duration<double, std::milli>(budget));
@@ -1077,6 +1136,7 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
   }
 
   m.keyed_threshold = threshold;
+  if (!m.waiting.empty()) m.unpark();
 
   // Greedy split/merge (D97 section 5): split the worst leaf while it exceeds the threshold,
   // merge the best diamond while it is within it; under a triangle cap, trade merges of
@@ -1098,6 +1158,10 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
     }
     if (s > threshold) {
       const std::uint32_t n = m.split.top().node;
+      if (!m.chain_ready(n)) {
+        m.park(n);
+        continue;
+      }
       if (cap != 0 && m.triangles + m.split_cost(n) > cap) {
         // Trade only a diamond that is not the leaf's own parent pair.
         if (g < s && m.nodes[n].parent != m.merge.top().node &&
@@ -1121,6 +1185,7 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
   triangles_ = m.triangles;
   m.st.triangles = m.triangles;
   m.st.max_remaining_error = m.split.empty() ? 0.0 : std::max(0.0f, m.split.top().key);
+  m.st.pending_splits = static_cast<std::uint32_t>(m.waiting.size());
   m.st.dirty_patches = static_cast<std::uint32_t>(m.dirty_list.size());
   m.st.memory_bytes = m.nodes.capacity() * sizeof(Node) + m.split.memory_bytes() +
                       m.merge.memory_bytes() + m.by_distance.memory_bytes() +
@@ -1198,13 +1263,14 @@ std::string RoamView::check_invariants() const {
         if (nb == kNone) continue;
         const Node& o = m.nodes[nb];
         if (o.child != kNone)
-          err = fmt("leaf %u (root %u heap %u) links to internal node %u", n, nd.root, nd.heap, nb);
+          err = fmt("leaf %u (root %u heap %llu) links to internal node %u", n, unsigned(nd.root),
+                    static_cast<unsigned long long>(nd.heap), nb);
         else if (o.base != n && o.left != n && o.right != n)
           err = fmt("leaf %u links to %u which does not link back", n, nb);
       }
       if (nd.base != kNone) {
         const Node& o = m.nodes[nd.base];
-        const std::uint32_t lo = 31 - __builtin_clz(o.heap), ln = 31 - __builtin_clz(nd.heap);
+        const std::uint32_t lo = 63 - __builtin_clzll(o.heap), ln = 63 - __builtin_clzll(nd.heap);
         if (o.base == n ? lo != ln : lo + 1 != ln)
           err = fmt("leaf %u and its base neighbour %u differ by more than one level", n, nd.base);
       }
@@ -1232,8 +1298,14 @@ const PatchMesh& RoamView::patch_mesh(std::uint32_t patch) {
   pm.indices.clear();
   pm.padding.clear();
   pm.version = m.patch_version[patch];
-  m.scratch_index.assign(std::size_t(P + 1) * std::size_t(P + 1), kNone);
-  const std::int64_t wmax = hf.width() - 1, hmax = hf.height() - 1;
+  // Vertex slots and geomorph data by lattice position: a dense table for patches of up to
+  // 2^18 vertices, a hash map beyond (patches refined into detail are sparse).
+  const std::size_t cells = std::size_t(P + 1) * std::size_t(P + 1);
+  const bool dense = cells <= (std::size_t{1} << 18);
+  m.scratch_index.assign(dense ? cells : 0, kNone);
+  std::unordered_map<std::size_t, std::uint32_t> sparse_index;
+  std::unordered_map<std::size_t, std::pair<float, float>> sparse_morph;
+  const std::int64_t wmax = l.last_i(), hmax = l.last_j();
 
   // Depth-first over the patch's two roots; a vertex's geomorph data comes from the diamond
   // whose split introduced it (the first time the traversal meets it as a midpoint).
@@ -1242,24 +1314,30 @@ const PatchMesh& RoamView::patch_mesh(std::uint32_t patch) {
     LatticeTriangle t;
   };
   std::vector<Item> stack;
-  std::vector<std::pair<float, float>> morph(m.scratch_index.size(), {0.0f, 0.0f});
+  std::vector<std::pair<float, float>> morph(dense ? cells : 0, {0.0f, 0.0f});
+  auto slot_of = [&](std::size_t key) -> std::uint32_t& {
+    return dense ? m.scratch_index[key] : sparse_index.try_emplace(key, kNone).first->second;
+  };
+  auto morph_of = [&](std::size_t key) -> std::pair<float, float>& {
+    return dense ? morph[key] : sparse_morph[key];
+  };
   auto vertex = [&](std::int64_t i, std::int64_t j) -> std::uint32_t {
     const std::size_t key = std::size_t(i - i0) + std::size_t(j - j0) * std::size_t(P + 1);
-    std::uint32_t& slot = m.scratch_index[key];
+    std::uint32_t& slot = slot_of(key);
     if (slot != kNone) return slot;
     slot = static_cast<std::uint32_t>(pm.vertices.size());
-    const auto ci = static_cast<std::uint32_t>(std::clamp<std::int64_t>(i, 0, wmax));
-    const auto cj = static_cast<std::uint32_t>(std::clamp<std::int64_t>(j, 0, hmax));
-    const glm::vec3 n = detail::vertex_normal(hf, ci, cj);
+    const glm::vec3 n = l.terrain().lattice_vertex_normal(std::clamp<std::int64_t>(i, 0, wmax),
+                                                          std::clamp<std::int64_t>(j, 0, hmax));
     MeshVertex v;
-    v.x = static_cast<float>(double(i - i0) * hf.spacing_x());
-    v.z = static_cast<float>(double(j - j0) * hf.spacing_z());
+    v.x = static_cast<float>(double(i - i0) * l.spacing_x());
+    v.z = static_cast<float>(double(j - j0) * l.spacing_z());
     v.y = l.lattice_height(i, j);
     v.nx = n.x;
     v.ny = n.y;
     v.nz = n.z;
-    v.morph_dy = morph[key].first;
-    v.morph_bound = morph[key].second;
+    const std::pair<float, float> mo = morph_of(key);
+    v.morph_dy = mo.first;
+    v.morph_bound = mo.second;
     pm.vertices.push_back(v);
     return slot;
   };
@@ -1282,12 +1360,11 @@ const PatchMesh& RoamView::patch_mesh(std::uint32_t patch) {
       const LatticeTriangle& t = it.t;
       const std::int64_t mx = (t.lx + t.rx) / 2, mz = (t.lz + t.rz) / 2;
       const std::size_t key = std::size_t(mx - i0) + std::size_t(mz - j0) * std::size_t(P + 1);
-      if (m.scratch_index[key] == kNone && morph[key].second == 0.0f) {
-        float b = l.bound(nd.root, nd.heap);
-        if (nd.base != kNone)
-          b = std::max(b, l.bound(m.nodes[nd.base].root, m.nodes[nd.base].heap));
+      if (slot_of(key) == kNone && morph_of(key).second == 0.0f) {
+        float b = nd.bound;
+        if (nd.base != kNone) b = std::max(b, m.nodes[nd.base].bound);
         const float interp = 0.5f * (l.lattice_height(t.lx, t.lz) + l.lattice_height(t.rx, t.rz));
-        morph[key] = {interp - l.lattice_height(mx, mz), std::max(b, 1e-30f)};
+        morph_of(key) = {interp - l.lattice_height(mx, mz), std::max(b, 1e-30f)};
       }
       stack.push_back({nd.child + 1, Landscape::child_triangle(it.t, 1)});
       stack.push_back({nd.child, Landscape::child_triangle(it.t, 0)});
@@ -1319,9 +1396,10 @@ RoamView::MeasuredError RoamView::measure_error(const Camera& camera, std::uint3
   const std::int64_t P = l.patch_cells();
   double sum2 = 0;
   std::vector<float> px;
-  for (std::uint32_t j = 0; j < hf.height(); j += stride) {
-    for (std::uint32_t i = 0; i < hf.width(); i += stride) {
-      const double y = hf.world(i, j);
+  for (std::int64_t j = 0; j <= l.last_j(); j += stride) {
+    for (std::int64_t i = 0; i <= l.last_i(); i += stride) {
+      const double surface = l.terrain().fine_local_height(i, j);
+      const double y = hf.height_offset() + surface;
       const glm::dvec3 p(l.world_x(i), y, l.world_z(j));
       double dist = 0;
       if (screen) {
@@ -1361,7 +1439,7 @@ RoamView::MeasuredError RoamView::measure_error(const Camera& camera, std::uint3
       const double plane = wa * l.lattice_height(t.ax, t.az) +
                            (1.0 - wa - wr) * l.lattice_height(t.lx, t.lz) +
                            wr * l.lattice_height(t.rx, t.rz);
-      const double err = std::abs(plane - double(hf.local(i, j)));
+      const double err = std::abs(plane - surface);
       out.max_m = std::max(out.max_m, err);
       sum2 += err * err;
       ++out.vertices;

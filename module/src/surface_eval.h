@@ -12,7 +12,10 @@ namespace ridgeline::detail {
 
 /// Unnormalised upward normal of the lattice triangle with corners (i + di[k], j + dj[k]), i.e.
 /// (p1 - p0) x (p2 - p0) in metres^2 (its length is twice the triangle's area).
-inline glm::dvec3 cell_triangle_cross(const Heightfield& hf, std::uint32_t i, std::uint32_t j,
+/// `Grid` is a Heightfield or any lattice with the same accessors (spacing_x/z(), width(),
+/// height(), local(i, j)): the terrain's finest lattice with detail (terrain.cpp).
+template <class Grid>
+inline glm::dvec3 cell_triangle_cross(const Grid& hf, std::uint32_t i, std::uint32_t j,
                                       const CellTriangle& t) {
   const double sx = hf.spacing_x(), sz = hf.spacing_z();
   glm::dvec3 p[3];
@@ -23,9 +26,10 @@ inline glm::dvec3 cell_triangle_cross(const Heightfield& hf, std::uint32_t i, st
 
 /// Area-weighted vertex normal at lattice vertex (i, j): the normalised sum of the cross products
 /// of every finest triangle that has (i, j) as a corner.
-inline glm::vec3 vertex_normal(const Heightfield& hf, std::uint32_t i, std::uint32_t j) {
+template <class Grid>
+inline glm::vec3 vertex_normal(const Grid& hf, std::uint32_t i, std::uint32_t j) {
   glm::dvec3 sum(0.0);
-  const std::int64_t w = hf.width(), h = hf.height();
+  const std::int64_t w = std::int64_t(hf.width()), h = std::int64_t(hf.height());
   for (int cj = -1; cj <= 0; ++cj) {
     for (int ci = -1; ci <= 0; ++ci) {
       const std::int64_t ii = std::int64_t(i) + ci, jj = std::int64_t(j) + cj;

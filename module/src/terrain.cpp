@@ -6,9 +6,11 @@
 #include <limits>
 
 #include "edit_layer.h"
+#include "ridgeline/detail.h"
 #include "edit_listener.h"
 #include "ray_hierarchy.h"
 #include "surface_eval.h"
+#include "terrain_fine.h"
 
 namespace ridgeline {
 
@@ -61,12 +63,22 @@ static inline float local_height(const Heightfield& hf, const Located& p) noexce
 }
 
 std::optional<double> Terrain::height(double x, double z) const noexcept {
+  if (detail_levels_ != 0) {
+    FineLocated f;
+    if (!locate_fine(x, z, f)) return std::nullopt;
+    return fine_height_at(f);
+  }
   Located p;
   if (!locate(heightfield_, inv_spacing_x_, inv_spacing_z_, x, z, p)) return std::nullopt;
   return heightfield_.height_offset() + double(local_height(heightfield_, p));
 }
 
 std::optional<glm::vec3> Terrain::face_normal(double x, double z) const noexcept {
+  if (detail_levels_ != 0) {
+    FineLocated f;
+    if (!locate_fine(x, z, f)) return std::nullopt;
+    return fine_face_normal(f);
+  }
   Located p;
   if (!locate(heightfield_, inv_spacing_x_, inv_spacing_z_, x, z, p)) return std::nullopt;
   return detail::face_normal(heightfield_, inv_spacing_x_, inv_spacing_z_, p.i, p.j, p.tri);
@@ -81,12 +93,22 @@ static glm::vec3 smooth_normal_at(const Heightfield& hf, const Located& p) noexc
 }
 
 std::optional<glm::vec3> Terrain::smooth_normal(double x, double z) const noexcept {
+  if (detail_levels_ != 0) {
+    FineLocated f;
+    if (!locate_fine(x, z, f)) return std::nullopt;
+    return fine_smooth_normal(f);
+  }
   Located p;
   if (!locate(heightfield_, inv_spacing_x_, inv_spacing_z_, x, z, p)) return std::nullopt;
   return smooth_normal_at(heightfield_, p);
 }
 
 std::optional<HeightNormal> Terrain::height_normal(double x, double z) const noexcept {
+  if (detail_levels_ != 0) {
+    FineLocated f;
+    if (!locate_fine(x, z, f)) return std::nullopt;
+    return HeightNormal{fine_height_at(f), fine_face_normal(f), fine_material(f)};
+  }
   Located p;
   if (!locate(heightfield_, inv_spacing_x_, inv_spacing_z_, x, z, p)) return std::nullopt;
   HeightNormal s;
@@ -98,6 +120,12 @@ std::optional<HeightNormal> Terrain::height_normal(double x, double z) const noe
 }
 
 std::optional<SurfaceSample> Terrain::sample(double x, double z) const noexcept {
+  if (detail_levels_ != 0) {
+    FineLocated f;
+    if (!locate_fine(x, z, f)) return std::nullopt;
+    return SurfaceSample{fine_height_at(f), fine_face_normal(f), fine_smooth_normal(f),
+                         fine_material(f)};
+  }
   Located p;
   if (!locate(heightfield_, inv_spacing_x_, inv_spacing_z_, x, z, p)) return std::nullopt;
   SurfaceSample s;
@@ -111,6 +139,11 @@ std::optional<SurfaceSample> Terrain::sample(double x, double z) const noexcept 
 
 void Terrain::heights(std::span<const glm::dvec2> xz, std::span<double> out) const noexcept {
   const std::size_t n = std::min(xz.size(), out.size());
+  if (detail_levels_ != 0) {
+    for (std::size_t k = 0; k < n; ++k)
+      out[k] = height(xz[k].x, xz[k].y).value_or(std::numeric_limits<double>::quiet_NaN());
+    return;
+  }
   for (std::size_t k = 0; k < n; ++k) {
     Located p;
     out[k] = locate(heightfield_, inv_spacing_x_, inv_spacing_z_, xz[k].x, xz[k].y, p)
@@ -130,7 +163,8 @@ void Terrain::samples(std::span<const glm::dvec2> xz, std::span<SurfaceSample> o
 }
 
 std::size_t Terrain::memory_bytes() const noexcept {
-  return sizeof(*this) + heightfield_.memory_bytes() + rays_->memory_bytes();
+  return sizeof(*this) + heightfield_.memory_bytes() + rays_->memory_bytes() +
+         (detail_ ? detail_->memory_bytes() : 0);
 }
 
 std::size_t Terrain::ray_hierarchy_bytes() const noexcept {

@@ -1,13 +1,17 @@
-# Shared by scripts/demo.sh and scripts/test.sh: package installation and the build.
+# Shared by scripts/game.sh, scripts/demo.sh and scripts/test.sh: package installation and the
+# build.
 # shellcheck shell=bash
 
 RIDGELINE_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 
-# Debian packages the build, the tests and the demo need (--no-install-recommends).
+# Debian packages the build, the tests and the game need (--no-install-recommends). The game:
+# GLFW, Dear ImGui, EGL and Mesa's software renderer; xvfb + xauth give it a display in CI.
 RIDGELINE_PACKAGES=(
   g++ cmake ninja-build pkg-config git ca-certificates
   libglm-dev libopenimageio-dev libtinygltf-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libbenchmark-dev liblua5.4-dev lua5.4
+  libglfw3-dev libimgui-dev libegl-dev libgl1-mesa-dri libegl-mesa0 libglx-mesa0
+  xvfb xauth
 )
 # Only for scripts/report.sh (the speed-versus-error report): plots and the CSV-to-plot step.
 RIDGELINE_REPORT_PACKAGES=(gnuplot-nox python3)
@@ -45,4 +49,14 @@ stage() {
   local rc=$?
   echo "=== stage: $name took $((SECONDS - t0)) s (exit $rc)"
   return $rc
+}
+
+# Runs a command under a virtual X server when there is no display and xvfb-run exists, so that
+# the game's window and hidden-window tests run in CI; runs it directly otherwise.
+with_display() {
+  if [ -z "${DISPLAY:-}" ] && command -v xvfb-run > /dev/null; then
+    xvfb-run -a -s "-screen 0 1280x720x24" "$@"
+  else
+    "$@"
+  fi
 }

@@ -258,5 +258,17 @@ run bench deform --default-terrain --count 5 --radii 5,20
 expect "bench deform" 0
 contains "bench deform reports medians" '"median_ms"'
 
+# ---- procedural detail flags -----------------------------------------------------------------------
+run info --heightmap "$PNG" --spacing 8 --detail-levels 3 --detail-seed 4
+expect "info with detail" 0
+contains "info reports the detail levels" '"detail_levels": 3'
+contains "info reports the finest spacing" '"finest_spacing": ['
+run info --default-terrain --detail-seed 4; expect "detail seed without levels" 1 "--detail-seed needs --detail-levels"
+run info --default-terrain --detail-levels 13; expect "too many detail levels" 1 "--detail-levels"
+run info --default-terrain --detail-levels 2 --detail-gain 0; expect "bad detail gain" 1 "gain is 0"
+run mesh --heightmap "$PNG" --spacing 8 --detail-levels 2 --detail-amplitude 0.5 --eye 16,1700,-30 --target 16,1200,12 --threshold 1 --out "$T/detail.glb"
+expect "mesh with detail" 0
+[ -s "$T/detail.glb" ] && ok || bad "mesh with detail wrote a file"
+
 echo "$passed passed, $failed failed"
 [ "$failed" = 0 ]

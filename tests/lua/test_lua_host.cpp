@@ -15,6 +15,9 @@ using ridgeline::lua::HostOptions;
 
 std::unique_ptr<Host> make_host(HostOptions options = {}) {
   options.data_root = RIDGELINE_TEST_DATA;
+  // The default wall-clock limit would make results depend on the machine's load (sanitizer
+  // builds on shared CI machines); tests that exercise the clock set their own.
+  if (options.time_limit_seconds == HostOptions{}.time_limit_seconds) options.time_limit_seconds = 0;
   auto host = Host::create(options);
   EXPECT_TRUE(host.ok()) << (host.ok() ? "" : host.error().message);
   return std::move(*host);
@@ -103,6 +106,108 @@ TEST(LuaHost, EscapesFailAndAreReported) {
   }
   EXPECT_FALSE(std::filesystem::exists("/tmp/ridgeline_pwned"));
   expect_alive(*host);
+}
+
+// Work inside C functions that the count hook cannot see (issue 9): each attack below ran for
+// hours (or forever) before the sandbox guards; now each ends its call with a clear error.
+struct Attack {
+  const char* name;
+  const char* source;
+  const char* expected;  // in the error message
+};
+
+void expect_contained(Host& host, const Attack& a) {
+  const auto s = host.run(a.source, a.name);
+  ASSERT_FALSE(s.ok()) << a.name;
+  EXPECT_NE(s.message().find(a.expected), std::string::npos) << a.name << ": " << s.message();
+  expect_alive(host);
+}
+
+TEST(LuaHost, UnboundedWorkInsideCFunctionsIsCharged) {
+  HostOptions o;
+  o.instruction_limit = 10'000'000;
+  o.time_limit_seconds = 0;  // the instruction budget alone must end these
+  auto host = make_host(o);
+  for (const Attack& a : {
+           // Each call is allowed (its worst case fits one call's budget), a loop is not.
+           Attack{"find loop", "local s = ('a'):rep(2000)\nwhile true do pcall(string.find, s, '.-b') end",
+                  "instruction limit exceeded (10000000 instructions per call"},
+           Attack{"gsub loop", "local s = ('ab'):rep(20000)\nwhile true do s:gsub('a*b', 'x') end",
+                  "instruction limit exceeded"},
+           Attack{"move loop", "local t = {}\nwhile true do pcall(table.move, t, 1, 5e6, 2) end",
+                  "instruction limit exceeded"},
+           Attack{"sort loop",
+                  "local t = {}\nfor i = 1, 100000 do t[i] = -i end\nwhile true do table.sort(t) end",
+                  "table.sort)"},
+           Attack{"collect loop",
+                  "local keep = {}\nfor i = 1, 300000 do keep[i] = {i} end\n"
+                  "while true do collectgarbage() end",
+                  "collectgarbage)"},
+           // load catches its reader's errors and returns them.
+           Attack{"endless comment", R"(local big, first = ('x'):rep(1 << 20), true
+                    local f, err = load(function()
+                      if first then first = false; return '--[[' end; return big end)
+                    assert(f == nil); error(err, 0))",
+                  "instruction limit exceeded"},
+           Attack{"concat loop", "local s = ('x'):rep(1 << 20)\nwhile true do local _ = s .. 'y' end",
+                  "instruction limit exceeded"},
+           Attack{"rep loop", "while true do local _ = ('x'):rep(1 << 20) end",
+                  "instruction limit exceeded"},
+           Attack{"pcall'ed pattern bomb", R"(
+                    for i = 1, 1e9 do pcall(string.find, ('a'):rep(1e5), '.-.-.-.-b') end)",
+                  "instruction limit exceeded"},
+       }) {
+    expect_contained(*host, a);
+  }
+  // A single pattern whose worst case exceeds one call's budget is refused before it runs.
+  const auto bomb = host->run("string.find(('a'):rep(1e5), '.-.-.-.-b')", "bomb");
+  EXPECT_NE(bomb.message().find("pattern too costly for the sandbox"), std::string::npos)
+      << bomb.message();
+  EXPECT_NE(bomb.message().find("stack traceback:"), std::string::npos) << bomb.message();
+}
+
+TEST(LuaHost, ErrorHandlingCannotBeHijacked) {
+  HostOptions o;
+  o.instruction_limit = 2'000'000;
+  auto host = make_host(o);
+  // The message handler runs with the limits off; it must not call a script's __tostring.
+  const auto s = host->run(
+      "error(setmetatable({}, {__tostring = function() while true do end end}))", "tostring");
+  EXPECT_NE(s.message().find("(error object is a table value)"), std::string::npos)
+      << s.message();
+  expect_alive(*host);
+  // A to-be-closed variable whose __close loops while the call is being ended.
+  expect_contained(*host, {"close", R"(
+    local x <close> = setmetatable({}, {__close = function() while true do end end})
+    while true do end)",
+                           "instruction limit exceeded"});
+  // A message handler of the script's own (xpcall) that loops.
+  expect_contained(*host, {"xpcall", R"(
+    xpcall(function() while true do end end, function() while true do end end)
+    while true do end)",
+                           "limit exceeded"});
+  // Resuming a coroutine that catches the limit error and loops on.
+  expect_contained(*host, {"coroutine", R"(
+    local co = coroutine.wrap(function()
+      while true do pcall(function() while true do end end) end
+    end)
+    co())",
+                           "instruction limit exceeded"});
+}
+
+TEST(LuaHost, WallClockEndsInstructionsThatCostTheirOperandsLength) {
+  // Comparing two distinct equal 16 MiB strings is one VM instruction and one memcmp: a loop of
+  // them would run for days inside the instruction budget. The wall-clock limit ends it.
+  HostOptions o;
+  o.instruction_limit = 0;
+  o.time_limit_seconds = 0.5;
+  auto host = make_host(o);
+  expect_contained(*host, {"equal strings", R"(
+    local a = ('x'):rep(1 << 24)
+    local b = ('x'):rep((1 << 24) - 1) .. 'x'
+    local n = 0
+    while true do if a == b then n = n + 1 end end)",
+                           "time limit exceeded (0.5 s per call)"});
 }
 
 TEST(LuaHost, GameCallbacks) {

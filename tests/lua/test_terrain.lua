@@ -133,3 +133,25 @@ T.case("release", function()
   end
   T.raises("attempt to use a released ridgeline.terrain", kept.height, kept, 102, 202)
 end)
+
+T.case("procedural detail through load", function()
+  local t = assert(ridgeline.load{heightmap = DATA .. "ramp16.png", spacing = 8, detail_levels = 3,
+                                  detail_seed = 7, detail_amplitude = 0.5})
+  local base = assert(ridgeline.load{heightmap = DATA .. "ramp16.png", spacing = 8})
+  -- At stored samples the detail is zero; between them the surface differs from the plane.
+  T.near(t:height(8, 8), base:height(8, 8), 1e-4, "stored sample")
+  local differs = false
+  for i = 1, 20 do
+    if math.abs(t:height(8 + i * 0.77, 9.3) - base:height(8 + i * 0.77, 9.3)) > 1e-3 then differs = true end
+  end
+  T.truthy(differs, "detail between the stored samples")
+  local again = assert(ridgeline.load{heightmap = DATA .. "ramp16.png", spacing = 8, detail_levels = 3,
+                                      detail_seed = 7, detail_amplitude = 0.5})
+  T.eq(again:height(13.1, 9.7), t:height(13.1, 9.7), "deterministic")
+  T.raises("field 'detail_levels': whole number in 0..12 expected", ridgeline.load,
+           {heightmap = DATA .. "ramp16.png", detail_levels = 13})
+  local bad, err = ridgeline.load{heightmap = DATA .. "ramp16.png", detail_levels = 2, detail_gain = 3}
+  T.eq(bad, nil); T.truthy(err:find("gain is 3", 1, true), err)
+  bad, err = ridgeline.load{heightmap = DATA .. "ramp16.png", detail_levels = 2, detail_amplitude = -1}
+  T.eq(bad, nil); T.truthy(err:find("amplitude", 1, true), err)
+end)

@@ -3,6 +3,8 @@
 #include "ridgeline/lua/host.h"
 
 #include <algorithm>
+#include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -11,6 +13,7 @@
 #include <sstream>
 
 #include "lua_util.h"
+#include "sandbox_guards.h"
 #include "ridgeline/lua/module.h"
 
 namespace ridgeline::lua {
@@ -22,8 +25,9 @@ struct Host::Limits {
   std::size_t hard_limit = 0;      // refused above this (memory_limit + headroom)
   std::size_t used = 0;            // bytes held by the owned state
   bool active = false;             // limits apply (off while the host sets the state up)
-  bool handling = false;           // inside the message handler: let it finish
   std::uint64_t failed_request = 0;
+  double time_limit = 0;                          // seconds per call; 0: none
+  std::chrono::steady_clock::time_point started;  // of the current call
   lua_State* main = nullptr;  // the thread the host calls on
 };
 
@@ -47,7 +51,12 @@ void* limited_alloc(void* ud, void* ptr, std::size_t osize, std::size_t nsize) {
     return nullptr;  // Lua raises "not enough memory" (after an emergency collection)
   }
   void* p = std::realloc(ptr, nsize);
-  if (p != nullptr) lim->used = lim->used - old + nsize;
+  if (p != nullptr) {
+    lim->used = lim->used - old + nsize;
+    // C functions that build big strings or tables (string.rep, table.concat, gsub) do work the
+    // hook does not count: every 64 bytes allocated cost one instruction.
+    if (lim->active && nsize > old) lim->instructions += (nsize - old) / 64;
+  }
   return p;
 }
 
@@ -58,18 +67,32 @@ Host::Limits* limits_of(lua_State* L) {
   return lim;
 }
 
+bool over_limits(const Host::Limits& lim) {
+  return (lim.instruction_limit != 0 && lim.instructions > lim.instruction_limit) ||
+         (lim.memory_limit != 0 && lim.used > lim.memory_limit) ||
+         (lim.time_limit > 0 &&
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - lim.started).count() >
+              lim.time_limit);
+}
+
 // Once a limit is exceeded the hook fires on every instruction of the running thread and of the
 // host's main thread, so that a script cannot keep going by catching the error with pcall (at a
 // 1000-instruction period the check would keep landing inside the pcall'ed loop).
 void count_hook(lua_State* L, lua_Debug*) {
   Host::Limits* lim = limits_of(L);
-  if (lim == nullptr || !lim->active || lim->handling) return;
+  if (lim == nullptr || !lim->active) return;
   const int step = lua_gethookcount(L);
   lim->instructions += static_cast<std::uint64_t>(step);
   const bool over_instructions =
       lim->instruction_limit != 0 && lim->instructions > lim->instruction_limit;
   const bool over_memory = lim->memory_limit != 0 && lim->used > lim->memory_limit;
-  if (!over_instructions && !over_memory) {
+  // Wall clock, for single instructions whose C work is proportional to a string's length
+  // (comparing two long equal strings is one instruction and one memcmp).
+  const bool over_time =
+      lim->time_limit > 0 &&
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - lim->started).count() >
+          lim->time_limit;
+  if (!over_instructions && !over_memory && !over_time) {
     if (step != kHookStep) lua_sethook(L, count_hook, LUA_MASKCOUNT, kHookStep);
     return;
   }
@@ -78,27 +101,71 @@ void count_hook(lua_State* L, lua_Debug*) {
   if (over_instructions)
     luaL_error(L, "instruction limit exceeded (%I instructions per call)",
                static_cast<lua_Integer>(lim->instruction_limit));
+  if (over_time) luaL_error(L, "time limit exceeded (%f s per call)", lim->time_limit);
   luaL_error(L, "memory limit exceeded (%I bytes in use, limit %I)",
              static_cast<lua_Integer>(lim->used), static_cast<lua_Integer>(lim->memory_limit));
 }
 
-// Adds a traceback to the error (lua.c's msghandler).
+// Adds a traceback to the error (lua.c's msghandler, without its __tostring call: when the error
+// was raised by the count hook, Lua runs the handler with hooks off, so a script's __tostring
+// would run unbounded).
 int message_handler(lua_State* L) {
-  Host::Limits* lim = limits_of(L);
-  if (lim != nullptr) lim->handling = true;
-  const char* msg = lua_tostring(L, 1);
-  if (msg == nullptr) {
-    if (luaL_callmeta(L, 1, "__tostring") && lua_type(L, -1) == LUA_TSTRING) return 1;
+  const char* msg = lua_type(L, 1) == LUA_TSTRING || lua_type(L, 1) == LUA_TNUMBER
+                        ? lua_tostring(L, 1)
+                        : nullptr;
+  if (msg == nullptr)
     msg = lua_pushfstring(L, "(error object is a %s value)", luaL_typename(L, 1));
-  }
   luaL_traceback(L, L, msg, 1);
   return 1;
 }
 
+// The message handler a script gives xpcall, wrapped: when the error comes from the count hook
+// (a limit), Lua calls the handler with hooks still off, and a looping handler would never end.
+// Past a limit the error goes on unhandled; otherwise the script's handler runs as usual.
+int guarded_handler(lua_State* L) {
+  const Host::Limits* lim = limits_of(L);
+  if (lim != nullptr && lim->active && over_limits(*lim)) return 1;
+  lua_pushvalue(L, lua_upvalueindex(1));
+  lua_insert(L, 1);
+  lua_call(L, lua_gettop(L) - 1, 1);
+  return 1;
+}
+
+// xpcall(f, msgh, ...) with msgh wrapped as above.
+int safe_xpcall(lua_State* L) {
+  luaL_checktype(L, 2, LUA_TFUNCTION);
+  lua_pushvalue(L, 2);
+  lua_pushcclosure(L, guarded_handler, 1);
+  lua_replace(L, 2);
+  lua_pushvalue(L, lua_upvalueindex(1));
+  lua_insert(L, 1);
+  lua_call(L, lua_gettop(L) - 1, LUA_MULTRET);
+  return lua_gettop(L);
+}
+
+// A reader function given to load, wrapped so that the bytes it returns are charged: the parser
+// runs in C, and a reader that keeps returning one long comment would parse forever.
+int charged_reader(lua_State* L) {
+  lua_pushvalue(L, lua_upvalueindex(1));
+  lua_call(L, 0, 1);
+  std::size_t len = 0;
+  if (lua_type(L, -1) == LUA_TSTRING) lua_tolstring(L, -1, &len);
+  detail::charge_work(L, static_cast<double>(len), "load");
+  return 1;
+}
+
 // load(chunk [, name [, mode [, env]]]): text chunks only; the default environment is the
-// sandbox, never the state's real globals.
+// sandbox, never the state's real globals. The chunk's bytes are charged to the budget (parsing
+// is C work the hook does not see).
 int safe_load(lua_State* L) {
   lua_settop(L, 4);
+  if (lua_type(L, 1) == LUA_TSTRING) {
+    detail::charge_work(L, static_cast<double>(lua_rawlen(L, 1)), "load");
+  } else if (lua_type(L, 1) == LUA_TFUNCTION) {
+    lua_pushvalue(L, 1);
+    lua_pushcclosure(L, charged_reader, 1);
+    lua_replace(L, 1);
+  }
   lua_pushvalue(L, lua_upvalueindex(1));  // the original load
   lua_pushvalue(L, 1);
   lua_pushvalue(L, 2);
@@ -123,10 +190,16 @@ int safe_setmetatable(lua_State* L) {
   return 1;
 }
 
-// collectgarbage limited to options that cannot switch the collector off or retune it.
+// collectgarbage limited to options that cannot switch the collector off or retune it. A collection
+// walks the whole heap in C: "collect" and "step" are charged one instruction per 16 bytes in use.
 int safe_collectgarbage(lua_State* L) {
   static const char* const kAllowed[] = {"collect", "count", "step", "isrunning", nullptr};
-  luaL_checkoption(L, 1, "collect", kAllowed);
+  const int opt = luaL_checkoption(L, 1, "collect", kAllowed);
+  if (opt == 0 || opt == 2) {
+    const Host::Limits* lim = limits_of(L);
+    const double used = lim != nullptr ? static_cast<double>(lim->used) : 0;
+    detail::charge_work(L, used / 16, "collectgarbage");
+  }
   lua_pushvalue(L, lua_upvalueindex(1));
   lua_insert(L, 1);
   lua_call(L, lua_gettop(L) - 1, LUA_MULTRET);
@@ -162,11 +235,14 @@ int setup_state(lua_State* L) {
   const int env = lua_gettop(L);
   for (const luaL_Reg* lib = kLibs; lib->func != nullptr; ++lib) {
     luaL_requiref(L, lib->name, lib->func, 0);
+    // Guards in the library tables themselves (the string metatable indexes the original).
+    if (lib->func == luaopen_string) detail::install_string_guards(L, lua_absindex(L, -1));
+    if (lib->func == luaopen_table) detail::install_table_guards(L, lua_absindex(L, -1));
     if (lib == kLibs) {  // base: copy the allowed functions only
       static const char* const kBase[] = {
           "assert",   "error",  "ipairs",       "next",     "pairs",  "pcall",    "print",
           "rawequal", "rawget", "rawlen",       "rawset",   "select", "tonumber", "tostring",
-          "type",     "xpcall", "getmetatable", "_VERSION", nullptr};
+          "type",     "getmetatable", "_VERSION", nullptr};
       for (const char* const* n = kBase; *n != nullptr; ++n) {
         lua_getfield(L, -1, *n);
         lua_setfield(L, env, *n);
@@ -177,6 +253,9 @@ int setup_state(lua_State* L) {
       lua_getfield(L, -1, "setmetatable");
       lua_pushcclosure(L, safe_setmetatable, 1);
       lua_setfield(L, env, "setmetatable");
+      lua_getfield(L, -1, "xpcall");
+      lua_pushcclosure(L, safe_xpcall, 1);
+      lua_setfield(L, env, "xpcall");
       lua_getfield(L, -1, "collectgarbage");
       lua_pushcclosure(L, safe_collectgarbage, 1);
       lua_setfield(L, env, "collectgarbage");
@@ -188,10 +267,6 @@ int setup_state(lua_State* L) {
         lua_pushvalue(L, -2);
         lua_insert(L, -2);
         lua_settable(L, -4);
-      }
-      if (lib->func == luaopen_string) {
-        lua_pushnil(L);
-        lua_setfield(L, -2, "dump");
       }
       lua_setfield(L, env, lib->name);
     }
@@ -248,6 +323,30 @@ std::string top_message(lua_State* L, int rc, const Host::Limits& lim) {
 
 }  // namespace
 
+namespace detail {
+
+double work_limit(lua_State* L) {
+  const Host::Limits* lim = limits_of(L);
+  return lim != nullptr && lim->active ? static_cast<double>(lim->instruction_limit) : 0;
+}
+
+void charge_work(lua_State* L, double steps, const char* what) {
+  Host::Limits* lim = limits_of(L);
+  if (lim == nullptr || !lim->active || lim->instruction_limit == 0 || !(steps > 0)) return;
+  const double limit = static_cast<double>(lim->instruction_limit);
+  const double after = static_cast<double>(lim->instructions) + std::ceil(steps);
+  lim->instructions = after >= limit ? lim->instruction_limit + 1
+                                     : static_cast<std::uint64_t>(after);
+  if (lim->instructions <= lim->instruction_limit) return;
+  // Over: as count_hook does, every later instruction raises again.
+  lua_sethook(L, count_hook, LUA_MASKCOUNT, 1);
+  if (lim->main != nullptr && lim->main != L) lua_sethook(lim->main, count_hook, LUA_MASKCOUNT, 1);
+  luaL_error(L, "instruction limit exceeded (%I instructions per call; %s)",
+             static_cast<lua_Integer>(lim->instruction_limit), what);
+}
+
+}  // namespace detail
+
 Result<std::unique_ptr<Host>> Host::create(const HostOptions& options) {
   std::unique_ptr<Host> host(new Host());
   host->limits_ = std::make_unique<Limits>();
@@ -274,6 +373,7 @@ Status Host::setup(const HostOptions& options) {
     return Error{"lua host: data_root is too long"};
   Limits& lim = *limits_;
   lim.instruction_limit = options.instruction_limit;
+  lim.time_limit = options.time_limit_seconds > 0 ? options.time_limit_seconds : 0;
   lim.memory_limit = owned_ ? options.memory_limit : 0;
   lim.hard_limit =
       lim.memory_limit + std::max<std::size_t>(std::size_t{1} << 20, lim.memory_limit / 8);
@@ -314,10 +414,9 @@ Status Host::call(int nargs, int nresults) {
   lua_pushcfunction(L, message_handler);
   lua_insert(L, base);
   limits_->instructions = 0;
-  limits_->handling = false;
+  limits_->started = std::chrono::steady_clock::now();
   lua_sethook(L, count_hook, LUA_MASKCOUNT, kHookStep);
   const int rc = lua_pcall(L, nargs, nresults, base);
-  limits_->handling = false;
   lua_remove(L, base);
   if (rc == LUA_OK) return {};
   std::string msg = top_message(L, rc, *limits_);
@@ -363,6 +462,30 @@ Status Host::call_global(const char* name) {
   lua_pushcfunction(L, call_global_protected);
   lua_pushlightuserdata(L, const_cast<char*>(name));
   return call(1, 0);
+}
+
+Status Host::set_global(const char* name) {
+  lua_State* L = L_;
+  if (lua_gettop(L) < 1) return Error{"lua host: set_global: no value on the stack"};
+  if (!lua_checkstack(L, 4)) return Error{"lua host: stack overflow"};
+  // rawset on a table with a string key cannot raise except for memory: do it protected.
+  lua_pushcfunction(L, [](lua_State* S) -> int {
+    lua_rawgetp(S, LUA_REGISTRYINDEX, &kSandboxKey);
+    lua_pushvalue(S, 1);
+    lua_pushvalue(S, 2);
+    lua_rawset(S, -3);
+    return 0;
+  });
+  lua_pushstring(L, name);
+  lua_pushvalue(L, -3);
+  const int rc = lua_pcall(L, 2, 0, 0);
+  if (rc != LUA_OK) {
+    std::string msg = lua_tostring(L, -1) != nullptr ? lua_tostring(L, -1) : "error";
+    lua_pop(L, 2);
+    return Error{"lua host: set_global '" + std::string(name) + "': " + msg};
+  }
+  lua_pop(L, 1);
+  return {};
 }
 
 std::size_t Host::memory_used() const noexcept {

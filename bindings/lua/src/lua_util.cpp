@@ -129,13 +129,24 @@ void push_metatable(lua_State* L, const char* tname, const luaL_Reg* methods,
 
 bool resolve_path(const ConfigBox& config, const char* name, char* out, std::size_t size,
                   char* err) noexcept {
+  return resolve_path(config.confine_paths, config.root, name, out, size, err);
+}
+
+void set_path_rules(TerrainBox* box, const ConfigBox& config) {
+  box->confine_paths = config.confine_paths;
+  box->root = std::make_shared<const std::string>(config.root);
+}
+
+bool resolve_path(bool confine_paths, const char* config_root, const char* name, char* out,
+                  std::size_t size, char* err) noexcept {
   namespace fs = std::filesystem;
+  if (config_root == nullptr) config_root = "";
   try {
     if (name[0] == '\0') {
       copy_error(err, "empty file name");
       return false;
     }
-    if (!config.confine_paths) {
+    if (!confine_paths) {
       if (std::strlen(name) + 1 > size) {
         copy_error(err, "file name too long");
         return false;
@@ -143,8 +154,13 @@ bool resolve_path(const ConfigBox& config, const char* name, char* out, std::siz
       std::strcpy(out, name);
       return true;
     }
-    std::string msg = std::string("file '") + name + "': ";
-    if (config.root[0] == '\0') {
+    // The name as given, shortened so that the reason still fits the error buffer.
+    const std::string_view given(name);
+    std::string msg = "file '" +
+                      (given.size() > 160 ? std::string(given.substr(0, 160)) + "..."
+                                          : std::string(given)) +
+                      "': ";
+    if (config_root[0] == '\0') {
       copy_error(err, (msg + "file access is not granted to scripts").c_str());
       return false;
     }
@@ -167,7 +183,7 @@ bool resolve_path(const ConfigBox& config, const char* name, char* out, std::siz
     }
     // Symbolic links may still point outside: compare canonical forms.
     std::error_code ec;
-    const fs::path root = fs::weakly_canonical(fs::path(config.root), ec);
+    const fs::path root = fs::weakly_canonical(fs::path(config_root), ec);
     if (ec) {
       copy_error(err, (msg + "the granted folder is not accessible").c_str());
       return false;

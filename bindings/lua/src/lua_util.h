@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <lua.hpp>
 #include <memory>
+#include <string>
 
 #include "ridgeline/landscape.h"
 #include "ridgeline/lua/module.h"
@@ -21,6 +22,7 @@ namespace ridgeline::lua::detail {
 inline constexpr char kTerrainMeta[] = "ridgeline.terrain";
 inline constexpr char kViewMeta[] = "ridgeline.view";
 inline constexpr char kConfigMeta[] = "ridgeline.config";
+inline constexpr char kBudgetMeta[] = "ridgeline.budget_controller";
 inline constexpr std::size_t kErrSize = 512;
 
 /// Per-module-table settings and caches: a userdata (with __gc) that module functions reach as
@@ -35,6 +37,9 @@ struct ConfigBox {
 /// A terrain userdata. Released: `terrain` is empty.
 struct TerrainBox {
   std::shared_ptr<Terrain> terrain;
+  // The path rules of the module that made it (terrain:save_edits / load_edits).
+  bool confine_paths = true;
+  std::shared_ptr<const std::string> root;
   std::shared_ptr<const Landscape> landscape;  // built on the first new_view
 };
 
@@ -81,6 +86,11 @@ ViewBox* push_view_box(lua_State* L);
 /// bytes). Returns false with a message in `err` when the name is refused. No Lua calls.
 bool resolve_path(const ConfigBox& config, const char* name, char* out, std::size_t size,
                   char* err) noexcept;
+/// The same with the rules spelled out (`root` may be null: no file access when confined).
+bool resolve_path(bool confine_paths, const char* root, const char* name, char* out,
+                  std::size_t size, char* err) noexcept;
+/// Gives a new terrain box the module's path rules.
+void set_path_rules(TerrainBox* box, const ConfigBox& config);
 
 /// Tells the collector about C++ memory held by a new object (kilobytes), so that dropped
 /// objects are finalized before they pile up.
@@ -88,8 +98,11 @@ void account_memory(lua_State* L, std::size_t bytes);
 
 /// Method tables, for `open_module`.
 int new_view(lua_State* L);  // terrain:new_view, defined in wrap_view.cpp
+int new_budget_controller(lua_State* L);  // ridgeline.budget_controller, wrap_budget.cpp
 int t_deform(lua_State* L);      // terrain:deform, wrap_edit.cpp
 int r_save_edits(lua_State* L);  // ridgeline.save_edits, wrap_edit.cpp
 int r_load_edits(lua_State* L);  // ridgeline.load_edits, wrap_edit.cpp
+int t_save_edits(lua_State* L);  // terrain:save_edits, wrap_edit.cpp
+int t_load_edits(lua_State* L);  // terrain:load_edits, wrap_edit.cpp
 
 }  // namespace ridgeline::lua::detail

@@ -102,11 +102,11 @@ ConfigBox* config_of(lua_State* L) {
 
 enum class FileOp { kSave, kLoad };
 
-bool do_file(const ConfigBox& config, Terrain& t, const char* name, FileOp op, EditResult* out,
-             char* err) noexcept {
+bool do_file(bool confine, const char* root, Terrain& t, const char* name, FileOp op,
+             EditResult* out, char* err) noexcept {
   try {
     char path[4096];
-    if (!resolve_path(config, name, path, sizeof path, err)) return false;
+    if (!resolve_path(confine, root, name, path, sizeof path, err)) return false;
     if (op == FileOp::kSave) {
       if (auto s = save_edits(t, path); !s) {
         copy_error(err, s.message().c_str());
@@ -127,13 +127,26 @@ bool do_file(const ConfigBox& config, Terrain& t, const char* name, FileOp op, E
   }
 }
 
-int file_op(lua_State* L, FileOp op) {
+// `method`: terrain:save_edits / load_edits (the terrain's own path rules); otherwise the module
+// functions (the module's rules, upvalue 1).
+int file_op(lua_State* L, FileOp op, bool method) {
   Terrain& t = editable_terrain(L, 1);
   const char* name = luaL_checkstring(L, 2);
   if (std::strlen(name) != lua_rawlen(L, 2)) luaL_argerror(L, 2, "file name holds a NUL byte");
+  bool confine = true;
+  const char* root = nullptr;  // kept alive by the terrain box or the module's config
+  if (method) {
+    const auto* box = static_cast<TerrainBox*>(lua_touserdata(L, 1));
+    confine = box->confine_paths;
+    root = box->root ? box->root->c_str() : nullptr;
+  } else {
+    const ConfigBox* config = config_of(L);
+    confine = config->confine_paths;
+    root = config->root;
+  }
   char err[kErrSize];
   EditResult r;
-  if (!do_file(*config_of(L), t, name, op, &r, err)) {
+  if (!do_file(confine, root, t, name, op, &r, err)) {
     lua_pushnil(L);
     lua_pushstring(L, err);
     return 2;
@@ -165,8 +178,11 @@ int t_deform(lua_State* L) {
 }
 
 // ridgeline.save_edits(terrain, file) -> true or nil, message
-int r_save_edits(lua_State* L) { return file_op(L, FileOp::kSave); }
+int r_save_edits(lua_State* L) { return file_op(L, FileOp::kSave, false); }
 // ridgeline.load_edits(terrain, file) -> result table (as deform) or nil, message
-int r_load_edits(lua_State* L) { return file_op(L, FileOp::kLoad); }
+int r_load_edits(lua_State* L) { return file_op(L, FileOp::kLoad, false); }
+// terrain:save_edits(file) -> true or nil, message; terrain:load_edits(file) -> result or nil, message
+int t_save_edits(lua_State* L) { return file_op(L, FileOp::kSave, true); }
+int t_load_edits(lua_State* L) { return file_op(L, FileOp::kLoad, true); }
 
 }  // namespace ridgeline::lua::detail

@@ -1,9 +1,11 @@
 // The `ridgeline` module table: loading terrains; the per-module configuration userdata.
+#include <cmath>
 #include <cstring>
 #include <exception>
 #include <new>
 
 #include "lua_util.h"
+#include "ridgeline/detail.h"
 #include "ridgeline/io.h"
 
 namespace ridgeline::lua::detail {
@@ -22,6 +24,8 @@ struct LoadArgs {
   bool has_nodata = false;
   double nodata = 0;
   bool fill_nearest = false;
+  double detail_levels = 0, detail_seed = 1, detail_amplitude = 0, detail_gain = 0;
+  bool has_amplitude = false, has_gain = false;
 };
 
 bool do_load(const ConfigBox& config, const LoadArgs& a, TerrainBox* box, char* err) noexcept {
@@ -53,7 +57,19 @@ bool do_load(const ConfigBox& config, const LoadArgs& a, TerrainBox* box, char* 
       }
       return false;
     }
-    box->terrain = Terrain::create(std::move(*hf));
+    DetailParams detail;
+    detail.levels = static_cast<std::uint32_t>(a.detail_levels);
+    detail.seed = static_cast<std::uint64_t>(a.detail_seed);
+    if (a.has_amplitude) detail.amplitude = a.detail_amplitude;
+    if (a.has_gain) detail.gain = a.detail_gain;
+    // Scripts never wait for tiles: two workers generate them; views hold coarser meanwhile.
+    auto t = Terrain::create(std::move(*hf), detail, {.worker_threads = 2});
+    if (!t) {
+      copy_error(err, t.error().message.c_str());
+      return false;
+    }
+    box->terrain = std::move(*t);
+    set_path_rules(box, config);
     return true;
   } catch (const std::exception& e) {
     copy_error(err, e.what());
@@ -66,8 +82,9 @@ bool do_load(const ConfigBox& config, const LoadArgs& a, TerrainBox* box, char* 
 int r_load(lua_State* L) {
   const ConfigBox* config = config_of(L);
   luaL_checktype(L, 1, LUA_TTABLE);
-  static const char* const kFields[] = {"heightmap",     "spacing", "origin", "height_scale",
-                                        "height_offset", "nodata",  "fill",   nullptr};
+  static const char* const kFields[] = {
+      "heightmap", "spacing",       "origin",      "height_scale",     "height_offset", "nodata",
+      "fill",      "detail_levels", "detail_seed", "detail_amplitude", "detail_gain",   nullptr};
   check_fields(L, 1, kFields);
   lua_settop(L, 1);
   LoadArgs a;
@@ -98,6 +115,15 @@ int r_load(lua_State* L) {
       luaL_argerror(L, 1, "field 'fill': 'refuse' or 'nearest' expected");
   }
   lua_pop(L, 1);
+  if (get_number_field(L, 1, "detail_levels", &a.detail_levels) &&
+      (a.detail_levels != std::floor(a.detail_levels) || a.detail_levels < 0 ||
+       a.detail_levels > kMaxDetailLevels))
+    luaL_argerror(L, 1, "field 'detail_levels': whole number in 0..12 expected");
+  if (get_number_field(L, 1, "detail_seed", &a.detail_seed) &&
+      (a.detail_seed != std::floor(a.detail_seed) || a.detail_seed < 0 || a.detail_seed > 9007199254740992.0))
+    luaL_argerror(L, 1, "field 'detail_seed': whole number in 0..2^53 expected");
+  a.has_amplitude = get_number_field(L, 1, "detail_amplitude", &a.detail_amplitude);
+  a.has_gain = get_number_field(L, 1, "detail_gain", &a.detail_gain);
   TerrainBox* box = push_terrain_box(L);
   char err[kErrSize];
   if (!do_load(*config, a, box, err)) {
@@ -120,6 +146,7 @@ bool make_default(ConfigBox* config, TerrainBox* box, char* err) noexcept {
       config->default_terrain = Terrain::create(std::move(*hf));
     }
     box->terrain = config->default_terrain;
+    set_path_rules(box, *config);
     return true;
   } catch (const std::exception& e) {
     copy_error(err, e.what());
@@ -146,6 +173,7 @@ int config_gc(lua_State* L) {
 const luaL_Reg kFunctions[] = {
     {"load", r_load},
     {"default_terrain", r_default_terrain},
+    {"budget_controller", new_budget_controller},
     {"save_edits", r_save_edits},
     {"load_edits", r_load_edits},
     {nullptr, nullptr}};
@@ -154,6 +182,11 @@ const luaL_Reg kFunctions[] = {
 }  // namespace ridgeline::lua::detail
 
 namespace ridgeline::lua {
+
+void push_terrain(lua_State* L, std::shared_ptr<Terrain> terrain) {
+  detail::TerrainBox* box = detail::push_terrain_box(L);
+  box->terrain = std::move(terrain);  // no Lua call after the push: nothing can longjmp here
+}
 
 int open_module(lua_State* L, const ModuleConfig& config) {
   using namespace detail;

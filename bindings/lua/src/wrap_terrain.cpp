@@ -300,6 +300,7 @@ int t_release(lua_State* L) {
   auto* box = static_cast<TerrainBox*>(check_self(L, kTerrainMeta));
   box->terrain.reset();
   box->landscape.reset();
+  box->root.reset();
   return 0;
 }
 
@@ -321,7 +322,8 @@ const luaL_Reg kMethods[] = {
     {"height", t_height},   {"normal", t_normal},     {"smooth_normal", t_smooth_normal},
     {"sample", t_sample},   {"heights", t_heights},   {"raycast", t_raycast},
     {"place", t_place},     {"contacts", t_contacts}, {"bounds", t_bounds},
-    {"new_view", new_view}, {"deform", t_deform},     {"release", t_release},
+    {"new_view", new_view}, {"deform", t_deform},     {"save_edits", t_save_edits},
+    {"load_edits", t_load_edits}, {"release", t_release},
     {nullptr, nullptr}};
 const luaL_Reg kMeta[] = {
     {"__gc", t_release}, {"__close", t_release}, {"__tostring", t_tostring}, {nullptr, nullptr}};

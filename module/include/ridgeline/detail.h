@@ -1,7 +1,7 @@
 // Procedural detail below the stored resolution (SPEC.md "The surface", with L detail levels;
-// docs/detail.md). This header is the detail layer's core: the detail function, its tiles, a
-// tile cache with worker threads, and conservative amplitude bounds. The ROAM tessellator and
-// the queries do not use it yet (docs/detail.md, "Not integrated yet").
+// docs/detail.md): the detail function, its tiles, a tile cache with worker threads, and
+// conservative amplitude bounds. A Terrain created with DetailParams owns a field and a cache
+// and makes them part of its surface (queries, Landscape, RoamView).
 #pragma once
 
 #include <cstddef>
@@ -128,7 +128,7 @@ class DetailField {
                                                            const DetailParams& params);
 
   const DetailParams& params() const noexcept { return params_; }
-  const Terrain& terrain() const noexcept { return *terrain_; }
+  const Terrain& terrain() const noexcept { return *base_; }
   std::uint32_t levels() const noexcept { return params_.levels; }
 
   /// Detail at level-`level` lattice sample (i, j) in units of kDetailUnit, evaluated directly
@@ -185,7 +185,13 @@ class DetailField {
   DetailField() = default;
   friend struct DetailKernel;
 
-  std::shared_ptr<const Terrain> terrain_;
+  std::shared_ptr<const Terrain> keep_;  // keeps a standalone field's terrain alive
+  const Terrain* base_ = nullptr;        // the terrain (a Terrain owning its field: no cycle)
+  friend class Terrain;
+  static Result<std::shared_ptr<const DetailField>> create_for(const Terrain& terrain,
+                                                               const DetailParams& params);
+  static Result<std::shared_ptr<DetailField>> build(const Terrain& terrain,
+                                                    const DetailParams& params);
   DetailParams params_;
   std::uint64_t seed_mix_ = 0;
   // Octave amplitude per level in kDetailUnit (index 0 is 0).
@@ -207,7 +213,9 @@ struct DetailCacheDesc {
   std::uint32_t worker_threads = 2;
   /// Optional job system of the embedding engine: called from request(), after the cache's lock
   /// is released, with a job to run once on any thread (it may also run it inline). The job is
-  /// self-contained and safe to run after the cache is destroyed (it then does nothing).
+  /// self-contained and safe to run after the cache is destroyed (it then does nothing). If the
+  /// executor throws, request() withdraws the request (as if it had not been made) and lets the
+  /// exception propagate; a job the executor accepts but never runs leaves its tile pending.
   std::function<void(std::function<void()>)> executor;
 };
 
@@ -283,6 +291,10 @@ class DetailCache {
   bool wait_idle(double timeout_seconds);
 
   DetailCacheStats stats() const;
+  /// Identifies the published snapshot: changes (to a value no cache has used before) whenever
+  /// a new snapshot is published. One atomic load: lets a reader keep a snapshot per thread and
+  /// refresh it only when this changes (Terrain's queries do).
+  std::uint64_t generation() const noexcept;
   const DetailField& field() const noexcept { return *field_; }
 
  private:

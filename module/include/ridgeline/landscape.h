@@ -55,13 +55,19 @@ class Landscape {
   const std::shared_ptr<const Terrain>& terrain_ptr() const noexcept { return terrain_; }
 
   std::uint32_t patch_exponent() const noexcept { return exponent_; }
-  std::int64_t patch_cells() const noexcept { return std::int64_t{1} << exponent_; }
+  /// Detail levels L of the terrain: lattice coordinates below are on the finest lattice
+  /// (spacing / 2^L); a patch spans 2^(patch_exponent + L) of its cells.
+  std::uint32_t detail_levels() const noexcept { return detail_; }
+  std::int64_t patch_cells() const noexcept { return std::int64_t{1} << (exponent_ + detail_); }
   std::uint32_t patches_x() const noexcept { return patches_x_; }
   std::uint32_t patches_z() const noexcept { return patches_z_; }
   std::uint32_t patch_count() const noexcept { return patches_x_ * patches_z_; }
   std::uint32_t root_count() const noexcept { return 2 * patch_count(); }
-  /// Deepest bintree level: 2 * patch_exponent (half-cell triangles).
-  std::uint32_t max_level() const noexcept { return 2 * exponent_; }
+  /// Deepest bintree level: 2 * (patch_exponent + L) (half-cell triangles of the finest lattice).
+  /// Levels below 2 * patch_exponent refine into procedural detail.
+  std::uint32_t max_level() const noexcept { return 2 * (exponent_ + detail_); }
+  /// Deepest level of the stored lattice: 2 * patch_exponent.
+  std::uint32_t base_level() const noexcept { return 2 * exponent_; }
 
   /// Geometry of node `heap` of root `root`.
   LatticeTriangle triangle(std::uint32_t root, std::uint64_t heap) const noexcept;
@@ -87,18 +93,33 @@ class Landscape {
   /// Geometry of a child given its parent's (child 0 or 1).
   static LatticeTriangle child_triangle(const LatticeTriangle& parent, int child) noexcept;
 
-  /// Nested error bound of a node, metres.
-  float bound(std::uint32_t root, std::uint64_t heap) const noexcept {
-    return heap < nodes_per_root_plus_one_
-               ? bounds_[root * (nodes_per_root_plus_one_ - 1) + heap - 1]
-               : 0.0f;
+  /// Nested error bound of node `heap` of root `root` whose triangle is `t`, metres. Levels of
+  /// the stored lattice: the stored exact nested bound, plus (with detail) the detail field's
+  /// amplitude bound over the triangle's box, and at least twice that bound. Levels below: twice
+  /// the bound of the contribution of the detail levels the node does not resolve
+  /// (docs/detail.md, "Bounds").
+  float bound(std::uint32_t root, std::uint64_t heap, const LatticeTriangle& t) const noexcept {
+    const float stored = heap < nodes_per_root_plus_one_
+                             ? bounds_[root * (nodes_per_root_plus_one_ - 1) + heap - 1]
+                             : 0.0f;
+    if (detail_ == 0) return stored;
+    const int level = 63 - __builtin_clzll(heap);
+    const float d = detail_bound(level, t);  // twice the bound of the detail's contribution
+    // Stored levels: the plane is the stored surface's, so |detail| (half of d) adds to the
+    // stored error; at least d keeps the bound nested over the levels below.
+    return level < int(base_level()) ? std::max(stored + 0.5f * d, d) : d;
   }
-  /// Exact (not nested) error of a node, metres: used by tests and the minimal-triangulation
-  /// reference. Recomputed on each call (O(area)).
+  float bound(std::uint32_t root, std::uint64_t heap) const noexcept {
+    return bound(root, heap, triangle(root, heap));
+  }
+  /// Exact (not nested) error of a node of the stored levels against the stored lattice (without
+  /// detail), metres: used by tests and the minimal-triangulation reference. O(area) per call.
   float exact_error(std::uint32_t root, std::uint64_t heap) const noexcept;
 
-  /// Height of lattice vertex (i, j) relative to the heightfield's offset, with the padding rule.
+  /// Height of finest-lattice vertex (i, j) relative to the heightfield's offset (base + detail +
+  /// edits), with the padding rule (indices clamped into the footprint).
   float lattice_height(std::int64_t i, std::int64_t j) const noexcept {
+    if (detail_ != 0) return static_cast<float>(terrain_->fine_local_height(i, j));
     const Heightfield& hf = terrain_->heightfield();
     if (i >= 0 && j >= 0 && i < std::int64_t(hf.width()) && j < std::int64_t(hf.height()))
       return hf.local(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j));
@@ -107,11 +128,16 @@ class Landscape {
   /// World x / z of a lattice index.
   double world_x(std::int64_t i) const noexcept { return origin_x_ + double(i) * spacing_x_; }
   double world_z(std::int64_t j) const noexcept { return origin_z_ + double(j) * spacing_z_; }
+  /// Metres between finest-lattice vertices along x and z.
+  double spacing_x() const noexcept { return spacing_x_; }
+  double spacing_z() const noexcept { return spacing_z_; }
   /// True when lattice vertex (i, j) is inside the sampled area (not padding).
   bool is_sampled(std::int64_t i, std::int64_t j) const noexcept {
-    return i >= 0 && j >= 0 && i < std::int64_t(terrain_->heightfield().width()) &&
-           j < std::int64_t(terrain_->heightfield().height());
+    return i >= 0 && j >= 0 && i <= last_i_ && j <= last_j_;
   }
+  /// The last finest-lattice index inside the footprint along x and z.
+  std::int64_t last_i() const noexcept { return last_i_; }
+  std::int64_t last_j() const noexcept { return last_j_; }
 
   /// Bytes of the bound arrays, and how long building them took.
   std::size_t bound_bytes() const noexcept { return bounds_.size() * sizeof(float); }
@@ -119,7 +145,14 @@ class Landscape {
 
  private:
   Landscape() = default;
+  // Exact error against the stored lattice of a triangle in stored-lattice coordinates.
   float compute_exact(const LatticeTriangle& t) const noexcept;
+  // Geometry of a stored-level node in stored-lattice coordinates.
+  LatticeTriangle base_triangle(std::uint32_t root, std::uint64_t heap) const noexcept;
+  float base_height(std::int64_t i, std::int64_t j) const noexcept {
+    return terrain_->heightfield().local_clamped(i, j);
+  }
+  float detail_bound(int level, const LatticeTriangle& t) const noexcept;
   // Edits (edit.cpp's transaction calls the hook; RoamViews register to hear of them).
   friend class RoamView;
   struct Hook;
@@ -136,7 +169,8 @@ class Landscape {
   std::uint64_t update_bounds(std::int64_t i0, std::int64_t j0, std::int64_t i1, std::int64_t j1);
 
   std::shared_ptr<const Terrain> terrain_;
-  std::uint32_t exponent_ = 6, patches_x_ = 0, patches_z_ = 0;
+  std::uint32_t exponent_ = 6, detail_ = 0, patches_x_ = 0, patches_z_ = 0;
+  std::int64_t last_i_ = 0, last_j_ = 0;
   std::uint64_t nodes_per_root_plus_one_ = 0;  // 2^(2k): heaps 1 .. 2^(2k) - 1 are stored
   std::vector<float> bounds_;
   double origin_x_ = 0, origin_z_ = 0, spacing_x_ = 1, spacing_z_ = 1;

@@ -63,6 +63,10 @@ struct RoamStats {
   double max_remaining_error = 0;
   std::size_t memory_bytes = 0;     ///< node pool, queues and output buffers of this view
   std::uint32_t dirty_patches = 0;  ///< patches whose mesh changed in this update
+  /// Leaves that should split but wait for a procedural-detail tile (requested, generated on the
+  /// cache's workers): held at the coarser level, exempt from the converged bound, re-queued at
+  /// the next update. max_remaining_error does not count them.
+  std::uint32_t pending_splits = 0;
 };
 
 /// One output vertex: patch-local float position (x, height, z) relative to the patch origin,

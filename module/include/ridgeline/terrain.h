@@ -20,6 +20,10 @@ namespace ridgeline {
 
 class RayHierarchy;
 class EditLayer;
+class DetailField;
+class DetailCache;
+struct DetailParams;
+struct DetailCacheDesc;
 struct Edit;
 struct EditLimits;
 struct EditResult;
@@ -82,6 +86,14 @@ class Terrain {
   /// Builds the query acceleration structures (a max-height pyramid for rays). Never fails for a
   /// valid Heightfield.
   static std::shared_ptr<Terrain> create(Heightfield heightfield);
+  /// A terrain whose surface includes procedural detail (SPEC.md "The surface" with L =
+  /// detail.levels levels; docs/detail.md): every query, Landscape and RoamView then works on the
+  /// finest lattice (spacing / 2^L), whose vertex heights are base + detail. The terrain owns the
+  /// detail field and a tile cache made from `cache`; detail values come from the cache's tiles
+  /// when resident and from the direct evaluator otherwise (bit-identical). Fails, naming the
+  /// field, on invalid parameters. detail.levels == 0 gives a terrain without detail.
+  static Result<std::shared_ptr<Terrain>> create(Heightfield heightfield, const DetailParams& detail,
+                                                 const DetailCacheDesc& cache);
 
   ~Terrain();
   Terrain(const Terrain&) = delete;
@@ -141,6 +153,31 @@ class Terrain {
   std::size_t triangles_in_box(const Box& box, std::vector<SurfaceTriangle>& out,
                                std::size_t max_triangles = 0) const;
 
+  // ---- procedural detail (detail.h, docs/detail.md) ----------------------------------------
+
+  /// Detail levels L of the surface (0: the stored lattice is the finest).
+  std::uint32_t detail_levels() const noexcept { return detail_levels_; }
+  /// The detail field, or null without detail.
+  const DetailField* detail() const noexcept { return detail_.get(); }
+  /// The tile cache, or null without detail. Its owner (the engine's frame loop, once per frame)
+  /// calls update(); views request tiles through it. Thread-safe (detail.h).
+  DetailCache* detail_cache() const noexcept { return cache_.get(); }
+  /// Finest-lattice samples per axis: (width - 1) * 2^L + 1 and (height - 1) * 2^L + 1.
+  std::int64_t fine_width() const noexcept;
+  std::int64_t fine_height() const noexcept;
+  /// Height relative to the offset of finest-lattice vertex (i, j) (base + detail + edits);
+  /// indices outside the footprint are clamped to it (the padding rule). Detail comes from the
+  /// cache's current snapshot (kept per thread, refreshed when the cache publishes: no lock per
+  /// call) or is evaluated directly. Without detail this is the stored height.
+  double fine_local_height(std::int64_t i, std::int64_t j) const noexcept;
+  /// Vertex normal (area-weighted, unit, y > 0) at finest-lattice vertex (i, j), which must lie
+  /// in the footprint: what shading wants at a mesh vertex.
+  glm::vec3 lattice_vertex_normal(std::int64_t i, std::int64_t j) const noexcept;
+  /// Detail (metres) at finest-lattice vertex (i, j) alone; 0 without detail.
+  double detail_at(std::int64_t i, std::int64_t j) const noexcept;
+  /// 64-bit hash of the detail parameters (0 without detail): save files record it.
+  std::uint64_t detail_hash() const noexcept { return detail_hash_; }
+
   // ---- deformation (edit.h, docs/deformation.md) -------------------------------------------
 
   /// Applies one brush as one transaction: changes the heights (clamped to the edit limits),
@@ -183,6 +220,17 @@ class Terrain {
   std::unique_ptr<EditLayer> edits_;
   std::uint64_t base_hash_ = 0;
   std::uint64_t edit_version_ = 0;
+  std::uint32_t detail_levels_ = 0;
+  std::shared_ptr<const DetailField> detail_;
+  std::unique_ptr<DetailCache> cache_;
+  std::uint64_t detail_hash_ = 0;
+  // Detail versions of the point queries (terrain_detail.cpp).
+  struct FineLocated;
+  bool locate_fine(double x, double z, FineLocated& p) const noexcept;
+  double fine_height_at(const FineLocated& p) const noexcept;
+  glm::vec3 fine_face_normal(const FineLocated& p) const noexcept;
+  glm::vec3 fine_smooth_normal(const FineLocated& p) const noexcept;
+  std::uint8_t fine_material(const FineLocated& p) const noexcept;
   // Cached for the query fast path.
   double inv_spacing_x_ = 1, inv_spacing_z_ = 1;
 

@@ -22,7 +22,13 @@ struct HostOptions {
   bool sandbox = true;
   /// Lua VM instructions one host call (run, call) may execute, counted by a hook every 1000
   /// instructions; 0 = no limit. Exceeding it ends the call with an error and a traceback.
+  /// In the sandbox, C work the hook cannot see is charged too: allocations (one instruction per
+  /// 64 bytes), pattern matching, table.move/sort, load and collectgarbage (docs/lua_api.md).
   std::uint64_t instruction_limit = 100'000'000;
+  /// Wall-clock seconds one host call may take, checked by the same hook (so a single C call
+  /// is not interrupted; the sandbox bounds those, see docs/lua_api.md); 0 = no limit. A backstop
+  /// for instructions whose cost grows with their operands (comparing two long equal strings).
+  double time_limit_seconds = 10;
   /// Bytes the Lua state may hold (owned states only; 0 = no limit). Above it the next hook
   /// check ends the call with an error and a traceback; a single allocation that would pass the
   /// limit plus a headroom of max(1 MiB, limit / 8) is refused (Lua's "not enough memory").
@@ -64,6 +70,11 @@ class Host {
   Status call(int nargs, int nresults);
   /// Calls global function `name` with no arguments and no results (a game callback).
   Status call_global(const char* name);
+
+  /// Pops the value on top of the stack and stores it as global `name` of the scripts'
+  /// environment (the sandbox table, or the real globals without the sandbox): how an engine
+  /// hands its own API (a `game` table) to its scripts. Fails only for memory or an empty stack.
+  Status set_global(const char* name);
 
   /// Bytes held by an owned state (0 for an attached one).
   std::size_t memory_used() const noexcept;

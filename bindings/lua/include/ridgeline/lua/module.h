@@ -3,8 +3,13 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 
 struct lua_State;
+
+namespace ridgeline {
+class Terrain;
+}
 
 namespace ridgeline::lua {
 
@@ -36,6 +41,10 @@ struct ModuleConfig {
 /// registered on first use). May raise a Lua error (memory); call it from a protected context
 /// or from luaopen_*. Returns 1.
 int open_module(lua_State* L, const ModuleConfig& config);
+
+/// Pushes a `ridgeline.terrain` userdata that shares `terrain` with the engine (the engine's own
+/// terrain, so that scripts query what the game simulates). May raise a Lua error (memory).
+void push_terrain(lua_State* L, std::shared_ptr<Terrain> terrain);
 
 }  // namespace ridgeline::lua
 

@@ -1,0 +1,330 @@
+// The sample game's simulation: fixed steps, vehicles, cameras, the budget controller, scripts.
+#include "game.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include <lua.hpp>
+
+#include "ridgeline/log.h"
+
+#include "ridgeline/edit.h"
+
+namespace game {
+
+using ridgeline::Error;
+using ridgeline::Result;
+using ridgeline::Status;
+
+const char* to_string(CameraMode mode) noexcept {
+  switch (mode) {
+    case CameraMode::kFree: return "free";
+    case CameraMode::kFollow: return "follow";
+    default: return "map";
+  }
+}
+
+Game::~Game() {
+  host_.reset();  // Lua first: its userdata refer to the game
+}
+
+Result<std::unique_ptr<Game>> Game::create(const GameOptions& options) {
+  std::unique_ptr<Game> g(new Game());
+  g->options_ = options;
+  if (!(options.dt > 0 && options.dt <= 0.1))
+    return Error{"game: time step " + std::to_string(options.dt) + " s; need 0 < dt <= 0.1"};
+  auto hf = ridgeline::make_default_heightfield();
+  if (!hf) return Error{hf.error().message};
+  g->terrain_ = ridgeline::Terrain::create(std::move(*hf));
+  auto land = ridgeline::Landscape::create(g->terrain_, {.patch_exponent = options.patch_exponent});
+  if (!land) return Error{land.error().message};
+  g->landscape_ = *land;
+  g->max_triangles_ = options.max_triangles;
+  g->tess_budget_ms_ = options.tessellation_budget_ms;
+  for (auto& v : g->views_) {
+    ridgeline::RoamSettings s;
+    s.threshold = 2;
+    s.max_triangles = options.max_triangles;
+    s.budget_ms = options.tessellation_budget_ms;
+    auto view = ridgeline::RoamView::create(g->landscape_, s);
+    if (!view) return Error{view.error().message};
+    v = std::move(*view);
+  }
+  auto ctl = ridgeline::BudgetController::create(options.budget);
+  if (!ctl) return Error{ctl.error().message};
+  g->controller_ = *ctl;
+  g->threshold_ = options.fixed_threshold > 0 ? options.fixed_threshold : ctl->threshold();
+  g->controller_on_ = options.fixed_threshold <= 0;
+  for (const char* name : {"truck", "buggy"}) {
+    const std::string path = options.assets_dir + "/vehicles/" + name + ".glb";
+    auto m = load_vehicle_model(path);
+    if (!m) return Error{m.error().message};
+    g->models_.emplace(name, std::move(*m));
+  }
+  ridgeline::lua::HostOptions ho;
+  ho.instruction_limit = options.instruction_limit;
+  ho.data_root = options.scripts_dir;
+  auto host = ridgeline::lua::Host::create(ho);
+  if (!host) return Error{host.error().message};
+  g->host_ = std::move(*host);
+  if (Status s = install_game_api(*g); !s) return Error{s.message()};
+  return g;
+}
+
+void Game::log(const std::string& line) {
+  ridgeline::log_message(ridgeline::LogLevel::kInfo, line);
+  log_lines.push_back(line);
+  while (log_lines.size() > 200) log_lines.pop_front();
+}
+
+void Game::record_error(int script, const std::string& message) {
+  ScriptError e;
+  e.script = script >= 0 && script < int(scripts.size()) ? scripts[script].name : "(game)";
+  e.message = message;
+  e.frame = frame_;
+  std::fprintf(stderr, "script error in %s (frame %llu): %s\n", e.script.c_str(),
+               static_cast<unsigned long long>(frame_), message.c_str());
+  errors_.push_back(std::move(e));
+  while (errors_.size() > 20) errors_.pop_front();
+  ++error_count_;
+  if (script >= 0 && script < int(scripts.size())) scripts[script].failed = true;
+}
+
+std::vector<std::string> Game::script_names() const {
+  std::vector<std::string> out;
+  for (const Script& s : scripts) out.push_back(s.name);
+  return out;
+}
+
+Status Game::load_script(const std::string& path) {
+  for (std::size_t i = 0; i < scripts.size(); ++i)
+    if (scripts[i].path == path) return run_script(int(i));
+  Script s;
+  s.path = path;
+  s.name = std::filesystem::path(path).filename().string();
+  scripts.push_back(s);
+  return run_script(int(scripts.size() - 1));
+}
+
+int Game::reload_changed_scripts() {
+  int n = 0;
+  for (std::size_t i = 0; i < scripts.size(); ++i) {
+    std::error_code ec;
+    const auto t = std::filesystem::last_write_time(scripts[i].path, ec);
+    if (!ec && t != scripts[i].mtime) {
+      (void)run_script(int(i));
+      ++n;
+    }
+  }
+  return n;
+}
+
+int Game::reload_all_scripts() {
+  for (std::size_t i = 0; i < scripts.size(); ++i) (void)run_script(int(i));
+  return int(scripts.size());
+}
+
+ridgeline::Result<int> Game::spawn(const std::string& model, double x, double z, double heading,
+                                   const std::string& name) {
+  const VehicleModel* m = this->model(model);
+  if (m == nullptr) return Error{"spawn: unknown model '" + model + "' (truck, buggy)"};
+  const auto h = terrain_->height(x, z);
+  if (!h) return Error{"spawn: (" + std::to_string(x) + ", " + std::to_string(z) +
+                       ") is off the terrain"};
+  if (vehicles_.size() >= 64) return Error{"spawn: 64 vehicles at most"};
+  VehicleParams p = params_from_model(*m, model == "truck" ? 3000.0 : 1200.0);
+  if (model == "buggy") p.max_speed = 30;
+  const double start_y = *h + p.com_in_model.y + p.rest_length * 0.5;
+  VehicleEntry e{next_vehicle_id_++, name.empty() ? model : name, model,
+                 Vehicle(p, {x, start_y, z}, heading), {}, 0};
+  e.body.chassis_min = glm::dvec3(m->body_min) - p.com_in_model;
+  e.body.chassis_max = glm::dvec3(m->body_max) - p.com_in_model;
+  // The chassis box check uses the bottom of the frame, not the (lower) wheels.
+  e.body.chassis_min.y = std::max(e.body.chassis_min.y,
+                                  double(m->wheel_centres[0].y) - p.com_in_model.y);
+  e.body.place_on_surface(*terrain_, x, z, heading);
+  const int id = e.id;
+  vehicles_.emplace(id, std::move(e));
+  return id;
+}
+
+VehicleEntry* Game::vehicle(int id) {
+  auto it = vehicles_.find(id);
+  return it == vehicles_.end() ? nullptr : &it->second;
+}
+
+bool Game::remove_vehicle(int id) { return vehicles_.erase(id) > 0; }
+
+const VehicleModel* Game::model(const std::string& name) const {
+  auto it = models_.find(name);
+  return it == models_.end() ? nullptr : &it->second;
+}
+
+std::vector<std::string> Game::model_names() const {
+  std::vector<std::string> out;
+  for (const auto& [k, v] : models_) out.push_back(k);
+  return out;
+}
+
+void Game::clamp_to_terrain(VehicleEntry& e) {
+  const auto& hf = terrain_->heightfield();
+  const double x0 = hf.origin_x() + 3, z0 = hf.origin_z() + 3;
+  const double x1 = hf.origin_x() + hf.extent_x() - 3, z1 = hf.origin_z() + hf.extent_z() - 3;
+  const glm::dvec3 p = e.body.position();
+  if (p.x < x0 || p.x > x1 || p.z < z0 || p.z > z1) {
+    // The edge of the world: the vehicle is stopped and put back inside.
+    const double x = std::clamp(p.x, x0, x1), z = std::clamp(p.z, z0, z1);
+    const double y = terrain_->height(x, z).value_or(p.y) + e.body.params().com_in_model.y;
+    (void)y;
+    e.body.place_on_surface(*terrain_, x, z, e.body.heading());
+  }
+}
+
+void Game::step() {
+  burned_ms_ = 0;
+  const double dt = options_.dt;
+  // Craters made since the last step (from scripts: handlers do not nest inside a script call).
+  for (; craters_emitted_ < craters_.size(); ++craters_emitted_) {
+    const CraterRecord& c = craters_[craters_emitted_];
+    double a[4] = {c.x, c.z, c.radius, c.depth};
+    emit_event(
+        *this, "crater",
+        [](lua_State* L, void* u) -> int {
+          for (int i = 0; i < 4; ++i) lua_pushnumber(L, static_cast<const double*>(u)[i]);
+          return 4;
+        },
+        a);
+  }
+  double args[2] = {dt, time()};
+  emit_event(
+      *this, "tick",
+      [](lua_State* L, void* u) -> int {
+        const double* a = static_cast<const double*>(u);
+        lua_pushnumber(L, a[0]);
+        lua_pushnumber(L, a[1]);
+        return 2;
+      },
+      args);
+  for (auto& [id, e] : vehicles_) {
+    if (e.autopilot.drive(e.body)) {
+      struct Arg { int id; std::size_t index; } arg{id, e.autopilot.next};
+      emit_event(
+          *this, "waypoint",
+          [](lua_State* L, void* u) -> int {
+            const auto* a = static_cast<const Arg*>(u);
+            lua_pushinteger(L, a->id);
+            lua_pushinteger(L, static_cast<lua_Integer>(a->index) + 1);
+            return 2;
+          },
+          &arg);
+    }
+  }
+  for (auto& [id, e] : vehicles_) {
+    const glm::dvec3 before = e.body.position();
+    e.body.step(*terrain_, dt);
+    clamp_to_terrain(e);
+    e.body.measure_contacts(*terrain_);
+    const glm::dvec3 d = e.body.position() - before;
+    e.distance_m += std::hypot(d.x, d.z);
+  }
+  ++frame_;
+}
+
+Result<std::size_t> Game::crater(double x, double z, double radius, double depth) {
+  if (!std::isfinite(x) || !std::isfinite(z) || !(radius > 0 && radius <= 200) ||
+      !(depth > 0 && depth <= 100))
+    return Error{"crater: radius in (0, 200] and depth in (0, 100] metres expected"};
+  ridgeline::Edit edit;
+  edit.brush = ridgeline::Brush::kCrater;
+  edit.x = x;
+  edit.z = z;
+  edit.radius = radius;
+  edit.depth = depth;
+  edit.rim = 0.15;
+  edit.strength = 1;
+  auto r = terrain_->apply_edit(edit);
+  if (!r) return Error{r.error().message};
+  CraterRecord rec{x, z, radius, depth, frame_, 0};
+  if (!r->empty()) {
+    for (auto& [id, e] : vehicles_) {
+      const glm::dvec3 p = e.body.position();
+      const double m = 6;  // a vehicle's half-length: bodies overlapping the box count
+      if (p.x >= r->changed.min.x - m && p.x <= r->changed.max.x + m &&
+          p.z >= r->changed.min.z - m && p.z <= r->changed.max.z + m)
+        rec.max_lift_m = std::max(rec.max_lift_m, e.body.resolve_penetration(*terrain_));
+    }
+  }
+  craters_.push_back(rec);
+  return r->samples_changed;
+}
+
+ridgeline::Camera Game::camera() const {
+  ridgeline::Camera c;
+  c.viewport = options_.viewport;
+  c.fov_y_deg = 60;
+  c.near_m = 0.5;
+  c.far_m = 6000;
+  switch (rig_.mode) {
+    case CameraMode::kFree: {
+      c.eye = rig_.free_eye;
+      const double cp = std::cos(rig_.free_pitch);
+      c.target = c.eye + glm::dvec3(std::sin(rig_.free_yaw) * cp, std::sin(rig_.free_pitch),
+                                    std::cos(rig_.free_yaw) * cp);
+      break;
+    }
+    case CameraMode::kFollow: {
+      const VehicleEntry* e = nullptr;
+      auto it = vehicles_.find(rig_.follow_vehicle);
+      if (it != vehicles_.end()) e = &it->second;
+      else if (!vehicles_.empty()) e = &vehicles_.begin()->second;
+      if (e == nullptr) {
+        c.eye = rig_.free_eye;
+        c.target = c.eye + glm::dvec3(0.5, -0.3, 0.5);
+        break;
+      }
+      const glm::dvec3 p = e->body.position();
+      const double h = e->body.heading();
+      glm::dvec3 eye = p - glm::dvec3(std::sin(h), 0, std::cos(h)) * rig_.follow_distance;
+      const double ground = terrain_->height(eye.x, eye.z).value_or(p.y);
+      eye.y = std::max(p.y, ground) + rig_.follow_height;
+      c.eye = eye;
+      c.target = p + glm::dvec3(0, 2, 0);
+      break;
+    }
+    case CameraMode::kMap:
+      c.eye = {rig_.map_centre.x, rig_.map_height, rig_.map_centre.y};
+      c.target = {rig_.map_centre.x, 0, rig_.map_centre.y};
+      c.up = {0, 0, 1};
+      c.far_m = rig_.map_height + 2000;
+      break;
+  }
+  return c;
+}
+
+ViewFrame Game::update_view(double frame_ms) {
+  if (controller_on_ && frame_ms > 0)
+    threshold_ = controller_.update(frame_ms, frame_ms / 1000.0);
+  ViewFrame out;
+  out.threshold = threshold_;
+  if (!options_.tessellate) return last_view_ = out;
+  ridgeline::RoamView& v = active_view();
+  ridgeline::RoamSettings s = v.settings();
+  s.threshold = threshold_;
+  s.max_triangles = max_triangles_;
+  s.budget_ms = tess_budget_ms_;
+  if (Status st = v.set_settings(s); !st) log("view settings: " + st.message());
+  auto r = v.update(camera());
+  if (r) {
+    out.stats = *r;
+    out.updated = true;
+  } else {
+    log("view update: " + r.error().message);
+  }
+  return last_view_ = out;
+}
+
+}  // namespace game

@@ -1,0 +1,325 @@
+// ridgeline_game: the sample game (docs/game.md). Modes: a window when a display exists,
+// --offscreen (hidden GLFW window + FBO under an X server such as Xvfb, or EGL surfaceless
+// without one) and --headless (simulation only, no GL). Fixed simulation step.
+// Exit codes: 0 done, 1 error, 2 bad command line, 3 no OpenGL context could be created.
+#define GL_GLEXT_PROTOTYPES 1
+#define GLFW_INCLUDE_NONE
+#include <GL/gl.h>
+#include <GLFW/glfw3.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "game.h"
+#include "gl_context.h"
+#include "panel.h"
+#include "renderer.h"
+#include "run_stats.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+struct Args {
+  bool headless = false, offscreen = false, egl = false, no_panel = false, wireframe = false;
+  std::uint64_t frames = 0;
+  std::vector<std::string> scripts;
+  std::string screenshot, stats, out_dir = "out", camera;
+  std::uint64_t screenshot_every = 0, steady_from = 0;
+  int width = 1280, height = 720;
+  double threshold = 0, target_ms = 33, dt = 1.0 / 60.0, tess_ms = 8;
+  std::uint32_t triangles = 60000;
+};
+
+void read_window_input(GLFWwindow* w, game::Game& g, bool keyboard_free, double dt) {
+  auto down = [w](int k) { return glfwGetKey(w, k) == GLFW_PRESS; };
+  game::Input in;
+  if (keyboard_free) {
+    in.up = down(GLFW_KEY_UP) || down(GLFW_KEY_W);
+    in.down = down(GLFW_KEY_DOWN) || down(GLFW_KEY_S);
+    in.left = down(GLFW_KEY_LEFT) || down(GLFW_KEY_A);
+    in.right = down(GLFW_KEY_RIGHT) || down(GLFW_KEY_D);
+    in.brake = down(GLFW_KEY_SPACE);
+    game::CameraRig& r = g.rig();
+    if (r.mode == game::CameraMode::kFree) {
+      // Free camera: I/K forward/back, J/L turn, U/O up/down, Y/H pitch.
+      const double speed = (down(GLFW_KEY_LEFT_SHIFT) ? 300.0 : 80.0) * dt;
+      const glm::dvec3 fwd(std::sin(r.free_yaw), 0, std::cos(r.free_yaw));
+      if (down(GLFW_KEY_I)) r.free_eye += fwd * speed;
+      if (down(GLFW_KEY_K)) r.free_eye -= fwd * speed;
+      if (down(GLFW_KEY_U)) r.free_eye.y += speed;
+      if (down(GLFW_KEY_O)) r.free_eye.y -= speed;
+      if (down(GLFW_KEY_J)) r.free_yaw += 1.2 * dt;
+      if (down(GLFW_KEY_L)) r.free_yaw -= 1.2 * dt;
+      if (down(GLFW_KEY_Y)) r.free_pitch = std::min(1.5, r.free_pitch + dt);
+      if (down(GLFW_KEY_H)) r.free_pitch = std::max(-1.5, r.free_pitch - dt);
+      if (auto h = g.terrain().height(r.free_eye.x, r.free_eye.z))
+        r.free_eye.y = std::max(r.free_eye.y, *h + 2.0);
+    }
+  }
+  g.input = in;
+}
+
+int run(const Args& a) {
+  game::GameOptions o;
+  o.assets_dir = RIDGELINE_GAME_ASSETS;
+  o.scripts_dir = RIDGELINE_GAME_SCRIPTS;
+  o.dt = a.dt;
+  o.viewport = {a.width, a.height};
+  o.fixed_threshold = a.threshold;
+  o.budget.target_ms = a.target_ms;
+  o.max_triangles = a.triangles;
+  o.tessellation_budget_ms = a.tess_ms;
+  auto created = game::Game::create(o);
+  if (!created) {
+    std::fprintf(stderr, "ridgeline_game: %s\n", created.error().message.c_str());
+    return 1;
+  }
+  game::Game& g = **created;
+  std::vector<std::string> scripts = a.scripts;
+  if (scripts.empty())
+    for (const char* s : {"default.lua", "artillery.lua", "budget.lua"})
+      scripts.push_back(std::string(RIDGELINE_GAME_SCRIPTS) + "/" + s);
+  for (const std::string& s : scripts) (void)g.load_script(s);  // errors are recorded, not fatal
+  if (a.threshold > 0) {  // the command line wins over scripts: reproducible pictures
+    g.set_controller_on(false);
+    g.set_threshold(a.threshold);
+    g.set_tessellation_budget_ms(a.tess_ms);
+  }
+  if (!a.camera.empty()) {
+    if (a.camera == "free") g.rig().mode = game::CameraMode::kFree;
+    if (a.camera == "follow") g.rig().mode = game::CameraMode::kFollow;
+    if (a.camera == "map") g.rig().mode = game::CameraMode::kMap;
+  }
+
+  std::unique_ptr<game::GlContext> ctx;
+  std::unique_ptr<game::Renderer> renderer;
+  std::unique_ptr<game::Panel> panel;
+  std::string mode = "headless";
+  if (!a.headless) {
+    const bool display = std::getenv("DISPLAY") != nullptr && *std::getenv("DISPLAY") != '\0';
+    game::GlMode gm = game::GlMode::kWindow;
+    if (a.offscreen) gm = (display && !a.egl) ? game::GlMode::kHiddenWindow
+                                               : game::GlMode::kEglSurfaceless;
+    if (!a.offscreen && !display) {
+      std::fprintf(stderr, "ridgeline_game: no display (DISPLAY is not set); use --offscreen or "
+                           "--headless\n");
+      return 3;
+    }
+    auto c = game::GlContext::create(gm, a.width, a.height, "Ridgeline sample game");
+    if (!c && gm == game::GlMode::kHiddenWindow) {
+      std::fprintf(stderr, "ridgeline_game: %s; trying EGL surfaceless\n",
+                   c.error().message.c_str());
+      c = game::GlContext::create(game::GlMode::kEglSurfaceless, a.width, a.height, "");
+    }
+    if (!c) {
+      std::fprintf(stderr, "ridgeline_game: no OpenGL context: %s\n", c.error().message.c_str());
+      return 3;
+    }
+    ctx = std::move(*c);
+    mode = to_string(ctx->mode());
+    std::fprintf(stderr, "ridgeline_game: %s\n", ctx->description().c_str());
+    auto r = game::Renderer::create(g, a.width, a.height);
+    if (!r) {
+      std::fprintf(stderr, "ridgeline_game: %s\n", r.error().message.c_str());
+      return 1;
+    }
+    renderer = std::move(*r);
+    if (!a.no_panel) panel = std::make_unique<game::Panel>(
+        ctx->mode() == game::GlMode::kWindow ? ctx->window() : nullptr, a.width, a.height);
+  }
+  if (!a.out_dir.empty() && (a.screenshot_every > 0)) std::filesystem::create_directories(a.out_dir);
+
+  game::RenderSettings rs;
+  rs.wireframe = a.wireframe;
+  game::RunStats stats;
+  double last_frame_ms = 0;
+  double accumulator = 0;
+  bool f5_was_down = false, tab_was_down = false, f1_was_down = false;
+  std::uint64_t frame = 0;
+  const bool window = ctx && ctx->mode() == game::GlMode::kWindow;
+  auto wall0 = Clock::now();
+  while (a.frames == 0 || frame < a.frames) {
+    if (ctx && ctx->should_close()) break;
+    const auto t0 = Clock::now();
+    if (window) {
+      GLFWwindow* w = ctx->window();
+      read_window_input(w, g, !(panel && panel->wants_keyboard()), 1.0 / 60.0);
+      const bool f5 = glfwGetKey(w, GLFW_KEY_F5) == GLFW_PRESS;
+      if (f5 && !f5_was_down) g.reload_all_scripts();
+      f5_was_down = f5;
+      const bool tab = glfwGetKey(w, GLFW_KEY_TAB) == GLFW_PRESS;
+      if (tab && !tab_was_down) g.rig().mode = game::CameraMode((int(g.rig().mode) + 1) % 3);
+      tab_was_down = tab;
+      const bool f1 = glfwGetKey(w, GLFW_KEY_F1) == GLFW_PRESS;
+      if (f1 && !f1_was_down) rs.wireframe = !rs.wireframe;
+      f1_was_down = f1;
+    }
+    if (frame % 30 == 0) g.reload_changed_scripts();  // hot reload: edit a script, it re-runs
+    // Fixed steps: offscreen and headless take exactly one per frame (reproducible); a window
+    // takes as many as wall-clock time asks for (at most 5 per frame).
+    int steps = 1;
+    if (window) {
+      const double now = std::chrono::duration<double>(Clock::now() - wall0).count();
+      accumulator = now - g.time();
+      steps = std::clamp(int(accumulator / g.dt()), 0, 5);
+      if (accumulator > 0.5) wall0 += std::chrono::duration_cast<Clock::duration>(
+                                 std::chrono::duration<double>(accumulator - 0.1));
+    }
+    const auto ts = Clock::now();
+    double burn = 0;
+    for (int s = 0; s < steps; ++s) {
+      g.step();
+      burn += g.burned_ms();
+    }
+    const double sim_ms = ms_since(ts);
+    const game::ViewFrame vf = g.update_view(last_frame_ms);
+    game::RenderStats rstats;
+    double render_ms = 0;
+    if (renderer) {
+      const auto tr = Clock::now();
+      rstats = renderer->draw(g, rs);
+      if (panel) {
+        game::PanelInput pin{last_frame_ms, rstats};
+        panel->draw(g, rs, pin, last_frame_ms / 1000.0);
+      }
+      glFinish();  // llvmpipe renders in threads: count the whole frame
+      render_ms = ms_since(tr);
+      const bool last = a.frames > 0 && frame + 1 == a.frames;
+      if (!a.screenshot.empty() && last) {
+        if (auto s = game::write_png(a.screenshot, renderer->width(), renderer->height(),
+                                     renderer->read_pixels());
+            !s)
+          std::fprintf(stderr, "ridgeline_game: %s\n", s.message().c_str());
+      }
+      if (a.screenshot_every > 0 && (frame + 1) % a.screenshot_every == 0) {
+        char name[64];
+        std::snprintf(name, sizeof name, "/frame_%06llu.png",
+                      static_cast<unsigned long long>(frame + 1));
+        if (auto s = game::write_png(a.out_dir + name, renderer->width(), renderer->height(),
+                                     renderer->read_pixels());
+            !s)
+          std::fprintf(stderr, "ridgeline_game: %s\n", s.message().c_str());
+      }
+      if (window) {
+        int ww = 0, wh = 0;
+        glfwGetFramebufferSize(ctx->window(), &ww, &wh);
+        renderer->blit_to_window(ww, wh);
+      }
+    }
+    const double frame_ms = ms_since(t0);  // the frame's work, before waiting for vsync
+    if (ctx) ctx->present();
+    last_frame_ms = frame_ms;
+    g.last_frame_ms = frame_ms;
+    game::FrameRecord rec;
+    rec.frame = frame;
+    rec.time_s = g.time();
+    rec.frame_ms = frame_ms;
+    rec.sim_ms = sim_ms;
+    rec.tess_ms = vf.stats.update_ms;
+    rec.render_ms = render_ms;
+    rec.burn_ms = burn;
+    rec.threshold = vf.threshold;
+    rec.triangles = vf.stats.triangles;
+    rec.splits = vf.stats.splits + vf.stats.forced_splits;
+    rec.merges = vf.stats.merges;
+    rec.patches_uploaded = rstats.patches_uploaded;
+    for (const auto& [id, e] : g.vehicles()) {
+      game::FrameRecord::VehicleRecord vr{};
+      const glm::dvec3 p = e.body.position();
+      vr.id = id;
+      vr.x = p.x;
+      vr.y = p.y;
+      vr.z = p.z;
+      vr.speed = e.body.speed();
+      vr.reached = e.autopilot.reached;
+      vr.min_gap = 1e9;
+      for (const auto& w : e.body.wheels()) {
+        vr.min_gap = std::min(vr.min_gap, w.surface_gap);
+        if (w.contact) {
+          ++vr.contacts;
+          vr.max_contact_gap = std::max(vr.max_contact_gap, std::abs(w.surface_gap));
+        }
+      }
+      rec.vehicles.push_back(vr);
+    }
+    stats.record(g, std::move(rec));
+    ++frame;
+  }
+  if (!a.stats.empty()) {
+    if (auto s = stats.write(a.stats, mode, g, a.steady_from); !s) {
+      std::fprintf(stderr, "ridgeline_game: %s\n", s.message().c_str());
+      return 1;
+    }
+  }
+  std::fprintf(stderr, "ridgeline_game: %llu frames (%s), %zu vehicles, %zu craters, %llu script "
+                       "errors\n",
+               static_cast<unsigned long long>(frame), mode.c_str(), g.vehicles().size(),
+               g.craters().size(), static_cast<unsigned long long>(g.error_count()));
+  panel.reset();
+  renderer.reset();
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Ridgeline sample game: vehicles on deformable terrain, driven by Lua"};
+  Args a;
+  app.add_flag("--headless", a.headless, "simulation only, no OpenGL");
+  app.add_flag("--offscreen", a.offscreen,
+               "render without a display: a hidden window under X (Xvfb), else EGL surfaceless");
+  app.add_flag("--egl", a.egl, "with --offscreen: use EGL surfaceless even when X is there");
+  app.add_option("--frames", a.frames, "exit after N frames (0: run until the window closes)");
+  app.add_option("--script", a.scripts,
+                 "Lua script to run (repeatable; default: default, artillery and budget from "
+                 "scripts/game)");
+  app.add_option("--screenshot", a.screenshot, "write the last frame to FILE.png (needs --frames)");
+  app.add_option("--screenshot-every", a.screenshot_every,
+                 "write every Nth frame to the output folder");
+  app.add_option("--out", a.out_dir, "output folder for --screenshot-every")->capture_default_str();
+  app.add_option("--stats", a.stats, "write per-frame statistics to FILE.json");
+  app.add_option("--steady-from", a.steady_from,
+                 "frames before this are left out of the stats summary's percentiles");
+  app.add_option("--width", a.width, "pixels")->check(CLI::Range(64, 8192))->capture_default_str();
+  app.add_option("--height", a.height, "pixels")->check(CLI::Range(64, 8192))->capture_default_str();
+  app.add_option("--threshold", a.threshold,
+                 "fixed pixel threshold (turns the budget controller off)")
+      ->check(CLI::Range(0.25, 256.0));
+  app.add_option("--target-ms", a.target_ms, "frame time the controller holds")
+      ->check(CLI::Range(1.0, 1000.0))->capture_default_str();
+  app.add_option("--triangles", a.triangles, "triangle budget of the views")
+      ->check(CLI::Range(100, 4000000))->capture_default_str();
+  app.add_option("--tess-ms", a.tess_ms, "tessellation time budget per frame (0: none)")
+      ->check(CLI::Range(0.0, 1000.0))->capture_default_str();
+  app.add_option("--dt", a.dt, "fixed simulation step, seconds")
+      ->check(CLI::Range(0.001, 0.1))->capture_default_str();
+  app.add_option("--camera", a.camera, "initial camera (overrides scripts)")
+      ->check(CLI::IsMember({"free", "follow", "map"}));
+  app.add_flag("--no-panel", a.no_panel, "no debug panel (reproducible pictures)");
+  app.add_flag("--wireframe", a.wireframe, "start in wireframe");
+  CLI11_PARSE(app, argc, argv);
+  if (a.headless && a.offscreen) {
+    std::fprintf(stderr, "ridgeline_game: --headless and --offscreen exclude each other\n");
+    return 2;
+  }
+  if (!a.screenshot.empty() && a.frames == 0) {
+    std::fprintf(stderr, "ridgeline_game: --screenshot needs --frames N\n");
+    return 2;
+  }
+  if (a.headless && (!a.screenshot.empty() || a.screenshot_every > 0)) {
+    std::fprintf(stderr, "ridgeline_game: --headless renders nothing: no screenshots\n");
+    return 2;
+  }
+  return run(a);
+}

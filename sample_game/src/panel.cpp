@@ -1,0 +1,116 @@
+// Dear ImGui (Debian's libimgui-dev 1.86, with its GLFW and OpenGL 3 backends): an immediate-mode
+// panel is a few lines per figure, which is why the game uses it instead of its own UI.
+#include "panel.h"
+
+#include <imgui.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+
+#include <cstdio>
+
+namespace game {
+
+Panel::Panel(GLFWwindow* window, int width, int height)
+    : window_(window), width_(width), height_(height) {
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGuiIO& io = ImGui::GetIO();
+  io.IniFilename = nullptr;  // no imgui.ini written next to the game
+  ImGui::StyleColorsDark();
+  ImGui::GetStyle().Alpha = 0.92f;
+  if (window_ != nullptr) ImGui_ImplGlfw_InitForOpenGL(window_, true);
+  ImGui_ImplOpenGL3_Init("#version 330 core");
+}
+
+Panel::~Panel() {
+  ImGui_ImplOpenGL3_Shutdown();
+  if (window_ != nullptr) ImGui_ImplGlfw_Shutdown();
+  ImGui::DestroyContext();
+}
+
+bool Panel::wants_keyboard() const { return ImGui::GetIO().WantCaptureKeyboard; }
+
+void Panel::draw(Game& game, RenderSettings& settings, const PanelInput& in, double dt_s) {
+  frame_history_.push_back(static_cast<float>(in.frame_ms));
+  while (frame_history_.size() > 240) frame_history_.pop_front();
+  ImGui_ImplOpenGL3_NewFrame();
+  if (window_ != nullptr) {
+    ImGui_ImplGlfw_NewFrame();
+  } else {
+    ImGuiIO& io = ImGui::GetIO();
+    io.DisplaySize = ImVec2(float(width_), float(height_));
+    io.DeltaTime = dt_s > 0 ? float(dt_s) : 1.0f / 60.0f;
+  }
+  ImGui::NewFrame();
+  ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(360, 0), ImGuiCond_FirstUseEver);
+  ImGui::Begin("Ridgeline");
+  const ViewFrame& vf = game.last_view_frame();
+  const ridgeline::BudgetController& c = game.controller();
+  ImGui::Text("frame %.1f ms  (target %.0f ms, smoothed %.1f)", in.frame_ms, c.desc().target_ms,
+              c.state().smoothed_ms);
+  std::vector<float> hist(frame_history_.begin(), frame_history_.end());
+  char label[64];
+  std::snprintf(label, sizeof label, "frame ms (last %zu)", hist.size());
+  ImGui::PlotLines("##frames", hist.data(), int(hist.size()), 0, label, 0.0f, 80.0f,
+                   ImVec2(340, 60));
+  ImGui::Separator();
+  ImGui::Text("threshold %.2f px  (%s)", game.threshold(),
+              game.controller_on() ? to_string(c.state().action) : "fixed");
+  bool on = game.controller_on();
+  if (ImGui::Checkbox("budget controller", &on)) game.set_controller_on(on);
+  if (!on) {
+    float t = float(game.threshold());
+    if (ImGui::SliderFloat("threshold px", &t, 0.5f, 16.0f, "%.2f")) game.set_threshold(t);
+  }
+  float target = float(c.desc().target_ms);
+  if (ImGui::SliderFloat("target ms", &target, 10.0f, 100.0f, "%.0f"))
+    (void)game.controller().set_target_ms(target);
+  int tris = int(game.max_triangles());
+  if (ImGui::SliderInt("triangle budget", &tris, 5000, 400000))
+    game.set_max_triangles(std::uint32_t(tris));
+  float tess = float(game.tessellation_budget_ms());
+  if (ImGui::SliderFloat("tessellation ms", &tess, 0.0f, 30.0f, "%.1f"))
+    game.set_tessellation_budget_ms(tess);
+  ImGui::Text("triangles %u  splits %u (+%u forced)  merges %u", vf.stats.triangles,
+              vf.stats.splits, vf.stats.forced_splits, vf.stats.merges);
+  ImGui::Text("tessellation %.2f ms  upload %.2f ms (%u patches)  draw %.2f ms",
+              vf.stats.update_ms, in.render.upload_ms, in.render.patches_uploaded,
+              in.render.draw_ms);
+  ImGui::Text("tiles resident: n/a (procedural detail is not in the surface yet)");
+  ImGui::Separator();
+  int mode = int(game.rig().mode);
+  ImGui::RadioButton("free", &mode, 0);
+  ImGui::SameLine();
+  ImGui::RadioButton("follow", &mode, 1);
+  ImGui::SameLine();
+  ImGui::RadioButton("map", &mode, 2);
+  game.rig().mode = CameraMode(mode);
+  ImGui::Checkbox("wireframe", &settings.wireframe);
+  ImGui::SameLine();
+  ImGui::Checkbox("geomorphs", &settings.geomorph);
+  ImGui::Text("vehicles %zu  craters %zu  t = %.1f s", game.vehicles().size(),
+              game.craters().size(), game.time());
+  ImGui::Separator();
+  if (ImGui::Button("reload scripts (F5)")) game.reload_all_scripts();
+  ImGui::SameLine();
+  ImGui::Text("%zu scripts, %llu errors", game.scripts.size(),
+              static_cast<unsigned long long>(game.error_count()));
+  if (!game.errors().empty()) {
+    const ScriptError& e = game.errors().back();
+    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.45f, 0.4f, 1.0f));
+    ImGui::TextWrapped("%s (frame %llu):\n%s", e.script.c_str(),
+                       static_cast<unsigned long long>(e.frame), e.message.c_str());
+    ImGui::PopStyleColor();
+  }
+  if (ImGui::CollapsingHeader("script log")) {
+    const std::size_t n = game.log_lines.size();
+    for (std::size_t i = n > 12 ? n - 12 : 0; i < n; ++i)
+      ImGui::TextUnformatted(game.log_lines[i].c_str());
+  }
+  ImGui::End();
+  ImGui::Render();
+  ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+}
+
+}  // namespace game

@@ -1,0 +1,37 @@
+// The Dear ImGui debug panel: LOD, budget and frame figures, camera and render toggles, script
+// errors with their tracebacks, the script log, reload.
+#pragma once
+
+#include <deque>
+
+#include "game.h"
+#include "renderer.h"
+
+struct GLFWwindow;
+
+namespace game {
+
+struct PanelInput {
+  double frame_ms = 0;
+  RenderStats render{};
+};
+
+class Panel {
+ public:
+  /// `window` may be null (offscreen: the display size is set by hand, no input).
+  Panel(GLFWwindow* window, int width, int height);
+  ~Panel();
+  Panel(const Panel&) = delete;
+  Panel& operator=(const Panel&) = delete;
+  /// Builds and renders the panel into the bound framebuffer.
+  void draw(Game& game, RenderSettings& settings, const PanelInput& in, double dt_s);
+  /// True when ImGui wants the keyboard (a text field has focus).
+  bool wants_keyboard() const;
+
+ private:
+  GLFWwindow* window_;
+  int width_, height_;
+  std::deque<float> frame_history_;
+};
+
+}  // namespace game

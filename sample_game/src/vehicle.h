@@ -1,0 +1,117 @@
+// Vehicle: a rigid body on four raycast-suspension wheels driven over Ridgeline terrain queries.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <glm/gtc/quaternion.hpp>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+#include "ridgeline/terrain.h"
+#include "vehicle_model.h"
+
+namespace game {
+
+/// Physical constants of a vehicle kind. Units: kg, metres, newtons, seconds, radians.
+struct VehicleParams {
+  double mass = 1500;
+  glm::dvec3 inertia_extent{2, 1.5, 4};  ///< box whose inertia the body takes (width, height, length)
+  std::array<glm::dvec3, 4> attach{};  ///< suspension tops in the body frame (from the COM)
+  double wheel_radius = 0.5;
+  double rest_length = 0.35;  ///< suspension length (attach -> wheel centre) with no load
+  double spring_k = 40000;    ///< N/m per wheel
+  double damper_c = 4000;     ///< N s/m per wheel
+  double friction = 1.0;      ///< tyre friction coefficient (friction circle radius / load)
+  double engine_force = 9000;  ///< N at full throttle, shared by the four wheels
+  double brake_force = 14000;  ///< N at full brake, shared by the four wheels
+  double max_steer = 0.55;     ///< radians at steer = +-1
+  double max_speed = 25;       ///< m/s; the engine gives no force above it
+  glm::dvec3 com_in_model{0, 1, 0};  ///< centre of mass in the model frame (the body origin)
+};
+
+/// Derives parameters from a model: wheels from its wheel nodes, inertia from its body box,
+/// mass from `mass_kg`; suspension sized so the static sag is about a third of the travel.
+VehicleParams params_from_model(const VehicleModel& model, double mass_kg);
+
+/// Driver input. throttle -1..1 (negative: reverse), steer -1..1 (positive: left), brake 0..1.
+struct Controls {
+  double throttle = 0, steer = 0, brake = 0;
+};
+
+/// State of one wheel after a step.
+struct WheelState {
+  glm::dvec3 centre{0};         ///< world position of the wheel centre
+  glm::dvec3 contact_point{0};  ///< where the suspension ray met the surface (valid with contact)
+  glm::dvec3 contact_normal{0, 1, 0};
+  bool contact = false;
+  double suspension_length = 0;  ///< metres, 0 .. rest_length
+  double load_n = 0;             ///< suspension force, newtons
+  double steer = 0;              ///< radians
+  double spin = 0;               ///< accumulated rotation, radians (for drawing)
+  /// Height of the wheel's lowest point (centre - up * radius, where the suspension ray meets
+  /// the ground when in contact) above the surface at that point's xz, measured with
+  /// Terrain::height after the step: about 0 in contact, positive in the air, negative when the
+  /// wheel sinks in. Set by Vehicle::measure_contacts().
+  double surface_gap = 0;
+};
+
+/// A vehicle body. Positions in world metres (double precision); the body frame is +y up,
+/// +z forward, +x to the left. Not thread-safe; the Terrain it reads is.
+class Vehicle {
+ public:
+  Vehicle(const VehicleParams& params, glm::dvec3 position, double heading_rad);
+
+  /// Advances by dt seconds (the game calls it with the fixed step, split into substeps).
+  void step(const ridgeline::Terrain& terrain, double dt);
+  /// Pushes the body up until no wheel and no chassis corner is below the surface, and removes
+  /// velocity into the surface: what keeps a body out of the ground, also when an edit removes
+  /// the ground under it. Returns the lift applied, metres.
+  double resolve_penetration(const ridgeline::Terrain& terrain);
+  /// Updates every wheel's surface_gap (see WheelState).
+  void measure_contacts(const ridgeline::Terrain& terrain);
+
+  Controls controls;
+  const VehicleParams& params() const noexcept { return params_; }
+  glm::dvec3 position() const noexcept { return pos_; }  ///< centre of mass
+  glm::dquat orientation() const noexcept { return q_; }
+  glm::dvec3 velocity() const noexcept { return v_; }
+  glm::dvec3 forward() const noexcept { return q_ * glm::dvec3(0, 0, 1); }
+  glm::dvec3 up() const noexcept { return q_ * glm::dvec3(0, 1, 0); }
+  double heading() const noexcept;  ///< radians, 0 = +z, positive towards +x
+  double speed() const noexcept;    ///< signed forward speed, m/s
+  const std::array<WheelState, 4>& wheels() const noexcept { return wheels_; }
+  /// Moves the body (teleport): velocities cleared.
+  void place(glm::dvec3 position, double heading_rad);
+  /// Teleports to (x, z) with the given heading, tilted to the surface normal there and lifted
+  /// so that the wheels just touch: how vehicles are spawned on slopes. False off-terrain.
+  bool place_on_surface(const ridgeline::Terrain& terrain, double x, double z,
+                        double heading_rad);
+  /// Bottom corners of the chassis box in world coordinates.
+  std::array<glm::dvec3, 4> chassis_corners() const;
+  glm::dvec3 chassis_min{-1, -0.5, -2}, chassis_max{1, 0.5, 2};  ///< body-frame box (from COM)
+
+ private:
+  void substep(const ridgeline::Terrain& terrain, double dt);
+  VehicleParams params_;
+  glm::dvec3 pos_{0}, v_{0}, w_{0};
+  glm::dquat q_{1, 0, 0, 0};
+  glm::dvec3 inertia_{1};  // body-frame diagonal
+  std::array<WheelState, 4> wheels_{};
+};
+
+/// Steers a vehicle along waypoints (pure pursuit on the xz plane).
+struct Autopilot {
+  std::vector<glm::dvec2> waypoints;  ///< x, z
+  std::size_t next = 0;               ///< index of the waypoint being approached
+  double speed = 10;                  ///< m/s wanted
+  double reach = 10;                  ///< metres: a waypoint within this is reached
+  bool loop = false;
+  bool active = false;
+  std::uint64_t reached = 0;  ///< waypoints reached so far (counts laps when looping)
+  /// Sets the vehicle's controls for this step. Returns true when a waypoint was reached.
+  bool drive(Vehicle& v);
+};
+
+}  // namespace game

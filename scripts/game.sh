@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# The main command: builds Ridgeline and runs the sample game's default scenario (a convoy on a
+# loop of waypoints over the hills while artillery drops craters near it, with the LOD budget
+# controller holding the frame time).
+#  - With a display: opens a window (close it to quit). Keys in docs/game.md.
+#  - Without one: renders offscreen (under xvfb-run when it is installed, else EGL surfaceless)
+#    for FRAMES frames (default 600 = 10 s of game time) and writes screenshots and per-frame
+#    statistics into out/game/.
+# Extra arguments go to the game (ridgeline_game --help).
+set -euo pipefail
+source "$(dirname "$0")/lib/common.sh"
+cd "$RIDGELINE_ROOT"
+ensure_packages "${RIDGELINE_PACKAGES[@]}"
+echo "building (build/game-release)..."
+mkdir -p build
+configure_and_build build/game-release -DCMAKE_BUILD_TYPE=Release -DRIDGELINE_BUILD_TESTS=OFF \
+  -DRIDGELINE_BUILD_BENCHMARKS=OFF -DRIDGELINE_BUILD_TOOLS=OFF > build/game-release.build.log 2>&1 ||
+  { tail -40 build/game-release.build.log; exit 1; }
+game=build/game-release/sample_game/ridgeline_game
+if [ -n "${DISPLAY:-}" ] && [ -z "${RIDGELINE_OFFSCREEN:-}" ]; then
+  echo "running the game in a window (Tab: camera, F1: wireframe, F5: reload scripts)"
+  exec "$game" "$@"
+fi
+frames=${FRAMES:-600}
+out=out/game
+rm -rf "$out" && mkdir -p "$out"
+echo "no display: running $frames frames offscreen; screenshots and stats go to $out/"
+args=(--offscreen --frames "$frames" --screenshot-every 120 --out "$out"
+      --screenshot "$out/last_frame.png" --stats "$out/stats.json" "$@")
+if command -v xvfb-run > /dev/null; then
+  xvfb-run -a -s "-screen 0 1280x720x24" "$game" "${args[@]}"
+else
+  "$game" --egl "${args[@]}"
+fi
+python3 - "$out/stats.json" <<'PY' 2>/dev/null || true
+import json, sys
+d = json.load(open(sys.argv[1]))
+s = d["summary"]
+print("frame ms p50 %.1f p90 %.1f p99 %.1f (target %.0f ms); threshold p50 %.2f px; "
+      "%d craters; %d script errors" % (s["frame_ms"]["p50"], s["frame_ms"]["p90"],
+      s["frame_ms"]["p99"], s["target_ms"], s["threshold_px"]["p50"], s["craters"],
+      s["script_errors"]))
+last = d["frames"][-1]
+for v in last["vehicles"]:
+    print("vehicle %d at (%.0f, %.0f, %.0f), %d waypoints reached" % (v["id"], *v["position"],
+          v["waypoints_reached"]))
+PY
+echo "done: $(ls "$out"/*.png | wc -l) screenshots in $out/ (last: $out/last_frame.png), per-frame statistics in $out/stats.json"

@@ -1,0 +1,32 @@
+-- Default scenario: a convoy of four vehicles follows a loop of waypoints over the hills in the
+-- middle of the default terrain while an artillery battery drops craters near it.
+-- (docs/game_scripting.md walks through this file.)
+
+-- The loop: 48 points on a 380 m circle around the terrain's centre.
+local waypoints = {}
+for i = 0, 47 do
+  local a = i / 48 * 2 * math.pi
+  waypoints[#waypoints + 1] = {1024 + 380 * math.sin(a), 1024 + 380 * math.cos(a)}
+end
+
+-- The convoy starts behind the first waypoint, nose to tail, heading along the loop (+x).
+local convoy = {}
+local models = {"truck", "buggy", "truck", "buggy"}
+for i, model in ipairs(models) do
+  local v, err = game.spawn{model = model, x = 1024 - 16 * i, z = 1404, heading = math.pi / 2,
+                            name = model .. " " .. i}
+  assert(v, err)
+  -- Each one aims a little behind the vehicle ahead by starting at the same waypoint.
+  v:follow{waypoints = waypoints, speed = 10 + (i % 2), loop = true, reach = 14}
+  convoy[i] = v
+end
+
+game.camera{mode = "follow", vehicle = convoy[1], distance = 26}
+game.log("convoy of " .. #convoy .. " vehicles on a " .. #waypoints .. "-point loop")
+
+-- Expose the convoy to the other scripts (artillery, budget) through a shared global.
+CONVOY = convoy
+
+game.on("waypoint", function(id, next_index)
+  if id == convoy[1]:id() and next_index == 1 then game.log("the lead vehicle finished a lap") end
+end)

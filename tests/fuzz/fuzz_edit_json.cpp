@@ -1,0 +1,24 @@
+// Fuzz target: io::parse_edits (the edits JSON, SPEC.md "Edits"); every edit it accepts must pass
+// validate_edit and apply to a small terrain without failing.
+#include <cstdint>
+#include <string_view>
+
+#include "ridgeline/edit.h"
+#include "ridgeline/edit_json.h"
+#include "ridgeline/heightfield.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  using namespace ridgeline;
+  const std::string_view json(reinterpret_cast<const char*>(data), size);
+  auto edits = io::parse_edits(json);
+  if (!edits) return 0;
+  DefaultTerrainParams p;
+  p.size = 33;
+  p.spacing = 8;
+  auto terrain = Terrain::create(std::move(make_default_heightfield(p)).value());
+  for (const Edit& e : *edits) {
+    if (!validate_edit(e)) __builtin_trap();  // parse_edits let through an invalid edit
+    if (!terrain->apply_edit(e)) __builtin_trap();
+  }
+  return 0;
+}
