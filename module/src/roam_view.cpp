@@ -279,7 +279,11 @@ class ExpiryWheel {
     return true;
   }
   std::uint64_t bucket(double key) const {
-    return key <= 0.0 ? 0 : static_cast<std::uint64_t>(key / width_);
+    // Keys beyond 2^63 buckets (heights near FLT_MAX give such expiry times) clamp instead of
+    // overflowing the conversion (undefined behaviour, caught by UBSan); NaN goes to bucket 0.
+    const double b = key / width_;
+    if (!(b > 0.0)) return 0;
+    return b >= 9.2e18 ? std::uint64_t{1} << 63 : static_cast<std::uint64_t>(b);
   }
   double width_;
   std::vector<std::vector<Expiry>> ring_;
