@@ -296,7 +296,10 @@ std::shared_ptr<Terrain> Terrain::clone() const {
     field->keep_.reset();
     field->base_ = t.get();
     t->detail_ = field;
-    auto cache = DetailCache::create(t->detail_, {.budget_bytes = std::size_t{64} << 20, .worker_threads = 0});
+    DetailCacheDesc desc;
+    desc.budget_bytes = std::size_t{64} << 20;
+    desc.worker_threads = 0;
+    auto cache = DetailCache::create(t->detail_, desc);
     if (cache) t->cache_ = std::move(*cache);
     t->detail_levels_ = t->cache_ ? detail_levels_ : 0;
     t->detail_hash_ = detail_hash_;

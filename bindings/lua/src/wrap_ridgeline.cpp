@@ -63,7 +63,9 @@ bool do_load(const ConfigBox& config, const LoadArgs& a, TerrainBox* box, char* 
     if (a.has_amplitude) detail.amplitude = a.detail_amplitude;
     if (a.has_gain) detail.gain = a.detail_gain;
     // Scripts never wait for tiles: two workers generate them; views hold coarser meanwhile.
-    auto t = Terrain::create(std::move(*hf), detail, {.worker_threads = 2});
+    DetailCacheDesc cache;
+    cache.worker_threads = 2;
+    auto t = Terrain::create(std::move(*hf), detail, cache);
     if (!t) {
       copy_error(err, t.error().message.c_str());
       return false;
