@@ -1100,9 +1100,17 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
 
   if (m.cache != nullptr) m.cache->update();  // integrate tiles generated since the last frame
   m.has_deadline = budget > 0.0;
-  m.deadline = t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                        std::chrono::duration<double, std::milli>(budget));
-  bool all = false;
+  auto deadline_at = [&](double fraction) {
+    return t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                    std::chrono::duration<double, std::milli>(budget * fraction));
+  };
+  // Recomputing expired keys may take at most this share of a time budget: the rest is kept for
+  // splits and merges, else a camera that outruns the budget starves them and the mesh freezes
+  // (what `ridge report` found: 0 changes per frame under 0.5 and 2 ms budgets). Keys left due
+  // are recomputed first on the next update.
+  constexpr double kRefreshShare = 0.5;
+  m.deadline = deadline_at(kRefreshShare);
+  bool all = false, refresh_ran_out = false;
   if (settings_.metric == ErrorMetric::kScreenPixels) all = m.set_camera(camera);
   if (m.reset_pending || settings_.mode == RoamMode::kRebuild) {
     m.reset_pending = false;
@@ -1136,10 +1144,12 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
     const auto r = m.refresh_expired(everything ? std::numeric_limits<std::size_t>::max()
                                                 : std::max<std::size_t>(2048, queued / 2));
     if (r == Impl::Refresh::kRebuild) m.reset_to_roots();
-    if (r == Impl::Refresh::kOutOfTime) m.st.stop = StopReason::kTimeBudget;
+    // Out of time (kOutOfTime): the rest stays due; splits and merges get the remaining budget.
+    refresh_ran_out = r == Impl::Refresh::kOutOfTime;
   }
 
   m.keyed_threshold = threshold;
+  m.deadline = deadline_at(1.0);
   if (!m.waiting.empty()) m.unpark();
 
   // Greedy split/merge (D97 section 5): split the worst leaf while it exceeds the threshold,
@@ -1186,6 +1196,7 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
     break;
   }
 
+  if (refresh_ran_out) m.st.stop = StopReason::kTimeBudget;  // keys are still due: not converged
   triangles_ = m.triangles;
   m.st.triangles = m.triangles;
   m.st.max_remaining_error = m.split.empty() ? 0.0 : std::max(0.0f, m.split.top().key);

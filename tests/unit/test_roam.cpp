@@ -568,3 +568,22 @@ TEST(Roam, ViewsUpdateOnDifferentThreadsOverOneLandscape) {
   EXPECT_EQ(a1, a2);
   EXPECT_EQ(b1, b2);
 }
+
+TEST(Roam, ATightTimeBudgetStillSplitsAndMerges) {
+  // A camera moving faster than a tiny budget can re-key: the refresh of expired keys may use
+  // only part of the budget, so splits and merges still happen and the mesh follows the camera
+  // (it froze before: every frame's budget went to re-keying).
+  auto l = make_landscape(257, 5);
+  auto view = RoamView::create(l, {.threshold = 1.0, .budget_ms = 0.02}).value();
+  std::uint64_t changes = 0;
+  for (int f = 0; f < 120; ++f) {
+    const double a = f * 0.05;
+    const Camera c = camera_at({256 + 200 * std::cos(a), 90, 256 + 200 * std::sin(a)}, {256, 40, 256});
+    auto st = view->update(c);
+    ASSERT_TRUE(st);
+    if (f >= 20) changes += st->splits + st->merges;
+  }
+  EXPECT_GT(changes, 0u);
+  EXPECT_EQ(check_crack_free(*view), "");
+  EXPECT_EQ(view->check_invariants(), "");
+}
