@@ -473,7 +473,54 @@ std::shared_ptr<const DetailTile> DetailField::make_tile(const DetailTileKey& ke
     }
   tile->min_ = lo;
   tile->max_ = hi;
+  tile->levels_ = params_.levels;
+  if (key.level == params_.levels) measure_increments(*tile);
   return tile;
+}
+
+// For a finest tile: the largest |D_l - P_{l-1}| at its new level-l vertices, for every level l
+// whose cells fit the tile (edge midpoints: the mean of the edge's ends; cell centres: the mean of
+// the diagonal's ends, by the diagonal rule of the coarser lattice).
+void DetailField::measure_increments(DetailTile& tile) const {
+  const int L = int(params_.levels);
+  const std::int64_t gx = tile.first_i(), gz = tile.first_j();
+  for (int l = 0; l <= L; ++l) tile.increment_max_[l] = -1;
+  for (int l = L; l >= 1; --l) {
+    const std::int32_t s = std::int32_t{1} << (L - l);  // level-l spacing, finest cells
+    if (2 * s > kDetailTileCells) break;                 // level-(l-1) cells exceed the tile
+    std::int64_t worst = 0;                              // in half units
+    for (std::int32_t lj = 0; lj <= kDetailTileCells; lj += s) {
+      const bool odd_j = (lj / s) & 1;
+      for (std::int32_t li = (odd_j ? 0 : s); li <= kDetailTileCells; li += odd_j ? s : 2 * s) {
+        const bool odd_i = (li / s) & 1;
+        std::int64_t a, b;
+        if (odd_i && !odd_j) {
+          a = tile.raw(li - s, lj), b = tile.raw(li + s, lj);
+        } else if (!odd_i && odd_j) {
+          a = tile.raw(li, lj - s), b = tile.raw(li, lj + s);
+        } else {
+          // A level-(l-1) cell centre: that cell's diagonal, in global level-(l-1) indices.
+          const std::int64_t ci = (gx + li - s) >> (L - l + 1), cj = (gz + lj - s) >> (L - l + 1);
+          if (cell_has_main_diagonal(ci, cj))
+            a = tile.raw(li - s, lj - s), b = tile.raw(li + s, lj + s);
+          else
+            a = tile.raw(li + s, lj - s), b = tile.raw(li - s, lj + s);
+        }
+        worst = std::max<std::int64_t>(worst, std::abs(2 * std::int64_t(tile.raw(li, lj)) - a - b));
+      }
+    }
+    tile.increment_max_[l] = static_cast<std::int32_t>((worst + 1) / 2);  // rounded up
+  }
+}
+
+double DetailTile::measured_contribution(std::uint32_t from_level) const noexcept {
+  if (key_.level != levels_ || from_level == 0) return INFINITY;
+  std::int64_t sum = 0;
+  for (std::uint32_t l = from_level; l <= levels_; ++l) {
+    if (increment_max_[l] < 0) return INFINITY;
+    sum += increment_max_[l];
+  }
+  return double(sum) * kDetailUnit;
 }
 
 std::shared_ptr<const DetailTile> DetailField::make_tile_chain(const DetailTileKey& key) const {

@@ -212,9 +212,14 @@ float Landscape::detail_bound(int level, const LatticeTriangle& t) const noexcep
   const int from = level < base ? 1 : (level - base) / 2 + 1;
   if (from > int(detail_)) return 0.0f;
   const DetailField& f = *terrain_->detail();
-  const double b = 2.0 * f.contribution_bound(std::uint32_t(from), detail_,
-                                              std::min({t.ax, t.lx, t.rx}), std::min({t.az, t.lz, t.rz}),
-                                              std::max({t.ax, t.lx, t.rx}), std::max({t.az, t.lz, t.rz}));
+  const std::int64_t i0 = std::min({t.ax, t.lx, t.rx}), j0 = std::min({t.az, t.lz, t.rz});
+  const std::int64_t i1 = std::max({t.ax, t.lx, t.rx}), j1 = std::max({t.az, t.lz, t.rz});
+  // The analytic bound holds before any tile exists; inside a resident finest tile the bound
+  // measured when the tile was generated (usually much tighter) replaces it. Both are upper
+  // bounds of the same quantity, so their minimum is too.
+  const double analytic = f.contribution_bound(std::uint32_t(from), detail_, i0, j0, i1, j1);
+  const double measured = terrain_->measured_detail_bound(std::uint32_t(from), i0, j0, i1, j1);
+  const double b = 2.0 * std::min(analytic, measured);
   float r = static_cast<float>(b);
   if (double(r) < b) r = std::nextafter(r, INFINITY);
   return r;

@@ -107,6 +107,17 @@ double Terrain::detail_at(std::int64_t i, std::int64_t j) const noexcept {
   return detail_->detail(m, li, lj);
 }
 
+double Terrain::measured_detail_bound(std::uint32_t from_level, std::int64_t i0, std::int64_t j0,
+                                      std::int64_t i1, std::int64_t j1) const noexcept {
+  if (detail_levels_ == 0 || i0 < 0 || j0 < 0) return INFINITY;
+  const std::int64_t tx = i0 / kDetailTileCells, tz = j0 / kDetailTileCells;
+  if (i1 > (tx + 1) * kDetailTileCells || j1 > (tz + 1) * kDetailTileCells) return INFINITY;
+  const DetailSnapshot* s = current_snapshot(*cache_);
+  const DetailTile* tile =
+      s ? s->find({detail_levels_, std::int32_t(tx), std::int32_t(tz)}) : nullptr;
+  return tile ? tile->measured_contribution(from_level) : INFINITY;
+}
+
 double Terrain::fine_local_height(std::int64_t i, std::int64_t j) const noexcept {
   const Heightfield& hf = heightfield_;
   const int L = int(detail_levels_);

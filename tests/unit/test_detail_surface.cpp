@@ -28,8 +28,10 @@ DetailParams params(std::uint32_t levels, std::uint64_t seed = 5) {
 std::shared_ptr<Terrain> detail_terrain(std::uint32_t size, std::uint32_t levels,
                                         std::uint32_t workers = 0, std::uint64_t seed = 5) {
   auto hf = make_default_heightfield({.size = size, .spacing = 4.0, .seed = 21});
-  auto t = Terrain::create(std::move(hf).value(), params(levels, seed),
-                           {.budget_bytes = std::size_t{64} << 20, .worker_threads = workers});
+  DetailCacheDesc cache;
+  cache.budget_bytes = std::size_t{64} << 20;
+  cache.worker_threads = workers;
+  auto t = Terrain::create(std::move(hf).value(), params(levels, seed), cache);
   EXPECT_TRUE(t) << (t ? "" : t.error().message);
   return t.value();
 }
@@ -100,10 +102,16 @@ TEST(DetailSurface, ContinuousAcrossTileSeamsAndTheStoredBoundary) {
   EXPECT_LT(worst, 50 * dx);
 }
 
-TEST(DetailSurface, BoundsHoldBelowTheStoredLevels) {
-  auto t = detail_terrain(33, 3);
-  auto l = Landscape::create(t, {.patch_exponent = 3}).value();
-  ASSERT_EQ(l->max_level(), 2u * (3 + 3));
+namespace {
+
+// Every node of a few roots down to the finest level: |surface - plane| over every finest vertex
+// of its triangle stays within the bound, and bounds are nested. Returns how many nodes had a
+// bound below the analytic one (measured bounds in use).
+int check_bounds_against_brute_force(const Terrain& terrain, const Landscape& landscape) {
+  const Landscape* l = &landscape;
+  int tighter = 0;
+  const DetailField& field = *terrain.detail();
+  EXPECT_EQ(l->max_level(), 2u * (3 + 3));
   // Every node of a few roots down to the finest level: |surface - plane| over every finest
   // vertex of its triangle stays within the bound, and bounds are nested.
   std::mt19937 rng(1);
@@ -130,7 +138,14 @@ TEST(DetailSurface, BoundsHoldBelowTheStoredLevels) {
           if (wa < -1e-12 || wr < -1e-12 || wl < -1e-12) continue;
           worst = std::max(worst, std::abs(l->lattice_height(x, z) - (wa * ha + wl * hl + wr * hr)));
         }
-      ASSERT_LE(worst, double(b) + 1e-4) << "root " << root << " level " << level;
+      EXPECT_LE(worst, double(b) + 1e-4) << "root " << root << " level " << level;
+      if (worst > double(b) + 1e-4) return -1;
+      if (level >= int(l->base_level())) {
+        const int from = (level - int(l->base_level())) / 2 + 1;
+        const double analytic =
+            2.0 * field.contribution_bound(std::uint32_t(from), l->detail_levels(), x0, z0, x1, z1);
+        tighter += double(b) < analytic * 0.999;
+      }
       ++checked;
       if (std::uint32_t(level) < l->max_level()) {
         // Descend fully near the top, then along one random child (keeps the test short).
@@ -145,6 +160,25 @@ TEST(DetailSurface, BoundsHoldBelowTheStoredLevels) {
     }
     EXPECT_GT(checked, 20u);
   }
+  return tighter;
+}
+
+}  // namespace
+
+TEST(DetailSurface, BoundsHoldBelowTheStoredLevels) {
+  auto t = detail_terrain(33, 3);
+  auto l = Landscape::create(t, {.patch_exponent = 3}).value();
+  EXPECT_EQ(check_bounds_against_brute_force(*t, *l), 0) << "no tile resident: analytic only";
+}
+
+TEST(DetailSurface, MeasuredBoundsFromResidentTilesHoldAndAreTighter) {
+  auto t = detail_terrain(33, 3);
+  // Every finest tile resident (synchronous cache): nodes inside one take its measured bound.
+  const std::int32_t n = std::int32_t((32 << 3) / kDetailTileCells) + 1;
+  for (std::int32_t tz = 0; tz < n; ++tz)
+    for (std::int32_t tx = 0; tx < n; ++tx) ASSERT_TRUE(t->detail_cache()->request({3, tx, tz}));
+  auto l = Landscape::create(t, {.patch_exponent = 3}).value();
+  EXPECT_GT(check_bounds_against_brute_force(*t, *l), 20);
 }
 
 TEST(DetailSurface, RoamRefinesBelowTheStoredSpacingNearTheCamera) {
@@ -254,7 +288,9 @@ TEST(DetailSurface, RaysHitTheFinestSurface) {
     EXPECT_NEAR(h->point.y, *at, 2e-5);
     for (double s = 0; s < h->distance - 1e-3; s += 0.02) {
       const glm::dvec3 p = o + dir * s;
-      if (auto hp = t->height(p.x, p.z)) ASSERT_GT(p.y - *hp, -2e-5) << "ray " << k << " at " << s;
+      if (auto hp = t->height(p.x, p.z)) {
+        ASSERT_GT(p.y - *hp, -2e-5) << "ray " << k << " at " << s;
+      }
     }
     // The normal is the finest triangle's.
     auto n = t->face_normal(h->point.x, h->point.z);

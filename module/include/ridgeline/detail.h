@@ -98,6 +98,13 @@ class DetailTile {
   /// tighter than DetailField::contribution_bound).
   double min_detail() const noexcept { return min_ * kDetailUnit; }
   double max_detail() const noexcept { return max_ * kDetailUnit; }
+  /// Measured bound, metres, on |D_L - P_{from_level - 1}| over the tile's area (P interpolating
+  /// the level-(from_level - 1) lattice): the sum over levels l >= from_level of the largest
+  /// |D_l - P_{l-1}| at the tile's new level-l vertices. Only for tiles of the finest level L,
+  /// and only where every level's cells fit the tile (l >= L - 7); otherwise +infinity (use
+  /// DetailField::contribution_bound). Usually well below the analytic bound: it replaces it for
+  /// ROAM nodes inside a resident finest tile.
+  double measured_contribution(std::uint32_t from_level) const noexcept;
   /// Bytes held by the tile (object and samples).
   std::size_t memory_bytes() const noexcept;
 
@@ -107,6 +114,9 @@ class DetailTile {
   DetailTileKey key_;
   std::vector<std::int32_t> samples_;  // kDetailTileStride^2, row-major, apron included
   std::int32_t min_ = 0, max_ = 0;
+  // Largest |D_l - P_{l-1}| at the new level-l vertices, kDetailUnit; -1: not measured.
+  std::int32_t increment_max_[kMaxDetailLevels + 1] = {};
+  std::uint32_t levels_ = 0;  // L of the field (measured only when key_.level == L)
 };
 
 /// The detail function over a terrain: immutable after create(); shared as
@@ -192,6 +202,7 @@ class DetailField {
                                                                const DetailParams& params);
   static Result<std::shared_ptr<DetailField>> build(const Terrain& terrain,
                                                     const DetailParams& params);
+  void measure_increments(DetailTile& tile) const;
   DetailParams params_;
   std::uint64_t seed_mix_ = 0;
   // Octave amplitude per level in kDetailUnit (index 0 is 0).

@@ -173,6 +173,11 @@ class Terrain {
   /// Vertex normal (area-weighted, unit, y > 0) at finest-lattice vertex (i, j), which must lie
   /// in the footprint: what shading wants at a mesh vertex.
   glm::vec3 lattice_vertex_normal(std::int64_t i, std::int64_t j) const noexcept;
+  /// Measured bound (metres) on |D_L - P_{from_level - 1}| over the finest-lattice rectangle
+  /// [i0, i1] x [j0, j1] when it lies inside one resident finest tile (its
+  /// DetailTile::measured_contribution), else +infinity. Through the per-thread snapshot.
+  double measured_detail_bound(std::uint32_t from_level, std::int64_t i0, std::int64_t j0,
+                               std::int64_t i1, std::int64_t j1) const noexcept;
   /// Detail (metres) at finest-lattice vertex (i, j) alone; 0 without detail.
   double detail_at(std::int64_t i, std::int64_t j) const noexcept;
   /// 64-bit hash of the detail parameters (0 without detail): save files record it.
