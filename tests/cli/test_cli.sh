@@ -265,7 +265,7 @@ run bench detail --default-terrain --detail-levels 3 --tile-reps 3 --workers 0 -
 expect "bench detail" 0
 out=$(cat "$T/detail.json")
 [ "$(grep -c '"level":' "$T/detail.json")" = 3 ] && ok || bad "bench detail: one tile figure per level"
-contains "bench detail tile bytes" '"tile_bytes": 72948'
+contains "bench detail tile bytes" '"tile_bytes": 73004'
 contains "bench detail frames" '"frames": 41,'
 contains "bench detail virtual samples" '"virtual_samples": 67125249.0'
 # Synchronous: every needed tile is there every frame, within the budget.

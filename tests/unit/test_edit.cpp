@@ -184,7 +184,9 @@ TEST(Transaction, ViewsStayCrackFreeAndHonestAndQueriesSeeTheEdit) {
     const PatchMesh& m = v->patch_mesh(p);
     for (std::size_t k = 0; k < m.vertices.size(); k += 7) {
       const double x = m.origin_x + m.vertices[k].x, z = m.origin_z + m.vertices[k].z;
-      if (auto h = t->height(x, z)) EXPECT_NEAR(m.origin_y + m.vertices[k].y, *h, 1e-3);
+      if (auto h = t->height(x, z)) {
+        EXPECT_NEAR(m.origin_y + m.vertices[k].y, *h, 1e-3);
+      }
     }
   }
 }
