@@ -19,8 +19,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (!host) __builtin_trap();
   const std::string_view source(reinterpret_cast<const char*>(data), size);
   (void)(*host)->run(source, "fuzz");
-  // The host stays usable after whatever the input did.
-  if (!(*host)->run("local t = {1, 2}; assert(#t == 2 and ridgeline.load)", "alive"))
-    __builtin_trap();
+  // The host stays usable after whatever the input did. The check reads no global: a script may
+  // legitimately reassign its own globals (`ridgeline = false`, `assert = nil`), which once
+  // made this check trap on a healthy host (regression input crash-globals-reassigned.lua).
+  if (!(*host)->run("local t = {1, 2}; return #t", "alive")) __builtin_trap();
   return 0;
 }
