@@ -4,7 +4,8 @@
 # Installs missing Debian packages first.
 # Usage: scripts/test.sh            (all stages)
 #        STAGES="release" scripts/test.sh   (a subset: release asan fuzz)
-#        FUZZ_SECONDS=600 STAGES=fuzz scripts/test.sh   (a longer fuzz run; default 30 s a target)
+#        FUZZ_SECONDS=600 FUZZ_SEED=$RANDOM STAGES=fuzz scripts/test.sh   (a longer, fresh fuzz run;
+#        default 30 s a target with the fixed seed 1, so that CI explores the same inputs each run)
 set -uo pipefail
 source "$(dirname "$0")/lib/common.sh"
 cd "$RIDGELINE_ROOT"
@@ -64,7 +65,7 @@ fuzz() {
     mkdir -p "$work"
     [ -f "$dict" ] && extra+=(-dict="$dict")
     ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-      "$dir/tests/fuzz/$t" -max_total_time="$secs" -timeout=20 -rss_limit_mb=2560 -max_len=8192 \
+      "$dir/tests/fuzz/$t" -max_total_time="$secs" -seed="${FUZZ_SEED:-1}" -timeout=20 -rss_limit_mb=2560 -max_len=8192 \
       -print_final_stats=1 -artifact_prefix="$dir/crashes/$t-" "${extra[@]}" \
       "$work" "tests/fuzz/corpus/$t" > "$dir/$t.log" 2>&1
     local r=$?
