@@ -1,6 +1,8 @@
 // Helpers shared by the ROAM and deformation tests.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <map>
 #include <string>
 
@@ -46,6 +48,24 @@ inline std::string check_crack_free(const RoamView& view) {
              "," + std::to_string(bj) + ") used by " + std::to_string(n) + " triangles";
   }
   return "";
+}
+
+// Checks every `stride`-th vertex of every patch mesh against the surface the queries see:
+// its height equals terrain.height() there within `tol`. Returns the vertices checked.
+inline std::size_t expect_mesh_on_surface(RoamView& view, const Terrain& terrain,
+                                          std::size_t stride, double tol) {
+  std::size_t checked = 0;
+  for (std::uint32_t p = 0; p < view.landscape().patch_count(); ++p) {
+    const PatchMesh& m = view.patch_mesh(p);
+    for (std::size_t k = 0; k < m.vertices.size(); k += stride) {
+      const double x = m.origin_x + m.vertices[k].x, z = m.origin_z + m.vertices[k].z;
+      if (auto h = terrain.height(x, z)) {
+        EXPECT_NEAR(m.origin_y + m.vertices[k].y, *h, tol) << "vertex at " << x << ", " << z;
+        ++checked;
+      }
+    }
+  }
+  return checked;
 }
 
 }  // namespace ridgeline::test

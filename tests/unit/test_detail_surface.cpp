@@ -202,17 +202,7 @@ TEST(DetailSurface, RoamRefinesBelowTheStoredSpacingNearTheCamera) {
   EXPECT_GT(err.vertices, 10000u);
   EXPECT_LE(err.max_px, 1.0 + 1e-3);
   // The mesh is the surface the queries see: every vertex height equals height() there.
-  std::size_t checked = 0;
-  for (std::uint32_t p = 0; p < l->patch_count(); ++p) {
-    const PatchMesh& m = v->patch_mesh(p);
-    for (std::size_t k = 0; k < m.vertices.size(); k += 5) {
-      const double x = m.origin_x + m.vertices[k].x, z = m.origin_z + m.vertices[k].z;
-      if (auto h = t->height(x, z)) {
-        EXPECT_NEAR(m.origin_y + m.vertices[k].y, *h, 1e-3);
-        ++checked;
-      }
-    }
-  }
+  const std::size_t checked = expect_mesh_on_surface(*v, *t, 5, 1e-3);
   EXPECT_GT(checked, 1000u);
 }
 
