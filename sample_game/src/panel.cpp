@@ -77,7 +77,7 @@ void Panel::draw(Game& game, RenderSettings& settings, const PanelInput& in, dou
   ImGui::Text("tessellation %.2f ms  upload %.2f ms (%u patches)  draw %.2f ms",
               vf.stats.update_ms, in.render.upload_ms, in.render.patches_uploaded,
               in.render.draw_ms);
-  ImGui::Text("tiles resident: n/a (procedural detail is not in the surface yet)");
+  ImGui::Text("tiles resident: n/a (the game runs without procedural detail)");
   ImGui::Separator();
   int mode = int(game.rig().mode);
   ImGui::RadioButton("free", &mode, 0);
