@@ -247,18 +247,17 @@ int setup_state(lua_State* L) {
         lua_getfield(L, -1, *n);
         lua_setfield(L, env, *n);
       }
-      lua_getfield(L, -1, "load");
-      lua_pushcclosure(L, safe_load, 1);
-      lua_setfield(L, env, "load");
-      lua_getfield(L, -1, "setmetatable");
-      lua_pushcclosure(L, safe_setmetatable, 1);
-      lua_setfield(L, env, "setmetatable");
-      lua_getfield(L, -1, "xpcall");
-      lua_pushcclosure(L, safe_xpcall, 1);
-      lua_setfield(L, env, "xpcall");
-      lua_getfield(L, -1, "collectgarbage");
-      lua_pushcclosure(L, safe_collectgarbage, 1);
-      lua_setfield(L, env, "collectgarbage");
+      // Guarded versions, each closing over the original.
+      static const luaL_Reg kGuarded[] = {{"load", safe_load},
+                                          {"setmetatable", safe_setmetatable},
+                                          {"xpcall", safe_xpcall},
+                                          {"collectgarbage", safe_collectgarbage},
+                                          {nullptr, nullptr}};
+      for (const luaL_Reg* g = kGuarded; g->name != nullptr; ++g) {
+        lua_getfield(L, -1, g->name);
+        lua_pushcclosure(L, g->func, 1);
+        lua_setfield(L, env, g->name);
+      }
     } else {
       // A copy: scripts that change `string.rep` change their copy, not the string methods.
       lua_newtable(L);
