@@ -31,13 +31,8 @@ struct CellPlane {
   double at(double fu, double fv) const noexcept { return h0 + gu * (fu - c0u) + gv * (fv - c0v); }
 };
 
-/// `Grid` is a Heightfield or a finest-lattice view with the same local(i, j).
-template <class Grid>
-inline CellPlane cell_plane(const Grid& hf, std::uint32_t i, std::uint32_t j,
-                            const CellTriangle& t) noexcept {
-  const double h0 = hf.local(i + t.di[0], j + t.dj[0]);
-  const double h1 = hf.local(i + t.di[1], j + t.dj[1]);
-  const double h2 = hf.local(i + t.di[2], j + t.dj[2]);
+/// The plane of lattice triangle `t` whose corners have heights h0, h1, h2 (corner order of t).
+inline CellPlane plane_of(const CellTriangle& t, double h0, double h1, double h2) noexcept {
   const double e1u = double(t.di[1]) - t.di[0], e1v = double(t.dj[1]) - t.dj[0];
   const double e2u = double(t.di[2]) - t.di[0], e2v = double(t.dj[2]) - t.dj[0];
   // The corners of a lattice triangle span a unit-area parallelogram: det is +-1.
@@ -45,6 +40,14 @@ inline CellPlane cell_plane(const Grid& hf, std::uint32_t i, std::uint32_t j,
   const double gu = ((h1 - h0) * e2v - (h2 - h0) * e1v) * det;  // 1 / det == det
   const double gv = ((h2 - h0) * e1u - (h1 - h0) * e2u) * det;
   return {h0, double(t.di[0]), double(t.dj[0]), gu, gv};
+}
+
+/// `Grid` is a Heightfield or a finest-lattice view with the same local(i, j).
+template <class Grid>
+inline CellPlane cell_plane(const Grid& hf, std::uint32_t i, std::uint32_t j,
+                            const CellTriangle& t) noexcept {
+  return plane_of(t, hf.local(i + t.di[0], j + t.dj[0]), hf.local(i + t.di[1], j + t.dj[1]),
+                  hf.local(i + t.di[2], j + t.dj[2]));
 }
 
 /// v / |v|. Unlike glm::normalize (v * inversesqrt), a vector along an axis comes out exactly

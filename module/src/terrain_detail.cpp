@@ -154,14 +154,8 @@ double Terrain::fine_height_at(const FineLocated& p) const noexcept {
 }
 
 glm::vec3 Terrain::fine_face_normal(const FineLocated& p) const noexcept {
-  const CellTriangle& t = p.tri;
-  const double e1u = double(t.di[1]) - t.di[0], e1v = double(t.dj[1]) - t.dj[0];
-  const double e2u = double(t.di[2]) - t.di[0], e2v = double(t.dj[2]) - t.dj[0];
-  const double det = e1u * e2v - e1v * e2u;  // +-1
-  const double gu = ((p.h[1] - p.h[0]) * e2v - (p.h[2] - p.h[0]) * e1v) * det;
-  const double gv = ((p.h[2] - p.h[0]) * e1u - (p.h[1] - p.h[0]) * e2u) * det;
   const int L = int(detail_levels_);
-  return detail::plane_normal({p.h[0], double(t.di[0]), double(t.dj[0]), gu, gv},
+  return detail::plane_normal(detail::plane_of(p.tri, p.h[0], p.h[1], p.h[2]),
                               std::ldexp(inv_spacing_x_, L), std::ldexp(inv_spacing_z_, L));
 }
 
