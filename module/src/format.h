@@ -36,6 +36,18 @@ inline std::string num(double v) {
   return buf;
 }
 
+/// A float as the shortest text that reads back to the same float (3e+38 rather than the
+/// double expansion 2.9999999521443642e+38).
+inline std::string numf(float v) {
+  char buf[32];
+  for (int prec = 1; prec < 9; ++prec) {
+    std::snprintf(buf, sizeof buf, "%.*g", prec, double(v));
+    if (std::strtof(buf, nullptr) == v) return buf;
+  }
+  std::snprintf(buf, sizeof buf, "%.9g", double(v));
+  return buf;
+}
+
 }  // namespace ridgeline::detail
 
 namespace ridgeline {

@@ -99,6 +99,13 @@ Result<Heightfield> Heightfield::create(const HeightfieldDesc& d, std::span<cons
 
   // Scale, then fill. Values are scaled in double and stored as float relative to the offset.
   const float fill_scaled = static_cast<float>(d.height_scale * d.fill_constant);
+  if (!missing.empty() && d.fill == FillPolicy::kConstant &&
+      !(std::abs(double(fill_scaled)) <= kMaxRelativeHeight))
+    return Error{fmt("%s: fill constant %s gives a height of %s m relative to the offset, beyond "
+                     "the +-%.0f m limit",
+                     d.name.c_str(), num(d.fill_constant).c_str(),
+                     num(d.height_scale * d.fill_constant).c_str(),
+                     kMaxRelativeHeight)};
   for (std::size_t k = 0; k < count; ++k) {
     if (!missing.empty() && missing[k]) {
       hf.heights_[k] = fill_scaled;
@@ -109,6 +116,12 @@ Result<Heightfield> Heightfield::create(const HeightfieldDesc& d, std::span<cons
       return Error{fmt("%s: sample (%zu, %zu) = %s times height scale %s overflows float",
                        d.name.c_str(), k % d.width, k / d.width, num(values[k]).c_str(),
                        num(d.height_scale).c_str())};
+    if (std::abs(h) > kMaxRelativeHeight)
+      return Error{fmt("%s: sample (%zu, %zu) = %s gives a height of %s m relative to the offset, "
+                       "beyond the +-%.0f m limit (if it marks missing data, give it as the "
+                       "no-data value with a fill policy)",
+                       d.name.c_str(), k % d.width, k / d.width, detail::numf(values[k]).c_str(),
+                       num(h).c_str(), kMaxRelativeHeight)};
     hf.heights_[k] = static_cast<float>(h);
   }
   if (!missing.empty()) {

@@ -193,8 +193,11 @@ double popping_px(const Heightfield& hf, const DisplayedHeights& before, const C
 }
 
 DrawnMesh roam_mesh(RoamView& view, const Camera& camera, bool morph) {
+  return roam_mesh(view, view.landscape().terrain().heightfield(), camera, morph);
+}
+
+DrawnMesh roam_mesh(RoamView& view, const Heightfield& hf, const Camera& camera, bool morph) {
   const Landscape& l = view.landscape();
-  const Heightfield& hf = l.terrain().heightfield();
   const double k = projection_scale(camera);
   const double threshold = view.settings().threshold;
   DrawnMesh out;
@@ -214,6 +217,23 @@ DrawnMesh roam_mesh(RoamView& view, const Camera& camera, bool morph) {
       }
     }
   }
+  return out;
+}
+
+DrawnMesh roam_leaves(const RoamView& view, const Heightfield& hf) {
+  DrawnMesh out;
+  out.corners.reserve(std::size_t(view.triangle_count()) * 3);
+  const std::int64_t W = hf.width() - 1, H = hf.height() - 1;
+  auto corner = [&](std::int64_t i, std::int64_t j) {
+    const auto ci = static_cast<std::uint32_t>(std::clamp<std::int64_t>(i, 0, W));
+    const auto cj = static_cast<std::uint32_t>(std::clamp<std::int64_t>(j, 0, H));
+    return glm::dvec3(double(i), hf.world(ci, cj), double(j));
+  };
+  view.for_each_leaf([&](std::uint32_t, std::uint64_t, const LatticeTriangle& t) {
+    out.corners.push_back(corner(t.ax, t.az));
+    out.corners.push_back(corner(t.lx, t.lz));
+    out.corners.push_back(corner(t.rx, t.rz));
+  });
   return out;
 }
 

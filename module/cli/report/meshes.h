@@ -82,6 +82,15 @@ double popping_px(const Heightfield& hf, const DisplayedHeights& before, const C
 /// The ROAM view's mesh as drawn: its patch meshes, geomorphed for `camera` when `morph` (the
 /// vertex shader's job: y + (1 - t) * morph_dy, t = morph_factor(...)).
 DrawnMesh roam_mesh(RoamView& view, const Camera& camera, bool morph);
+/// The same in lattice units of `lattice` (same origin as the view's terrain): with procedural
+/// detail, the finest lattice as a heightfield (the stored one's spacing / 2^L).
+DrawnMesh roam_mesh(RoamView& view, const Heightfield& lattice, const Camera& camera, bool morph);
+/// The view's leaves as drawn without geomorphs, straight from the bintree (RoamView::
+/// for_each_leaf) with the vertex heights of `lattice` (its vertices are the view's lattice
+/// vertices; padding repeats the edge samples). The same triangles as roam_mesh(..., false)
+/// without building patch meshes (whose normals cost several full-detail height queries per
+/// vertex on a detail terrain).
+DrawnMesh roam_leaves(const RoamView& view, const Heightfield& lattice);
 
 // ---- uniform grid -----------------------------------------------------------------------
 

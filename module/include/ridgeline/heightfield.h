@@ -11,6 +11,13 @@
 
 namespace ridgeline {
 
+/// Largest |height - height_offset| (metres) a stored sample may have after scaling: 1e5 m, the
+/// range edits may produce by default (EditLimits), five times Earth's relief. Heightfield::create
+/// refuses a sample beyond it (naming the sample and its value) instead of storing heights near
+/// the float limit that no camera, bound or query could use; a no-data value (even -3.4e38, a
+/// common GDAL one) is replaced by the fill policy before the check.
+inline constexpr double kMaxRelativeHeight = 1e5;
+
 /// What to do with samples that are non-finite or equal to the no-data value.
 enum class FillPolicy {
   kRefuse,    ///< creation fails, naming the first bad sample (the default)

@@ -12,6 +12,7 @@
 
 #include "format.h"
 #include "io/loader_common.h"
+#include "io/tiff_tags.h"
 #include "ridgeline/log.h"
 
 namespace ridgeline::io {
@@ -144,6 +145,47 @@ Status read_values(ImageInput& in, int c, std::vector<float>& values, const std:
   }
 }
 
+/// TIFF files from GDAL carry their no-data value in tag 42113 (GDAL_NODATA), which
+/// OpenImageIO does not expose: read it (tiff_tags.h) and use it when the caller gave none.
+void apply_file_nodata(const std::string& path, const std::string& name, ImageInput& in,
+                       HeightfieldDesc& desc) {
+  if (std::string(in.format_name()) != "tiff") return;
+  auto tag = detail::read_gdal_nodata_file(path);
+  if (!tag) {
+    log_message(LogLevel::kWarning,
+                fmt("%s: GDAL_NODATA tag ignored: %s", name.c_str(), tag.error().message.c_str()));
+    return;
+  }
+  if (!*tag) return;
+  const std::string& text = **tag;
+  const auto v = detail::parse_nodata_text(text);
+  if (!v) {
+    log_message(LogLevel::kWarning, fmt("%s: GDAL_NODATA tag '%s' is not a number; ignored",
+                                        name.c_str(), text.c_str()));
+    return;
+  }
+  if (desc.nodata) {
+    if (*desc.nodata != *v)
+      log_message(LogLevel::kInfo,
+                  fmt("%s: no-data value %s given; the file's GDAL_NODATA tag says '%s' (the "
+                      "given value is used)",
+                      name.c_str(), num(*desc.nodata).c_str(), text.c_str()));
+    return;
+  }
+  if (!std::isfinite(*v)) {
+    log_message(LogLevel::kInfo,
+                fmt("%s: the file's GDAL_NODATA tag is '%s': non-finite samples are always "
+                    "treated as missing",
+                    name.c_str(), text.c_str()));
+    return;
+  }
+  desc.nodata = *v;
+  log_message(LogLevel::kInfo,
+              fmt("%s: no-data value %s from the file's GDAL_NODATA tag (samples equal to it are "
+                  "refused unless a fill policy is given)",
+                  name.c_str(), num(*v).c_str()));
+}
+
 }  // namespace
 
 namespace detail {
@@ -212,6 +254,8 @@ Result<Heightfield> load_image(const std::string& path, const LoadOptions& optio
             "channel option, e.g. --channel 0)",
             name.c_str(), img->nchannels, channel_list(spec).c_str())};
   }
+
+  apply_file_nodata(path, name, *img->input, desc);
 
   std::vector<float> values;
   if (auto s = read_values(*img->input, channel, values, name); !s) return Error{s.message()};
