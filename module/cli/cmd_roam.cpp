@@ -246,6 +246,7 @@ int run_bench_lod(const BenchLodArgs& a) {
           {"splits", st->splits + st->forced_splits},
           {"merges", st->merges},
           {"priority_updates", st->priority_updates},
+          {"expired", st->expired},
           {"rebuilt", st->rebuilt},
           {"stopped_by", st->stop == StopReason::kConverged        ? "converged"
                          : st->stop == StopReason::kTriangleBudget ? "triangles"

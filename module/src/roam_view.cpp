@@ -18,6 +18,7 @@
 #include "ridgeline/roam_view.h"
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <glm/geometric.hpp>
@@ -37,8 +38,13 @@ namespace {
 
 constexpr std::uint32_t kNone = 0xffffffffu;
 constexpr float kInf = std::numeric_limits<float>::infinity();
-// How much of the way to the threshold crossing a priority window spans (see priority()).
-constexpr double kWindowFraction = 0.5;
+// How much of the way to the threshold crossing a priority window spans (see priority()): for
+// a node below the threshold (the key stays below it for any fraction < 1: the larger, the
+// fewer recomputations as the eye approaches; 0.9 needs ~log10 instead of ~log2 of them), and
+// for a node above it (split soon anyway; a smaller window keeps the keys that order splits
+// under a budget finite and meaningful).
+constexpr double kWindowBelow = 0.9;
+constexpr double kWindowAbove = 0.5;
 // Deepest level the hierarchical culling pass tracks (see refresh_culling()).
 constexpr std::uint32_t kCullDepth = 4;
 
@@ -342,6 +348,10 @@ struct RoamView::Impl {
   ErrorMetric metric = ErrorMetric::kScreenPixels;
   double slack = 0.05;
   double threshold = 2.0;        // used only to size priority windows
+  double window_below = kWindowBelow;  // window fraction below it (see kWindowBelow)
+  // Under a triangle cap: the priority level at which the last capped update stopped (the
+  // largest key left in the split queue); windows are sized around it instead of the threshold.
+  double capped_level = 0.0;
   double keyed_threshold = 0.0;  // threshold of the previous update
   double height_offset = land.terrain().heightfield().height_offset();
   bool reset_pending = true;
@@ -467,41 +477,54 @@ struct RoamView::Impl {
       v.distance = d - cam.far_m;
       return 0.0f;
     }
-    // Side planes. The box is outside a plane by margin m (metres) when its most inward corner
-    // is m behind it; the classification holds while translation + rotation * reach < m.
-    const glm::dvec3 c = 0.5 * (lo + hi) - e, he = 0.5 * (hi - lo);
-    double margin = 0.0;
-    for (const glm::dvec3& pn : planes) {
-      const double s_max =
-          glm::dot(pn, c) + std::abs(pn.x) * he.x + std::abs(pn.y) * he.y + std::abs(pn.z) * he.z;
-      margin = std::max(margin, -s_max);
+    // Window: at least slack * d; wider when the node is far from the threshold either way
+    // (a fraction of the way to the distance at which its priority would equal the threshold),
+    // so nodes that are clearly fine or clearly too coarse are not recomputed every frame. The
+    // key stays below the threshold if the node was below it (and above if above), so decisions
+    // only ever err on the side of more detail.
+    double window = r;
+    if (threshold > 0.0) {
+      const double gap = d - double(b) * K / threshold;  // > 0: below the threshold
+      window = std::max(window, (gap > 0.0 ? window_below : kWindowAbove) * std::abs(gap));
     }
-    if (margin > r && margin > 0.0) {
-      const double reach = std::max(glm::length(c) + glm::length(he), 1e-9);
-      v.distance = 0.5 * margin;
-      v.angle = 0.5 * margin / reach;
-      return 0.0f;
+    const double dd = d - window;
+    const float key = dd <= 0.0 ? kInf : static_cast<float>(double(b) * K / dd);
+    // Lazy culling: a key at or below the threshold decides the same in view or out of it (no
+    // split; mergeable), so the frustum is tested only for nodes that would split in view. Their
+    // out-of-view key (0) then holds while translation and rotation cannot bring them inside.
+    if (key > threshold) {
+      // Side planes. The box is outside a plane by margin m (metres) when its most inward
+      // corner is m behind it; the classification holds while translation + rotation * reach
+      // < m.
+      const glm::dvec3 c = 0.5 * (lo + hi) - e, he = 0.5 * (hi - lo);
+      double margin = 0.0;
+      for (const glm::dvec3& pn : planes) {
+        const double s_max = glm::dot(pn, c) + std::abs(pn.x) * he.x + std::abs(pn.y) * he.y +
+                             std::abs(pn.z) * he.z;
+        margin = std::max(margin, -s_max);
+      }
+      if (margin > r && margin > 0.0) {
+        const double reach = std::max(glm::length(c) + glm::length(he), 1e-9);
+        v.distance = 0.5 * margin;
+        v.angle = 0.5 * margin / reach;
+        return 0.0f;
+      }
     }
     // Counting a node as visible is always conservative; nodes that turn out of view are
     // re-keyed when an ancestor leaves the view (refresh_culling()).
-    // Window: at least slack * d; wider when the node is far from the threshold either way
-    // (half the way to the distance at which its priority would equal the threshold), so nodes
-    // that are clearly fine or clearly too coarse are not recomputed every frame. The key stays
-    // below the threshold if the node was below it (and above if above), so decisions only ever
-    // err on the side of more detail.
-    double window = r;
-    if (threshold > 0.0)
-      window = std::max(window, kWindowFraction * std::abs(d - double(b) * K / threshold));
     v.distance = window;
-    const double dd = d - window;
-    if (dd <= 0.0) return kInf;
-    return static_cast<float>(double(b) * K / dd);
+    return key;
   }
 
   // Largest float not above x: due times round down, so a key is recomputed early, never late.
   static float floor_float(double x) {
     float f = static_cast<float>(x);
-    if (double(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
+    if (double(f) > x) {  // one float step down (the bit pattern's neighbour; no libm call)
+      if (f > 0.0f && std::isfinite(f))
+        f = std::bit_cast<float>(std::bit_cast<std::uint32_t>(f) - 1u);
+      else
+        f = std::nextafter(f, -std::numeric_limits<float>::infinity());
+    }
     return f;
   }
 
@@ -1091,8 +1114,17 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
   m.metric = settings_.metric;
   m.slack = settings_.slack;
   const double threshold = settings_.threshold;
-  m.threshold = settings_.metric == ErrorMetric::kScreenPixels ? threshold : 0.0;
   const std::uint32_t cap = settings_.max_triangles;
+  m.threshold = settings_.metric == ErrorMetric::kScreenPixels ? threshold : 0.0;
+  m.window_below = kWindowBelow;
+  if (cap != 0 && m.capped_level > m.threshold && settings_.metric == ErrorMetric::kScreenPixels) {
+    // The cap, not the threshold, decides: keys matter near the level where the last update
+    // stopped. Size windows around that level (any level gives valid upper-bound keys; this one
+    // makes them tight where splits and merges trade), with the half-way window that keeps the
+    // keys just below it in order.
+    m.threshold = m.capped_level;
+    m.window_below = kWindowAbove;
+  }
   const double budget = settings_.budget_ms;
   auto elapsed_ms = [&] {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -1200,6 +1232,9 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
   triangles_ = m.triangles;
   m.st.triangles = m.triangles;
   m.st.max_remaining_error = m.split.empty() ? 0.0 : std::max(0.0f, m.split.top().key);
+  m.capped_level = m.st.stop == StopReason::kTriangleBudget && std::isfinite(m.st.max_remaining_error)
+                       ? m.st.max_remaining_error
+                       : 0.0;
   m.st.pending_splits = static_cast<std::uint32_t>(m.waiting.size());
   m.st.dirty_patches = static_cast<std::uint32_t>(m.dirty_list.size());
   m.st.memory_bytes = m.nodes.capacity() * sizeof(Node) + m.split.memory_bytes() +
