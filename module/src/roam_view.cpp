@@ -21,6 +21,7 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <glm/geometric.hpp>
 #include <limits>
 #include <queue>
@@ -69,6 +70,40 @@ struct Node {
 
 static_assert(sizeof(Node) == 64, "docs/architecture.md and docs/roam.md quote the node size");
 
+// Node storage in fixed chunks: growing never moves nodes. A contiguous vector doubled by
+// copying the whole pool (10+ MB at 60k triangles) inside one update, with fresh pages to
+// fault in: 5-15 ms spikes under a 0.5-2 ms time budget (`ridge bench lod --budget-ms`).
+class NodePool {
+ public:
+  Node& operator[](std::uint32_t i) noexcept { return chunks_[i >> kShift][i & kMask]; }
+  const Node& operator[](std::uint32_t i) const noexcept {
+    return chunks_[i >> kShift][i & kMask];
+  }
+  std::uint32_t size() const noexcept { return size_; }
+  // Appends `count` default nodes (count divides the chunk size).
+  void grow(std::uint32_t count) {
+    if (((size_ + count - 1) >> kShift) >= chunks_.size())
+      chunks_.push_back(std::make_unique<Node[]>(std::size_t{1} << kShift));
+    for (std::uint32_t k = 0; k < count; ++k) (*this)[size_ + k] = Node{};
+    size_ += count;
+  }
+  // `count` default nodes; keeps the chunks (a rebuild reuses them without faulting pages in).
+  void assign(std::uint32_t count) {
+    size_ = 0;
+    while (size_ < count) grow(std::min<std::uint32_t>(2, count - size_));
+  }
+  std::size_t memory_bytes() const noexcept {
+    return chunks_.size() * (sizeof(Node) << kShift) +
+           chunks_.capacity() * sizeof(std::unique_ptr<Node[]>);
+  }
+
+ private:
+  static constexpr std::uint32_t kShift = 14;  // 16k nodes, 1 MiB per chunk
+  static constexpr std::uint32_t kMask = (1u << kShift) - 1;
+  std::vector<std::unique_ptr<Node[]>> chunks_;
+  std::uint32_t size_ = 0;
+};
+
 struct HeapEntry {
   float key;
   std::uint32_t node;
@@ -79,7 +114,7 @@ struct HeapEntry {
 template <bool kMax>
 class IndexedHeap {
  public:
-  explicit IndexedHeap(std::vector<Node>& nodes) : nodes_(&nodes) {}
+  explicit IndexedHeap(NodePool& nodes) : nodes_(&nodes) {}
   bool empty() const { return a_.empty(); }
   std::size_t size() const { return a_.size(); }
   const HeapEntry& top() const { return a_.front(); }
@@ -152,7 +187,7 @@ class IndexedHeap {
     (*nodes_)[a_[i].node].qslot = static_cast<std::uint32_t>(i);
     (*nodes_)[a_[j].node].qslot = static_cast<std::uint32_t>(j);
   }
-  std::vector<Node>* nodes_;
+  NodePool* nodes_;
   std::vector<HeapEntry> a_;
 };
 
@@ -330,7 +365,7 @@ struct RoamView::Impl {
   explicit Impl(const Landscape& l) : land(l), split(nodes), merge(nodes) {}
 
   const Landscape& land;
-  std::vector<Node> nodes;
+  NodePool nodes;
   std::vector<std::uint32_t> free_pairs;
   IndexedHeap<true> split;
   IndexedHeap<false> merge;
@@ -369,6 +404,17 @@ struct RoamView::Impl {
   DetailCache* cache = land.terrain().detail_cache();
   std::vector<std::uint32_t> waiting;
 
+  // Keys due whose recomputation did not fit in a time budget (see refresh_expired()).
+  struct Due {
+    std::uint32_t node;
+    float key;  // the due time of the record (stale when the node's due time differs)
+    bool angular;
+  };
+  std::deque<Due> backlog;
+  // Round-robin position and scratch of the culling pass (see refresh_culling()).
+  std::uint32_t cull_cursor = 0;
+  std::vector<std::uint32_t> cull_stack;
+
   // Per-update counters and the time budget.
   RoamStats st;
   bool has_deadline = false;
@@ -397,8 +443,8 @@ struct RoamView::Impl {
       free_pairs.pop_back();
       return c;
     }
-    const auto c = static_cast<std::uint32_t>(nodes.size());
-    nodes.resize(nodes.size() + 2);
+    const std::uint32_t c = nodes.size();
+    nodes.grow(2);
     return c;
   }
 
@@ -417,13 +463,14 @@ struct RoamView::Impl {
 
   void reset_to_roots() {
     waiting.clear();
+    backlog.clear();
     split.clear();
     merge.clear();
     by_distance.clear(odometer);
     by_angle.clear(angometer);
     free_pairs.clear();
     const std::uint32_t px = land.patches_x(), pz = land.patches_z();
-    nodes.assign(land.root_count(), Node{});
+    nodes.assign(land.root_count());
     for (std::uint32_t z = 0; z < pz; ++z) {
       for (std::uint32_t x = 0; x < px; ++x) {
         const std::uint32_t p = x + z * px;
@@ -843,6 +890,7 @@ struct RoamView::Impl {
   // keys are recomputed by refresh_expired(), within the time budget: what does not fit waits
   // for the next update, and the mesh keeps its shape meanwhile.
   void mark_all_due() {
+    backlog.clear();
     by_distance.clear(odometer);
     by_angle.clear(angometer);
     auto due = [&](std::uint32_t n) {
@@ -902,9 +950,19 @@ struct RoamView::Impl {
   // nodes wholly in or out of view end the descent, so the cost follows the frustum's border.
   // A node that left the view has every queued key below it made due, so what turned out of
   // view is merged back (keys computed as visible stay conservative but would keep the detail).
-  void refresh_culling(bool rekey = true) {
-    std::vector<std::uint32_t> stack, sub;
-    for (std::uint32_t r = 0; r < land.root_count(); ++r) {
+  // Under a time budget the pass goes round robin over the roots and stops at `until`; the
+  // next update resumes where it stopped. A root not yet re-checked keeps its old flags, which
+  // only delays merging what left the view (more detail for a moment, never less).
+  void refresh_culling(bool rekey = true, bool budgeted = false,
+                       std::chrono::steady_clock::time_point until = {}) {
+    std::vector<std::uint32_t>& stack = cull_stack;
+    std::vector<std::uint32_t> sub;
+    const std::uint32_t roots = land.root_count();
+    if (cull_cursor >= roots) cull_cursor = 0;
+    for (std::uint32_t k = 0; k < roots; ++k) {
+      if (budgeted && (k & 7) == 7 && std::chrono::steady_clock::now() >= until) return;
+      const std::uint32_t r = cull_cursor;
+      cull_cursor = cull_cursor + 1 < roots ? cull_cursor + 1 : 0;
       stack.push_back(r);
       while (!stack.empty()) {
         const std::uint32_t n = stack.back();
@@ -992,21 +1050,32 @@ struct RoamView::Impl {
 
   enum class Refresh { kDone, kRebuild, kOutOfTime };
 
-  // Recomputes expired keys. Stops with kRebuild when more than `rebuild_above` expired (then
-  // rebuilding costs less), with kOutOfTime when the time budget ran out (the rest stays due).
+  // Recomputes expired keys. Stops with kRebuild when more than `rebuild_above` keys are due
+  // (coherence lost: rebuilding costs less), with kOutOfTime when the time budget ran out.
+  // Records due when the budget has run out move to the backlog, which the next update takes
+  // first (oldest first). The wheels are always drained up to the current clocks, so their
+  // cursors never lag behind the camera: a lagging cursor sent every new record to the
+  // overflow heap and later paid for moving them all back at once (frames of 100+ ms under a
+  // 2 ms budget, found with `ridge bench lod --budget-ms 2`).
   Refresh refresh_expired(std::size_t rebuild_above) {
     std::size_t done = 0;
     Refresh why = Refresh::kDone;
-    auto visit = [&](std::uint32_t node, bool angular, double key) {
+    bool out = false;
+    // false: stop (rebuild).
+    auto visit = [&](std::uint32_t node, bool angular, double key, bool from_backlog) {
       ++st.expiry_records;
+      if (out) {
+        // Out of time: set aside without touching the node (a cache miss per record would cost
+        // more than the budget), staleness is checked when it is taken.
+        if (!from_backlog) backlog.push_back({node, float(key), angular});
+        return true;
+      }
       if (angular ? !live_angle(node, key) : !live_distance(node, key)) return true;  // stale
       if (out_of_time()) {
-        // Still due: look at it first next update.
-        Node& nd = nodes[node];
-        nd.due_d = floor_float(odometer);
-        by_distance.push(nd.due_d, node);
+        out = true;
         why = Refresh::kOutOfTime;
-        return false;
+        if (!from_backlog) backlog.push_back({node, float(key), angular});
+        return true;
       }
       ++st.expired;
       // Only the clock that fired is spent; the other record stays valid and is kept when it is
@@ -1019,9 +1088,25 @@ struct RoamView::Impl {
       }
       return true;
     };
-    auto visit_angle = [&](std::uint32_t node, double key) { return visit(node, true, key); };
-    auto visit_distance = [&](std::uint32_t node, double key) { return visit(node, false, key); };
+    // The backlog first (oldest first); once out of time the rest of it stays.
+    while (!backlog.empty() && !out) {
+      const Due b = backlog.front();
+      if (!visit(b.node, b.angular, double(b.key), true)) return why;
+      if (!out) backlog.pop_front();
+    }
+    auto visit_angle = [&](std::uint32_t node, double key) { return visit(node, true, key, false); };
+    auto visit_distance = [&](std::uint32_t node, double key) {
+      return visit(node, false, key, false);
+    };
     if (by_angle.drain(angometer, visit_angle)) by_distance.drain(odometer, visit_distance);
+    // Stale entries pile up in a backlog that never empties (a budget far too small for the
+    // camera): drop them (rare; O(backlog)).
+    if (backlog.size() > 4 * (split.size() + merge.size()) + 65536) {
+      std::deque<Due> keep;
+      for (const Due& b : backlog)
+        if (b.angular ? live_angle(b.node, b.key) : live_distance(b.node, b.key)) keep.push_back(b);
+      backlog.swap(keep);
+    }
     return why;
   }
 };
@@ -1154,14 +1239,19 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
     // are dropped; a projection change makes every key due.
     auto live_d = [&](std::uint32_t n, double key) { return m.live_distance(n, key); };
     auto live_a = [&](std::uint32_t n, double key) { return m.live_angle(n, key); };
-    if (m.by_distance.size() + m.by_angle.size() > 8 * queued + 65536) {
+    const bool behind = m.by_distance.size() + m.by_angle.size() > 8 * queued + 65536;
+    if (behind && !m.has_deadline) {
       m.by_distance.compact(live_d);  // rare: the round-robin sweep below fell behind
       m.by_angle.compact(live_a);
     } else {
-      m.by_distance.compact_some(live_d, 4096);
-      m.by_angle.compact_some(live_a, 4096);
+      // Under a time budget a full compaction (milliseconds) would break it: sweep faster.
+      const std::size_t quota = behind ? 32768 : 4096;
+      m.by_distance.compact_some(live_d, quota);
+      m.by_angle.compact_some(live_a, quota);
     }
-    m.refresh_culling();
+    // Culling gets a small share of a time budget (it resumes where it stopped next update).
+    constexpr double kCullShare = 0.15;
+    m.refresh_culling(true, m.has_deadline, deadline_at(kCullShare));
     const bool everything = all;
     if (everything) {
       m.mark_all_due();
@@ -1202,6 +1292,14 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
       m.merge_diamond(m.merge.top().node);
       continue;
     }
+    // Under a time budget, a merge that is due goes first every other operation: splits alone
+    // would take the whole budget while the camera moves, and the mesh would keep every
+    // triangle it no longer needs (2.7x the unbudgeted count at 1 px, 2 ms on the noise
+    // flyover) at the cost of the draw calls.
+    if (m.has_deadline && g <= threshold && s > threshold && (ops & 1) == 0) {
+      m.merge_diamond(m.merge.top().node);
+      continue;
+    }
     if (s > threshold) {
       const std::uint32_t n = m.split.top().node;
       if (!m.chain_ready(n)) {
@@ -1237,7 +1335,7 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
                        : 0.0;
   m.st.pending_splits = static_cast<std::uint32_t>(m.waiting.size());
   m.st.dirty_patches = static_cast<std::uint32_t>(m.dirty_list.size());
-  m.st.memory_bytes = m.nodes.capacity() * sizeof(Node) + m.split.memory_bytes() +
+  m.st.memory_bytes = m.nodes.memory_bytes() + m.split.memory_bytes() +
                       m.merge.memory_bytes() + m.by_distance.memory_bytes() +
                       m.by_angle.memory_bytes() + m.free_pairs.capacity() * sizeof(std::uint32_t);
   for (const PatchMesh& pm : m.meshes)
