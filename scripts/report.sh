@@ -13,10 +13,14 @@ data=build/report-data
 mkdir -p "$out" "$data"
 ensure_packages "${RIDGELINE_PACKAGES[@]}" "${RIDGELINE_REPORT_PACKAGES[@]}"
 ridge=${RIDGE:-}
-if [ -z "$ridge" ]; then
-  configure_and_build build/release -DCMAKE_BUILD_TYPE=Release > /dev/null
+if [ -z "$ridge" ]; then  # the report needs only `ridge`: build that target, not the whole tree
+  mkdir -p build/release
+  cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release > build/release.configure.log 2>&1 ||
+    { cat build/release.configure.log; exit 1; }
+  cmake --build build/release -j "$(nproc)" --target ridge > /dev/null
   ridge=build/release/module/ridge
 fi
+build_s=$SECONDS
 
 gen=$RIDGELINE_ROOT/../shared/tools/make-noise-field
 [ -f "$data/noise1025.png" ] || python3 "$gen" "$data" > /dev/null
@@ -33,8 +37,14 @@ fi
        "$(awk '/MemTotal/ {printf "%.1f GB", $2 / 1048576}' /proc/meminfo)"
   echo "date: $(date -u +%Y-%m-%dT%H:%MZ), commit $(git rev-parse --short HEAD), binary $ridge"
   echo "load average at start: $(cut -d' ' -f1-3 /proc/loadavg)"
+  echo "uptime at start: $(uptime)"
+  echo "build (ridge only, before the start): ${build_s} s"
 } > "$out/machine.txt"
 "$ridge" report --noise "$data/noise1025.png" --dem "$dem" --out "$out" --work "$data/hard"
-echo "load average at end: $(cut -d' ' -f1-3 /proc/loadavg)" >> "$out/machine.txt"
 python3 docs/benchmarks/report/plots.py "$out"
+{
+  echo "load average at end: $(cut -d' ' -f1-3 /proc/loadavg)"
+  echo "uptime at end: $(uptime)"
+  echo "wall time of scripts/report.sh: ${SECONDS} s (build ${build_s} s, then ridge report and plots)"
+} >> "$out/machine.txt"
 echo "wrote $out/report.json, report.csv, summary.md, plots/*.png"
