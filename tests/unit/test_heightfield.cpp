@@ -158,6 +158,31 @@ TEST(Heightfield, ScaledOverflowIsRefused) {
   EXPECT_NE(hf.error().message.find("overflows"), std::string::npos);
 }
 
+TEST(Heightfield, HeightsBeyondTheLimitAreRefused) {
+  // The limit is on the height relative to the offset, after scaling: 1e5 m passes, more not.
+  auto d = desc(2, 2);
+  d.height_offset = 5e6;
+  d.height_scale = 2;
+  std::vector<float> v{5e4f, -5e4f, 0, 0};
+  ASSERT_TRUE(Heightfield::create(d, v));
+  v[3] = 50000.5f;
+  auto hf = Heightfield::create(d, v);
+  ASSERT_FALSE(hf);
+  EXPECT_NE(hf.error().message.find("sample (1, 1) = 50000.5 gives a height of 100001 m"),
+            std::string::npos)
+      << hf.error().message;
+  // A fill constant beyond it is refused too (only when something is filled).
+  v = {1, 2, std::nanf(""), 4};
+  d.fill = FillPolicy::kConstant;
+  d.fill_constant = 1e6;
+  auto filled = Heightfield::create(d, v);
+  ASSERT_FALSE(filled);
+  EXPECT_NE(filled.error().message.find("fill constant 1e+06 gives a height of 2e+06 m"), std::string::npos)
+      << filled.error().message;
+  v[2] = 3;
+  EXPECT_TRUE(Heightfield::create(d, v));
+}
+
 TEST(DefaultTerrain, IsDeterministicAndDocumented) {
   auto a = make_default_heightfield();
   auto b = make_default_heightfield();
