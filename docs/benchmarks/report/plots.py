@@ -53,11 +53,12 @@ def main():
                             r["triangles"], r["err_rms"], r["ms"], r["err_max"], r["value"]))
                 files[m] = fn
             png = os.path.join(pdir, f"{sc}_{p}.png")
+            ths = ", ".join("%g" % v for v in sorted({r["value"] for r in by[(sc, p, "roam_coherent", "threshold")]}))
             gp = [
                 "set terminal pngcairo size 1500,460 font 'sans,10'",
                 f"set output '{png}'",
                 "set multiplot layout 1,3 title "
-                f"'{sc}, {p}: thresholds 0.5-16 px, comparators at the median triangles of ROAM coherent'",
+                f"'{sc}, {p}: thresholds {ths} px, comparators at the median triangles of ROAM coherent'",
                 "set logscale xy", "set grid", "set key top right",
                 "set xlabel 'triangles (median)'", "set ylabel 'RMS error in view (m)'",
                 "plot " + ", ".join(f"'{files[m]}' using 1:2 with linespoints lw 2 lc rgb '{COLORS[m]}' title '{TITLES[m]}'"
