@@ -50,7 +50,9 @@ double quantile(std::vector<double> v, double q) {
 double vmax(const std::vector<double>& v) {
   return v.empty() ? std::nan("") : *std::max_element(v.begin(), v.end());
 }
-Json num(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+Json num(double v) {
+  return std::isfinite(v) ? Json(v) : Json(nullptr);
+}
 
 // ---- captured loader messages -----------------------------------------------------------
 
@@ -59,7 +61,9 @@ struct Captured {
 };
 void capture_sink(LogLevel level, std::string_view m, void* user) {
   if (level == LogLevel::kDebug) return;
-  const char* tag = level == LogLevel::kInfo ? "note" : level == LogLevel::kWarning ? "warning" : "error";
+  const char* tag = level == LogLevel::kInfo      ? "note"
+                    : level == LogLevel::kWarning ? "warning"
+                                                  : "error";
   static_cast<Captured*>(user)->lines.push_back(std::string(tag) + ": " + std::string(m));
 }
 
@@ -136,8 +140,8 @@ struct ModeResult {
     if (extra.contains("matched_ratio")) matched = csv_number(extra["matched_ratio"].get<double>());
     return prefix + "," + mode + "," + n(quantile(tris, 0.5)) + "," + n(quantile(ms, 0.5)) + "," +
            n(quantile(ms, 0.99)) + "," + n(quantile(changes, 0.5)) + "," + n(vmax(max_m)) + "," +
-           n(quantile(rms_m, 0.5)) + "," + n(vmax(max_px)) + "," + n(quantile(p99_px, 0.5)) +
-           "," + n(vmax(pop)) + "," + (has_morph ? n(vmax(pop_morph)) : std::string()) + "," +
+           n(quantile(rms_m, 0.5)) + "," + n(vmax(max_px)) + "," + n(quantile(p99_px, 0.5)) + "," +
+           n(vmax(pop)) + "," + (has_morph ? n(vmax(pop_morph)) : std::string()) + "," +
            n(quantile(mem, 0.5)) + "," + matched + "\n";
   }
 };
@@ -154,7 +158,9 @@ struct Options {
 
 // True for the frames whose mesh the measurement reads: K-1, K, 2K-1, 2K, ... (errors at frame
 // K, 2K, ...; popping between frames nK-1 and nK).
-bool measured_frame(std::size_t k, int K) { return int(k % K) == K - 1 || (k % K == 0 && k > 0); }
+bool measured_frame(std::size_t k, int K) {
+  return int(k % K) == K - 1 || (k % K == 0 && k > 0);
+}
 
 // Runs one mode along a path: `update(k)` does frame k's work and records its cost; `draw(camera,
 // morph)` returns the mesh as drawn. Errors every K-th frame; popping between frames K-1 and K.
@@ -162,8 +168,7 @@ template <class Update, class Draw>
 void run_mode(const Heightfield& hf, const std::vector<Camera>& frames, const Options& o,
               Update update, Draw draw, ModeResult& r) {
   const auto t_run = Clock::now();
-  DisplayedHeights prev(hf, o.stride), prev_m(hf, o.stride), cur(hf, o.stride),
-      cur_m(hf, o.stride);
+  DisplayedHeights prev(hf, o.stride), prev_m(hf, o.stride), cur(hf, o.stride), cur_m(hf, o.stride);
   const int K = std::max(o.error_every, 2);
   for (std::size_t k = 0; k < frames.size(); ++k) {
     const Camera& c = frames[k];
@@ -206,7 +211,8 @@ struct Scene {
   // error is measured against and what the comparators draw from), and a fresh terrain with a
   // cold tile cache and its landscape for every ROAM run.
   std::shared_ptr<const Heightfield> fine;
-  std::function<Result<std::pair<std::shared_ptr<const Terrain>, std::shared_ptr<const Landscape>>>()>
+  std::function<
+      Result<std::pair<std::shared_ptr<const Terrain>, std::shared_ptr<const Landscape>>>()>
       fresh;
   Json detail = nullptr;
 
@@ -394,8 +400,8 @@ ModeResult run_cdlod(Scene& sc, const NamedPath& path, double target, const Opti
                              std::uint64_t(c.j0) << 2 | std::uint64_t(q));
         std::sort(keys.begin(), keys.end());
         std::vector<std::uint64_t> diff;
-        std::set_symmetric_difference(keys.begin(), keys.end(), prev_keys.begin(),
-                                      prev_keys.end(), std::back_inserter(diff));
+        std::set_symmetric_difference(keys.begin(), keys.end(), prev_keys.begin(), prev_keys.end(),
+                                      std::back_inserter(diff));
         r.changes.push_back(k == 0 ? 0.0 : double(diff.size()));
         std::swap(keys, prev_keys);
       },
@@ -715,7 +721,7 @@ std::vector<float> synthetic(std::uint32_t n, int kind) {
       double h = 60 * std::sin(6.1 * x) * std::cos(4.3 * z) + 25 * std::sin(23 * x + 17 * z) +
                  8 * std::sin(71 * x) * std::sin(53 * z) + 100;
       if (kind == 1) h = (i >= n / 2 ? 1000.0 : 0.0) + 0.05 * h;  // a 1,000 m cliff
-      if (kind == 2) h = 0;                                        // flat
+      if (kind == 2) h = 0;                                       // flat
       v[i + std::size_t(j) * n] = static_cast<float>(h);
     }
   return v;
@@ -846,8 +852,7 @@ Result<std::vector<Scene>> loader_cases(const std::filesystem::path& dir, std::u
     install_log_sink();
     sc.messages = cap.lines;
     if (hf) {
-      sc.messages.push_back("loaded: " + std::to_string(hf->filled_samples()) +
-                            " samples filled");
+      sc.messages.push_back("loaded: " + std::to_string(hf->filled_samples()) + " samples filled");
     }
     if (auto s = finish_scene(sc, std::move(hf)); !s) return s;
     out.push_back(std::move(sc));
@@ -858,7 +863,8 @@ Result<std::vector<Scene>> loader_cases(const std::filesystem::path& dir, std::u
     for (std::size_t k = 0; k < v.size(); ++k) v[k] = (k % n) >= n / 2 ? 65535 : 0;
     const auto f = dir / "saturated_u16.raw";
     if (auto s = write_raw(f, v); !s) return Error{s.message()};
-    if (auto s = load("saturated_u16", f, io::RawType::kU16, 0.01, false); !s) return Error{s.message()};
+    if (auto s = load("saturated_u16", f, io::RawType::kU16, 0.01, false); !s)
+      return Error{s.message()};
   }
   {  // non-finite floats: NaN, +inf and -inf samples
     std::vector<float> v = base;
@@ -877,7 +883,8 @@ Result<std::vector<Scene>> loader_cases(const std::filesystem::path& dir, std::u
     for (std::size_t k = 0; k < v.size(); ++k) v[k] = (k % n) >= n / 2 ? 3e38f : -3e38f;
     const auto f = dir / "huge_f32.raw";
     if (auto s = write_raw(f, v); !s) return Error{s.message()};
-    if (auto s = load("huge_f32", f, io::RawType::kF32, std::nullopt, false); !s) return Error{s.message()};
+    if (auto s = load("huge_f32", f, io::RawType::kF32, std::nullopt, false); !s)
+      return Error{s.message()};
   }
   return out;
 }
@@ -888,8 +895,7 @@ struct ReportArgs {
   bool smoke = false;
   std::string skip;  // comma-separated: detail, storm, hard
   std::string out = "docs/benchmarks/report", noise, dem, dem_spacing = "598,927", dem_nodata,
-              frames,
-              error_every, paths, work;
+              frames, error_every, paths, work;
 };
 
 int run_report(const ReportArgs& a) {
@@ -913,7 +919,8 @@ int run_report(const ReportArgs& a) {
     o.error_every = int(*k);
   }
   if (o.frames <= o.error_every)
-    return report_error("--frames must exceed --error-every (errors are measured every K-th frame)");
+    return report_error(
+        "--frames must exceed --error-every (errors are measured every K-th frame)");
   if (!a.paths.empty()) {
     std::stringstream ss(a.paths);
     for (std::string p; std::getline(ss, p, ',');) {
@@ -976,10 +983,10 @@ int run_report(const ReportArgs& a) {
       lo.placement.spacing_x = (*sp)[0];
       lo.placement.spacing_z = (*sp)[1];
       lo.placement.fill = FillPolicy::kNearest;
-      sc.loader = {{"spacing", *sp},
-                   {"nodata", a.dem_nodata.empty() ? "from the file's GDAL_NODATA tag"
-                                                    : a.dem_nodata},
-                   {"fill", "nearest"}};
+      sc.loader = {
+          {"spacing", *sp},
+          {"nodata", a.dem_nodata.empty() ? "from the file's GDAL_NODATA tag" : a.dem_nodata},
+          {"fill", "nearest"}};
       Captured cap;
       set_log_sink(capture_sink, &cap);
       // As a user would load it: first plain (the loader takes the no-data value from the
@@ -1045,17 +1052,17 @@ int run_report(const ReportArgs& a) {
   const std::uint32_t hn = a.smoke ? 65 : 257;
   std::vector<Scene> hard;
   if (!skips("hard")) {
-  hard.push_back(synthetic_scene("origin_0", hn, 0, 0.0, 4.0));
-  hard.push_back(synthetic_scene("origin_1e6", hn, 0, 1e6, 4.0));
-  hard.push_back(synthetic_scene("origin_1e7", hn, 0, 1e7, 4.0));
-  hard.push_back(synthetic_scene("cliff_1000m", hn, 1, 0.0, 4.0));
-  hard.push_back(synthetic_scene("flat", hn, 2, 0.0, 4.0));
-  const std::filesystem::path work =
-      a.work.empty() ? std::filesystem::temp_directory_path() / "ridge_report"
-                     : std::filesystem::path(a.work);
-  auto lc = loader_cases(work, hn);
-  if (!lc) return report_error(lc.error().message);
-  for (auto& s : *lc) hard.push_back(std::move(s));
+    hard.push_back(synthetic_scene("origin_0", hn, 0, 0.0, 4.0));
+    hard.push_back(synthetic_scene("origin_1e6", hn, 0, 1e6, 4.0));
+    hard.push_back(synthetic_scene("origin_1e7", hn, 0, 1e7, 4.0));
+    hard.push_back(synthetic_scene("cliff_1000m", hn, 1, 0.0, 4.0));
+    hard.push_back(synthetic_scene("flat", hn, 2, 0.0, 4.0));
+    const std::filesystem::path work = a.work.empty()
+                                           ? std::filesystem::temp_directory_path() / "ridge_report"
+                                           : std::filesystem::path(a.work);
+    auto lc = loader_cases(work, hn);
+    if (!lc) return report_error(lc.error().message);
+    for (auto& s : *lc) hard.push_back(std::move(s));
   }
   Json out_hard = Json::array();
   for (Scene& sc : hard) {
@@ -1079,21 +1086,21 @@ int run_report(const ReportArgs& a) {
     out_hard.push_back(*j);
   }
 
-  Json root = {
-      {"report", "ridge report"},
-      {"smoke", a.smoke},
-      {"machine", {{"hardware_threads", std::thread::hardware_concurrency()}}},
-      {"frames_per_path", o.frames},
-      {"error_every", o.error_every},
-      {"error_stride", o.stride},
-      {"match_tolerance", kMatchTolerance},
-      {"settings", {{"thresholds_px", o.thresholds},
-                    {"triangle_caps", o.triangle_caps},
-                    {"time_budgets_ms", o.time_budgets},
-                    {"time_budget_threshold_px", 1.0}}},
-      {"scenes", out_scenes},
-      {"hard_cases", out_hard},
-      {"wall_s", ms_since(t0) / 1000}};
+  Json root = {{"report", "ridge report"},
+               {"smoke", a.smoke},
+               {"machine", {{"hardware_threads", std::thread::hardware_concurrency()}}},
+               {"frames_per_path", o.frames},
+               {"error_every", o.error_every},
+               {"error_stride", o.stride},
+               {"match_tolerance", kMatchTolerance},
+               {"settings",
+                {{"thresholds_px", o.thresholds},
+                 {"triangle_caps", o.triangle_caps},
+                 {"time_budgets_ms", o.time_budgets},
+                 {"time_budget_threshold_px", 1.0}}},
+               {"scenes", out_scenes},
+               {"hard_cases", out_hard},
+               {"wall_s", ms_since(t0) / 1000}};
   std::error_code ec;
   std::filesystem::create_directories(a.out, ec);
   if (auto s = write_json(root, (std::filesystem::path(a.out) / "report.json").string()); !s)
@@ -1135,8 +1142,7 @@ Command add_report_command(CLI::App& parent) {
                   "The DEM's no-data value (default: the file's GDAL_NODATA tag, -32768 in "
                   "elev.tif, which the image loader reads)")
       ->type_name("V");
-  app->add_option("--frames", a->frames, "Frames per path (default 60; smoke 12)")
-      ->type_name("N");
+  app->add_option("--frames", a->frames, "Frames per path (default 60; smoke 12)")->type_name("N");
   app->add_option("--error-every", a->error_every,
                   "Measure error and popping every K-th frame (default 6; smoke 3)")
       ->type_name("K");

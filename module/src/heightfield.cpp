@@ -90,10 +90,11 @@ Result<Heightfield> Heightfield::create(const HeightfieldDesc& d, std::span<cons
   if (first_bad != count) {
     if (d.fill == FillPolicy::kRefuse) {
       const float v = values[first_bad];
-      return Error{fmt("%s: sample (%zu, %zu) is %s%s; refuse (choose a fill policy to replace "
-                       "missing samples)",
-                       d.name.c_str(), first_bad % d.width, first_bad / d.width, num(v).c_str(),
-                       std::isfinite(v) ? " (the no-data value)" : "")};
+      return Error{
+          fmt("%s: sample (%zu, %zu) is %s%s; refuse (choose a fill policy to replace "
+              "missing samples)",
+              d.name.c_str(), first_bad % d.width, first_bad / d.width, num(v).c_str(),
+              std::isfinite(v) ? " (the no-data value)" : "")};
     }
   }
 
@@ -101,11 +102,11 @@ Result<Heightfield> Heightfield::create(const HeightfieldDesc& d, std::span<cons
   const float fill_scaled = static_cast<float>(d.height_scale * d.fill_constant);
   if (!missing.empty() && d.fill == FillPolicy::kConstant &&
       !(std::abs(double(fill_scaled)) <= kMaxRelativeHeight))
-    return Error{fmt("%s: fill constant %s gives a height of %s m relative to the offset, beyond "
-                     "the +-%.0f m limit",
-                     d.name.c_str(), num(d.fill_constant).c_str(),
-                     num(d.height_scale * d.fill_constant).c_str(),
-                     kMaxRelativeHeight)};
+    return Error{
+        fmt("%s: fill constant %s gives a height of %s m relative to the offset, beyond "
+            "the +-%.0f m limit",
+            d.name.c_str(), num(d.fill_constant).c_str(),
+            num(d.height_scale * d.fill_constant).c_str(), kMaxRelativeHeight)};
   for (std::size_t k = 0; k < count; ++k) {
     if (!missing.empty() && missing[k]) {
       hf.heights_[k] = fill_scaled;
@@ -117,11 +118,12 @@ Result<Heightfield> Heightfield::create(const HeightfieldDesc& d, std::span<cons
                        d.name.c_str(), k % d.width, k / d.width, num(values[k]).c_str(),
                        num(d.height_scale).c_str())};
     if (std::abs(h) > kMaxRelativeHeight)
-      return Error{fmt("%s: sample (%zu, %zu) = %s gives a height of %s m relative to the offset, "
-                       "beyond the +-%.0f m limit (if it marks missing data, give it as the "
-                       "no-data value with a fill policy)",
-                       d.name.c_str(), k % d.width, k / d.width, detail::numf(values[k]).c_str(),
-                       num(h).c_str(), kMaxRelativeHeight)};
+      return Error{
+          fmt("%s: sample (%zu, %zu) = %s gives a height of %s m relative to the offset, "
+              "beyond the +-%.0f m limit (if it marks missing data, give it as the "
+              "no-data value with a fill policy)",
+              d.name.c_str(), k % d.width, k / d.width, detail::numf(values[k]).c_str(),
+              num(h).c_str(), kMaxRelativeHeight)};
     hf.heights_[k] = static_cast<float>(h);
   }
   if (!missing.empty()) {

@@ -577,11 +577,16 @@ std::vector<char> int16_tiff(int w, int h, const std::vector<std::int16_t>& v,
   const std::uint32_t text_len = static_cast<std::uint32_t>(nodata.size()) + 1;
   const std::uint32_t pixels_at = (text_at + (nodata.empty() ? 0 : text_len) + 1) & ~1u;
   const std::uint32_t bytes = static_cast<std::uint32_t>(v.size() * 2);
-  std::vector<Entry> e = {{256, 3, 1, std::uint32_t(w)}, {257, 3, 1, std::uint32_t(h)},
-                          {258, 3, 1, 16},    {259, 3, 1, 1},
-                          {262, 3, 1, 1},     {273, 4, 1, pixels_at},
-                          {277, 3, 1, 1},     {278, 3, 1, std::uint32_t(h)},
-                          {279, 4, 1, bytes}, {339, 3, 1, 2}};
+  std::vector<Entry> e = {{256, 3, 1, std::uint32_t(w)},
+                          {257, 3, 1, std::uint32_t(h)},
+                          {258, 3, 1, 16},
+                          {259, 3, 1, 1},
+                          {262, 3, 1, 1},
+                          {273, 4, 1, pixels_at},
+                          {277, 3, 1, 1},
+                          {278, 3, 1, std::uint32_t(h)},
+                          {279, 4, 1, bytes},
+                          {339, 3, 1, 2}};
   if (!nodata.empty()) e.push_back({42113, 2, text_len, tag_offset ? tag_offset : text_at});
   std::vector<char> b;
   auto u16 = [&](std::uint32_t x) {

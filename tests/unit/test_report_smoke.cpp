@@ -20,7 +20,9 @@ std::string slurp(const std::string& p) {
   return s.str();
 }
 
-bool finite_number(const json& j) { return j.is_number() && std::isfinite(j.get<double>()); }
+bool finite_number(const json& j) {
+  return j.is_number() && std::isfinite(j.get<double>());
+}
 
 TEST(ReportSmoke, JsonAndCsvAreCompleteAndSane) {
   const std::string out = std::string(RIDGELINE_TEST_TMP) + "/report_smoke";
@@ -49,17 +51,16 @@ TEST(ReportSmoke, JsonAndCsvAreCompleteAndSane) {
           ASSERT_TRUE(m.count(name));
           const json& x = m[name];
           ++rows;
-          for (const char* f : {"triangles_median", "update_ms_median", "update_ms_p99",
-                                "changes_per_frame_median", "error_max_m", "error_rms_m",
-                                "screen_error_max_px", "screen_error_p99_px", "popping_max_px",
-                                "memory_bytes"})
+          for (const char* f :
+               {"triangles_median", "update_ms_median", "update_ms_p99", "changes_per_frame_median",
+                "error_max_m", "error_rms_m", "screen_error_max_px", "screen_error_p99_px",
+                "popping_max_px", "memory_bytes"})
             EXPECT_TRUE(finite_number(x[f])) << f << " = " << x[f];
           EXPECT_GT(x["measured_frames"].get<int>(), 0);
           EXPECT_GT(x["measured_vertices_median"].get<double>(), 0);
           EXPECT_EQ(x["uncovered_vertices"].get<int>(), 0) << "holes in the drawn mesh";
           EXPECT_GE(x["error_max_m"].get<double>(), x["error_rms_m"].get<double>());
-          EXPECT_GE(x["screen_error_max_px"].get<double>(),
-                    x["screen_error_p99_px"].get<double>());
+          EXPECT_GE(x["screen_error_max_px"].get<double>(), x["screen_error_p99_px"].get<double>());
           EXPECT_GE(x["update_ms_p99"].get<double>(), x["update_ms_median"].get<double>());
           EXPECT_GT(x["memory_bytes"].get<double>(), 0);
         }
@@ -118,9 +119,9 @@ TEST(ReportSmoke, JsonAndCsvAreCompleteAndSane) {
   // Hard cases: all present; the far origins give the same mesh and errors as origin 0.
   std::map<std::string, json> hard;
   for (const json& h : r["hard_cases"]) hard[h["name"]] = h;
-  for (const char* n : {"origin_0", "origin_1e6", "origin_1e7", "cliff_1000m", "flat",
-                        "saturated_u16", "nonfinite_f32_refuse", "nonfinite_f32_fill_nearest",
-                        "huge_f32"})
+  for (const char* n :
+       {"origin_0", "origin_1e6", "origin_1e7", "cliff_1000m", "flat", "saturated_u16",
+        "nonfinite_f32_refuse", "nonfinite_f32_fill_nearest", "huge_f32"})
     ASSERT_TRUE(hard.count(n)) << n;
   for (const char* n : {"origin_0", "origin_1e6", "origin_1e7", "cliff_1000m", "flat",
                         "saturated_u16", "nonfinite_f32_fill_nearest"})

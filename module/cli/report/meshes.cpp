@@ -3,12 +3,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <glm/geometric.hpp>
 #include <limits>
 #include <map>
 #include <sstream>
 #include <tuple>
-
-#include <glm/geometric.hpp>
 
 namespace ridgeline::report {
 
@@ -16,7 +15,9 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kMorphStartRatio = 0.66;  // Strugar's default
 
-double sq(double x) { return x * x; }
+double sq(double x) {
+  return x * x;
+}
 
 // Appends the two triangles of every quad of a row-major (nx + 1) x (nz + 1) vertex grid, split
 // along (0,0)-(1,1).
@@ -81,11 +82,8 @@ bool ViewFrustum::contains(const glm::dvec3& p, double* distance) const {
 bool ViewFrustum::may_intersect(const glm::dvec3& lo, const glm::dvec3& hi) const {
   // Planes through the eye with inward normals; the box is out when its most inward corner is
   // outside any of them. Far: the box's nearest point beyond far_m.
-  const glm::dvec3 normals[5] = {forward,
-                                 tan_h * forward + right,
-                                 tan_h * forward - right,
-                                 tan_v * forward + up,
-                                 tan_v * forward - up};
+  const glm::dvec3 normals[5] = {forward, tan_h * forward + right, tan_h * forward - right,
+                                 tan_v * forward + up, tan_v * forward - up};
   for (const glm::dvec3& n : normals) {
     const glm::dvec3 p(n.x >= 0 ? hi.x : lo.x, n.y >= 0 ? hi.y : lo.y, n.z >= 0 ? hi.z : lo.z);
     if (glm::dot(p - eye, n) < 0) return false;
@@ -145,8 +143,7 @@ MeshError measure(const Heightfield& hf, const DisplayedHeights& shown, const Ca
     for (std::uint32_t k = 0; k < shown.columns(); ++k) {
       const std::uint32_t i = k * s, j = l * s;
       const double y = hf.world(i, j);
-      const glm::dvec3 p(hf.origin_x() + i * hf.spacing_x(), y,
-                         hf.origin_z() + j * hf.spacing_z());
+      const glm::dvec3 p(hf.origin_x() + i * hf.spacing_x(), y, hf.origin_z() + j * hf.spacing_z());
       double d = 0;
       if (!f.contains(p, &d)) continue;
       ++out.vertices;
@@ -171,8 +168,8 @@ MeshError measure(const Heightfield& hf, const DisplayedHeights& shown, const Ca
   return out;
 }
 
-double popping_px(const Heightfield& hf, const DisplayedHeights& before, const Camera& before_camera,
-                  const DisplayedHeights& now, const Camera& camera) {
+double popping_px(const Heightfield& hf, const DisplayedHeights& before,
+                  const Camera& before_camera, const DisplayedHeights& now, const Camera& camera) {
   const ViewFrustum f(camera), fb(before_camera);
   double worst = 0;
   const std::uint32_t s = now.stride();
@@ -248,7 +245,8 @@ UniformGrid UniformGrid::for_triangles(const Heightfield& hf, double triangles) 
   double best_err = std::numeric_limits<double>::infinity();
   for (double cx : {std::floor(fx), std::ceil(fx)}) {
     const double nx = std::max(1.0, cx);
-    for (double nz : {std::max(1.0, std::floor(quads / nx)), std::max(1.0, std::ceil(quads / nx))}) {
+    for (double nz :
+         {std::max(1.0, std::floor(quads / nx)), std::max(1.0, std::ceil(quads / nx))}) {
       const double err = std::abs(2.0 * nx * nz - triangles);
       if (err < best_err) {
         best_err = err;
@@ -348,7 +346,8 @@ void Cdlod::refresh(std::int64_t i0, std::int64_t j0, std::int64_t i1, std::int6
     const std::int64_t size = std::int64_t(grid_) << L;
     const std::int64_t rows = std::int64_t(nodes_[L].size()) / per_row_[L];
     // Closed footprints: a sample on a node border belongs to both nodes.
-    for (std::int64_t b = std::max<std::int64_t>(0, (j0 - 1) / size); b <= std::min(rows - 1, j1 / size); ++b)
+    for (std::int64_t b = std::max<std::int64_t>(0, (j0 - 1) / size);
+         b <= std::min(rows - 1, j1 / size); ++b)
       for (std::int64_t a = std::max<std::int64_t>(0, (i0 - 1) / size);
            a <= std::min(per_row_[L] - 1, i1 / size); ++a)
         nodes_[L][std::size_t(a + b * per_row_[L])] = compute(L, a, b);
@@ -363,7 +362,8 @@ void Cdlod::compute_min_r0() {
   for (std::uint32_t L = 0; L + 2 < levels_; ++L) {
     const std::int64_t size = std::int64_t(grid_) << (L + 1);
     for (std::size_t n = 0; n < nodes_[L + 1].size(); ++n) {
-      const std::int64_t a = std::int64_t(n) % per_row_[L + 1], b = std::int64_t(n) / per_row_[L + 1];
+      const std::int64_t a = std::int64_t(n) % per_row_[L + 1],
+                         b = std::int64_t(n) / per_row_[L + 1];
       glm::dvec3 lo, hi;
       box(L + 1, a * size, b * size, &lo, &hi);
       const double diag = glm::length(hi - lo);

@@ -76,8 +76,8 @@ MeshError measure(const Heightfield& hf, const DisplayedHeights& shown, const Ca
 /// displayed meshes (the previous and the current frame), projected in pixels at the vertex's
 /// distance in `camera` (the current frame), over the vertices inside both frames' frustums
 /// (a vertex that was out of view cannot visibly pop when it comes into view).
-double popping_px(const Heightfield& hf, const DisplayedHeights& before, const Camera& before_camera,
-                  const DisplayedHeights& now, const Camera& camera);
+double popping_px(const Heightfield& hf, const DisplayedHeights& before,
+                  const Camera& before_camera, const DisplayedHeights& now, const Camera& camera);
 
 /// The ROAM view's mesh as drawn: its patch meshes, geomorphed for `camera` when `morph` (the
 /// vertex shader's job: y + (1 - t) * morph_dy, t = morph_factor(...)).
@@ -136,7 +136,7 @@ class Cdlod {
 
   struct Chunk {
     std::uint32_t level;
-    std::int64_t i0, j0;    ///< lattice cell of the node's lower corner
+    std::int64_t i0, j0;     ///< lattice cell of the node's lower corner
     std::uint8_t quadrants;  ///< bit q (q = qx + 2 qz) set: that quadrant is drawn
   };
   struct Selection {
