@@ -1,8 +1,16 @@
 // The embedding Host: limits end the offending call with an error and a traceback, and the host
 // keeps running; callbacks; attaching to an engine's state; symbolic links out of the folder.
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <lua.hpp>
 #include <string>
 
@@ -281,6 +289,105 @@ TEST(LuaHost, SymlinkOutOfTheGrantedFolderIsRefused) {
     assert(t == nil and err:find("file access is not granted", 1, true), err))",
                                 "none");
   EXPECT_TRUE(c.ok()) << c.message();
+}
+
+std::string read_bytes(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// A full disk under terrain:save_edits and ridgeline.save_edits (issue 9): a forked child whose
+// files may not grow past `limit` bytes (RLIMIT_FSIZE, SIGXFSZ ignored: write() fails with EFBIG)
+// runs the saving script; the script must get nil and a message naming the cause, the host must
+// keep running, and the previous save must stay as it was (tests/unit/test_faults.cpp does the
+// same for the C++ call at more limits).
+TEST(LuaHost, DiskFullDuringSaveIsAnErrorForTheScript) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(RIDGELINE_TEST_TMP) / "lua_full";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  fs::copy_file(fs::path(RIDGELINE_TEST_DATA) / "ramp16.png", dir / "ramp16.png");
+  HostOptions o;
+  o.data_root = dir.string();
+  o.time_limit_seconds = 0;
+  {
+    auto host = Host::create(o);
+    ASSERT_TRUE(host.ok());
+    const auto s = (*host)->run(R"lua(
+      local t = assert(ridgeline.load{heightmap = "ramp16.png"})
+      assert(t:deform{brush = "raise", x = 1, z = 1, radius = 2, depth = 1})
+      assert(t:save_edits("state.bin"))
+      assert(t:deform{brush = "lower", x = 3, z = 2, radius = 3, depth = 2})
+      assert(t:save_edits("new.bin")))lua",
+                                "previous");
+    ASSERT_TRUE(s.ok()) << s.message();
+  }
+  const std::string previous = read_bytes(dir / "state.bin");
+  const std::size_t new_size = fs::file_size(dir / "new.bin");
+  ASSERT_GT(new_size, std::size_t{16});
+  const std::string efbig = std::strerror(EFBIG);
+  for (const std::size_t limit : {std::size_t{0}, std::size_t{5}, new_size / 2, new_size - 1}) {
+    SCOPED_TRACE("file size limit " + std::to_string(limit));
+    int fds[2];
+    ASSERT_EQ(pipe(fds), 0);
+    const pid_t child = fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      close(fds[0]);
+      signal(SIGXFSZ, SIG_IGN);
+      rlimit r{};
+      getrlimit(RLIMIT_FSIZE, &r);
+      r.rlim_cur = limit;
+      std::string msg = "setrlimit failed";
+      if (setrlimit(RLIMIT_FSIZE, &r) == 0) {
+        auto host = Host::create(o);
+        ridgeline::Status s = host.ok() ? (*host)->run(R"lua(
+          local t = assert(ridgeline.load{heightmap = "ramp16.png"})
+          assert(t:deform{brush = "raise", x = 1, z = 1, radius = 2, depth = 1})
+          assert(t:deform{brush = "lower", x = 3, z = 2, radius = 3, depth = 2})
+          local ok, err = t:save_edits("state.bin")
+          assert(ok == nil and type(err) == "string", "save_edits did not fail")
+          local ok2, err2 = ridgeline.save_edits(t, "state.bin")
+          assert(ok2 == nil and err2 == err, tostring(err2))
+          error(err, 0))lua",
+                                                       "full")
+                                        : ridgeline::Status(host.error());
+        msg = s.message();
+        if (host.ok()) {  // the host keeps running after the failed saves
+          const ridgeline::Status alive = (*host)->run(
+              "local t = assert(ridgeline.load{heightmap = 'ramp16.png'}) assert(t:height(1, 1))",
+              "alive");
+          if (!alive) msg += "\nhost not usable: " + alive.message();
+        }
+      }
+      (void)!write(fds[1], msg.data(), msg.size());
+      _exit(0);  // no atexit handlers (gtest, leak checker) in the child
+    }
+    close(fds[1]);
+    std::string msg;
+    char buf[512];
+    for (ssize_t n; (n = read(fds[0], buf, sizeof buf)) > 0;) msg.append(buf, std::size_t(n));
+    close(fds[0]);
+    int status = 0;
+    waitpid(child, &status, 0);
+    ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "child died: " << msg;
+    EXPECT_EQ(msg.rfind("save edits '", 0), 0u) << msg;  // the script's error: the save's message
+    EXPECT_NE(msg.find("state.bin"), std::string::npos) << msg;
+    EXPECT_NE(msg.find(efbig), std::string::npos) << msg;
+    EXPECT_EQ(msg.find("host not usable"), std::string::npos) << msg;
+    EXPECT_EQ(read_bytes(dir / "state.bin"), previous);
+    for (const auto& e : fs::directory_iterator(dir))
+      EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos)
+          << "temporary file left: " << e.path();
+  }
+  // The previous save still loads in a fresh host.
+  auto host = Host::create(o);
+  ASSERT_TRUE(host.ok());
+  const auto s = (*host)->run(R"lua(
+    local t = assert(ridgeline.load{heightmap = "ramp16.png"})
+    assert(t:load_edits("state.bin")))lua",
+                              "reload");
+  EXPECT_TRUE(s.ok()) << s.message();
 }
 
 }  // namespace
