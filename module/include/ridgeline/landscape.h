@@ -79,7 +79,7 @@ class Landscape {
     static constexpr int kUx[8] = {1, 1, 0, -1, -1, -1, 0, 1};
     static constexpr int kUz[8] = {0, 1, 1, 1, 0, -1, -1, -1};
     const int level = 63 - __builtin_clzll(heap);
-    const int dir = ((root & 1) ? 7 : 3) + 3 * level + 2 * (__builtin_popcountll(heap) - 1);
+    const int dir = ((root & 1) ? 7 : 3) + 3 * level + 2 * (popcount64(heap) - 1);
     const int k = dir & 7;
     const std::int64_t s2 = patch_cells() >> (level / 2);  // twice the apex-midpoint distance
     const std::int64_t ux = kUx[k], uz = kUz[k], px = -uz, pz = ux;  // p: u turned +90 degrees
@@ -89,6 +89,14 @@ class Landscape {
             az + (uz + pz) * s2 / 2,
             ax + (ux - px) * s2 / 2,
             az + (uz - pz) * s2 / 2};
+  }
+  /// Bits set in x, inline (without -mpopcnt the builtin is a libgcc call; triangle_at runs
+  /// for every priority).
+  static constexpr int popcount64(std::uint64_t x) noexcept {
+    x -= (x >> 1) & 0x5555555555555555ull;
+    x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
+    x = (x + (x >> 4)) & 0x0f0f0f0f0f0f0f0full;
+    return int((x * 0x0101010101010101ull) >> 56);
   }
   /// Geometry of a child given its parent's (child 0 or 1).
   static LatticeTriangle child_triangle(const LatticeTriangle& parent, int child) noexcept;
