@@ -3,7 +3,6 @@
 // saving the edit layer, the disk filling up during a save.
 #include <gtest/gtest.h>
 #include <signal.h>
-#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -20,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "file_limit_child.h"
 #include "ridgeline/detail.h"
 #include "ridgeline/edit.h"
 #include "ridgeline/heightfield.h"
@@ -47,6 +47,26 @@ std::shared_ptr<const DetailField> make_field(std::uint32_t levels) {
   auto f = DetailField::create(make_terrain(), p);
   EXPECT_TRUE(f.ok()) << (f.ok() ? "" : f.error().message);
   return std::move(f).value();
+}
+
+// An empty folder for one test under the build's test tmp folder.
+fs::path fresh_dir(const char* name) {
+  const fs::path dir = fs::path(RIDGELINE_TEST_TMP) / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+// `count` edits of all five brushes at random places of the square [0, extent] m (a large edit
+// layer).
+void apply_random_edits(Terrain& t, int count, std::mt19937& rng, double extent, double radius) {
+  std::uniform_real_distribution<double> u(0, extent);
+  for (int k = 0; k < count; ++k) {
+    Edit e;
+    e.brush = static_cast<Brush>(k % 5);
+    e.x = u(rng), e.z = u(rng), e.radius = radius, e.depth = 5, e.height = 50;
+    ASSERT_TRUE(t.apply_edit(e).ok());
+  }
 }
 
 std::string read_bytes(const fs::path& p) {
@@ -168,9 +188,7 @@ TEST(Faults, HeightmapFileChangingWhileLoadedDoesNotTouchTheTerrain) {
 }
 
 TEST(Faults, KilledMidSaveLeavesThePreviousFileIntact) {
-  const fs::path dir = fs::path(RIDGELINE_TEST_TMP) / "faults_save";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = fresh_dir("faults_save");
   // Two edit states of a 513 x 513 terrain; B is much larger (many edits) so saving it takes a
   // while and the kill lands inside the write.
   auto a = make_terrain(513), b = make_terrain(513);
@@ -181,12 +199,7 @@ TEST(Faults, KilledMidSaveLeavesThePreviousFileIntact) {
     e.x = u(rng), e.z = u(rng), e.radius = 40;
     ASSERT_TRUE(a->apply_edit(e).ok());
   }
-  for (int k = 0; k < 400; ++k) {
-    Edit e;
-    e.brush = static_cast<Brush>(k % 5);
-    e.x = u(rng), e.z = u(rng), e.radius = 90, e.depth = 5, e.height = 50;
-    ASSERT_TRUE(b->apply_edit(e).ok());
-  }
+  apply_random_edits(*b, 400, rng, 2048, 90);
   const fs::path pa = dir / "a.bin", pb = dir / "b.bin", target = dir / "state.bin";
   ASSERT_TRUE(save_edits(*a, pa.string()).ok());
   ASSERT_TRUE(save_edits(*b, pb.string()).ok());
@@ -232,53 +245,11 @@ std::vector<std::string> files_starting_with(const fs::path& dir, const std::str
   return out;
 }
 
-// Runs `body` in a forked child whose files may not grow past `limit` bytes (RLIMIT_FSIZE, with
-// SIGXFSZ ignored, so write() fails with EFBIG as on a full disk); the child sends back the
-// message `body` returns ("ok" for success). Without root and without touching any file system.
-std::string in_child_with_file_limit(rlim_t limit, const std::function<std::string()>& body) {
-  int fds[2];
-  if (pipe(fds) != 0) return "pipe failed";
-  const pid_t child = fork();
-  if (child < 0) return "fork failed";
-  if (child == 0) {
-    close(fds[0]);
-    signal(SIGXFSZ, SIG_IGN);
-    rlimit r{};
-    getrlimit(RLIMIT_FSIZE, &r);
-    r.rlim_cur = limit;
-    std::string msg = setrlimit(RLIMIT_FSIZE, &r) == 0 ? body() : "setrlimit failed";
-    for (std::size_t done = 0; done < msg.size();) {
-      const ssize_t n = write(fds[1], msg.data() + done, msg.size() - done);
-      if (n <= 0) break;
-      done += std::size_t(n);
-    }
-    _exit(0);  // no atexit handlers (gtest, leak checker) in the child
-  }
-  close(fds[1]);
-  std::string msg;
-  char buf[512];
-  for (ssize_t n; (n = read(fds[0], buf, sizeof buf)) > 0;) msg.append(buf, std::size_t(n));
-  close(fds[0]);
-  int status = 0;
-  waitpid(child, &status, 0);
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
-    return "child died (status " + std::to_string(status) + "): " + msg;
-  return msg;
-}
-
 TEST(Faults, DiskFullDuringSaveKeepsThePreviousFileAndCleansUp) {
-  const fs::path dir = fs::path(RIDGELINE_TEST_TMP) / "faults_full";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = fresh_dir("faults_full");
   auto a = make_terrain(257), b = make_terrain(257);
   std::mt19937 rng(11);
-  std::uniform_real_distribution<double> u(0, 1024);
-  for (int k = 0; k < 60; ++k) {
-    Edit e;
-    e.brush = static_cast<Brush>(k % 5);
-    e.x = u(rng), e.z = u(rng), e.radius = 60, e.depth = 5, e.height = 50;
-    ASSERT_TRUE(b->apply_edit(e).ok());
-  }
+  apply_random_edits(*b, 60, rng, 1024, 60);
   Edit one;
   one.x = 500, one.z = 500, one.radius = 30;
   ASSERT_TRUE(a->apply_edit(one).ok());
@@ -297,7 +268,7 @@ TEST(Faults, DiskFullDuringSaveKeepsThePreviousFileAndCleansUp) {
                                   std::size_t{4096}, new_size / 2, new_size - 1}) {
     SCOPED_TRACE("file size limit " + std::to_string(limit));
     fs::copy_file(previous, target, fs::copy_options::overwrite_existing);
-    const std::string msg = in_child_with_file_limit(limit, [&] {
+    const std::string msg = test::in_child_with_file_limit(limit, [&] {
       const Status s = save_edits(*b, target.string());
       return s ? std::string("ok") : s.message();
     });
@@ -315,7 +286,7 @@ TEST(Faults, DiskFullDuringSaveKeepsThePreviousFileAndCleansUp) {
   // The same limit set to exactly the file's size lets the save through: the failures above
   // came from the limit, not from the child.
   fs::copy_file(previous, target, fs::copy_options::overwrite_existing);
-  const std::string ok = in_child_with_file_limit(new_size, [&] {
+  const std::string ok = test::in_child_with_file_limit(new_size, [&] {
     const Status s = save_edits(*b, target.string());
     return s ? std::string("ok") : s.message();
   });
@@ -328,9 +299,7 @@ TEST(Faults, NoSpaceLeftOnDeviceDuringSaveIsReported) {
   // A real ENOSPC from the kernel: the save's temporary file (NAME.tmp.PID, created without
   // O_EXCL) is made a link to /dev/full, whose every write fails with ENOSPC.
   if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
-  const fs::path dir = fs::path(RIDGELINE_TEST_TMP) / "faults_enospc";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = fresh_dir("faults_enospc");
   auto a = make_terrain(129), b = make_terrain(129);
   Edit e;
   e.x = 200, e.z = 200, e.radius = 40;
@@ -355,8 +324,7 @@ TEST(Faults, NoSpaceLeftOnDeviceDuringSaveIsReported) {
 
 TEST(Faults, RenameFailingDuringSaveCleansUp) {
   // The target is a folder that is not empty: rename() fails after the data was written.
-  const fs::path dir = fs::path(RIDGELINE_TEST_TMP) / "faults_rename";
-  fs::remove_all(dir);
+  const fs::path dir = fresh_dir("faults_rename");
   fs::create_directories(dir / "state.bin");
   std::ofstream(dir / "state.bin" / "keep") << "kept";
   auto t = make_terrain(129);
