@@ -147,6 +147,10 @@ class IndexedHeap {
     if (!up(i)) down(i);
   }
   const std::vector<HeapEntry>& entries() const { return a_; }
+  // Multiplies every key by r > 0: the order is kept, so no entry moves.
+  void scale_keys(float r) {
+    for (auto& e : a_) e.key *= r;
+  }
   float key_of(std::uint32_t node) const { return a_[(*nodes_)[node].qslot].key; }
   std::size_t memory_bytes() const { return a_.capacity() * sizeof(HeapEntry); }
 
@@ -378,6 +382,7 @@ struct RoamView::Impl {
   double K = 1;
   glm::dvec3 planes[4];  // inward normals of the side planes, through the eye
   double odometer = 0, angometer = 0;
+  bool zoomed = false;  // the field of view or viewport changed in this update
 
   // Settings snapshot used by priorities.
   ErrorMetric metric = ErrorMetric::kScreenPixels;
@@ -405,11 +410,20 @@ struct RoamView::Impl {
   std::vector<std::uint32_t> waiting;
 
   // Keys due whose recomputation did not fit in a time budget (see refresh_expired()).
+  enum class Clock : std::uint8_t { kDistance, kAngle, kForced };
   struct Due {
     std::uint32_t node;
-    float key;  // the due time of the record (stale when the node's due time differs)
-    bool angular;
+    float key;    // the due time of the record (stale when the node's due time differs)
+    Clock clock;  // kForced: made due by a threshold or far-plane change (live while queued)
   };
+  bool live(const Due& b) const {
+    switch (b.clock) {
+      case Clock::kDistance: return live_distance(b.node, b.key);
+      case Clock::kAngle: return live_angle(b.node, b.key);
+      case Clock::kForced: break;
+    }
+    return nodes[b.node].qslot != kNone;
+  }
   std::deque<Due> backlog;
   // Round-robin position and scratch of the culling pass (see refresh_culling()).
   std::uint32_t cull_cursor = 0;
@@ -871,7 +885,24 @@ struct RoamView::Impl {
     if (have_camera) {
       odometer += glm::length(c.eye - cam.eye);
       angometer += frame_angle(frame, fr);
-      all = c.fov_y_deg != cam.fov_y_deg || c.viewport != cam.viewport || c.far_m != cam.far_m;
+      all = c.far_m != cam.far_m;
+      zoomed = !all && (c.fov_y_deg != cam.fov_y_deg || c.viewport != cam.viewport);
+      if (zoomed) {
+        // A zoom or a viewport change scales every priority by K'/K: every key (the largest
+        // priority over its window) scales alike and stays an upper bound, and the queues keep
+        // their order. A wider frustum can bring culled nodes into view: it counts as that much
+        // rotation, so the culled keys whose angular margin it uses up come due.
+        const float r = static_cast<float>(projection_scale(c) / K);
+        split.scale_keys(r);
+        merge.scale_keys(r);
+        auto half_angles = [](const Camera& x) {
+          const double tv = std::tan(x.fov_y_deg * 3.14159265358979323846 / 360.0);
+          return std::pair{std::atan(tv), std::atan(tv * double(x.viewport.x) / x.viewport.y)};
+        };
+        const auto [v0, h0] = half_angles(cam);
+        const auto [v1, h1] = half_angles(c);
+        angometer += std::max({0.0, v1 - v0, h1 - h0});
+      }
     }
     cam = c;
     frame = fr;
@@ -891,15 +922,8 @@ struct RoamView::Impl {
   // for the next update, and the mesh keeps its shape meanwhile.
   void mark_all_due() {
     backlog.clear();
-    by_distance.clear(odometer);
-    by_angle.clear(angometer);
-    auto due = [&](std::uint32_t n) {
-      nodes[n].due_a = std::numeric_limits<float>::infinity();
-      nodes[n].due_d = floor_float(odometer);
-      by_distance.push(nodes[n].due_d, n);
-    };
-    for (const auto& e : split.entries()) due(e.node);
-    for (const auto& e : merge.entries()) due(e.node);
+    for (const auto& e : split.entries()) backlog.push_back({e.node, 0.0f, Clock::kForced});
+    for (const auto& e : merge.entries()) backlog.push_back({e.node, 0.0f, Clock::kForced});
   }
 
   enum class Cull : std::uint8_t { kOut, kPartial, kIn };
@@ -981,11 +1005,7 @@ struct RoamView::Impl {
   }
 
   void mark_merges_due() {
-    for (const auto& e : merge.entries()) {
-      Node& nd = nodes[e.node];
-      nd.due_d = floor_float(odometer);
-      by_distance.push(nd.due_d, e.node);
-    }
+    for (const auto& e : merge.entries()) backlog.push_back({e.node, 0.0f, Clock::kForced});
   }
 
   // Time budget: true once the update's deadline has passed (the clock is read every 4th call:
@@ -1062,26 +1082,28 @@ struct RoamView::Impl {
     Refresh why = Refresh::kDone;
     bool out = false;
     // false: stop (rebuild).
-    auto visit = [&](std::uint32_t node, bool angular, double key, bool from_backlog) {
+    auto visit = [&](const Due& b, bool from_backlog) {
       ++st.expiry_records;
       if (out) {
         // Out of time: set aside without touching the node (a cache miss per record would cost
         // more than the budget), staleness is checked when it is taken.
-        if (!from_backlog) backlog.push_back({node, float(key), angular});
+        if (!from_backlog) backlog.push_back(b);
         return true;
       }
-      if (angular ? !live_angle(node, key) : !live_distance(node, key)) return true;  // stale
+      if (!live(b)) return true;  // stale
       if (out_of_time()) {
         out = true;
         why = Refresh::kOutOfTime;
-        if (!from_backlog) backlog.push_back({node, float(key), angular});
+        if (!from_backlog) backlog.push_back(b);
         return true;
       }
       ++st.expired;
       // Only the clock that fired is spent; the other record stays valid and is kept when it is
       // due no later than the new key's window (push_records).
-      (angular ? nodes[node].due_a : nodes[node].due_d) = std::numeric_limits<float>::infinity();
-      requeue(node);
+      // A forced recomputation replaces both records.
+      if (b.clock != Clock::kDistance) nodes[b.node].due_a = std::numeric_limits<float>::infinity();
+      if (b.clock != Clock::kAngle) nodes[b.node].due_d = std::numeric_limits<float>::infinity();
+      requeue(b.node);
       if (++done > rebuild_above) {
         why = Refresh::kRebuild;
         return false;
@@ -1091,12 +1113,14 @@ struct RoamView::Impl {
     // The backlog first (oldest first); once out of time the rest of it stays.
     while (!backlog.empty() && !out) {
       const Due b = backlog.front();
-      if (!visit(b.node, b.angular, double(b.key), true)) return why;
+      if (!visit(b, true)) return why;
       if (!out) backlog.pop_front();
     }
-    auto visit_angle = [&](std::uint32_t node, double key) { return visit(node, true, key, false); };
+    auto visit_angle = [&](std::uint32_t node, double key) {
+      return visit(Due{node, float(key), Clock::kAngle}, false);
+    };
     auto visit_distance = [&](std::uint32_t node, double key) {
-      return visit(node, false, key, false);
+      return visit(Due{node, float(key), Clock::kDistance}, false);
     };
     if (by_angle.drain(angometer, visit_angle)) by_distance.drain(odometer, visit_distance);
     // Stale entries pile up in a backlog that never empties (a budget far too small for the
@@ -1104,7 +1128,7 @@ struct RoamView::Impl {
     if (backlog.size() > 4 * (split.size() + merge.size()) + 65536) {
       std::deque<Due> keep;
       for (const Due& b : backlog)
-        if (b.angular ? live_angle(b.node, b.key) : live_distance(b.node, b.key)) keep.push_back(b);
+        if (live(b)) keep.push_back(b);
       backlog.swap(keep);
     }
     return why;
@@ -1263,7 +1287,7 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
     // Coherence loses when most keys expire at once (a teleport, a snap turn): rebuilding
     // top-down then costs less than requeueing everything and merging most of the mesh away.
     // Not after a projection change (a zoom): the mesh keeps its shape while keys catch up.
-    const auto r = m.refresh_expired(everything ? std::numeric_limits<std::size_t>::max()
+    const auto r = m.refresh_expired(everything || m.zoomed ? std::numeric_limits<std::size_t>::max()
                                                 : std::max<std::size_t>(2048, queued / 2));
     if (r == Impl::Refresh::kRebuild) m.reset_to_roots();
     // Out of time (kOutOfTime): the rest stays due; splits and merges get the remaining budget.

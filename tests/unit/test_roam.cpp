@@ -587,3 +587,30 @@ TEST(Roam, ATightTimeBudgetStillSplitsAndMerges) {
   EXPECT_EQ(check_crack_free(*view), "");
   EXPECT_EQ(view->check_invariants(), "");
 }
+
+// A zoom scales the queued keys instead of recomputing them; a wider field of view counts as a
+// rotation so culled nodes that come into view are split. Converged after each change, crack
+// free, and no coarser than a fresh view of the same camera.
+TEST(Roam, ZoomInAndOutStaysConvergedWithoutRecomputingEveryKey) {
+  auto l = make_landscape(257, 5);
+  auto view = RoamView::create(l, {.threshold = 1.0}).value();
+  const glm::dvec3 eye(60, 150, 60), target(200, 20, 220);
+  RoamStats first{};
+  for (double fov : {60.0, 20.0, 10.0, 90.0, 120.0, 45.0}) {
+    const Camera c = camera_at(eye, target, fov);
+    auto st = view->update(c);
+    ASSERT_TRUE(st) << st.error().message;
+    if (fov == 60.0) first = *st;
+    EXPECT_EQ(st->stop, StopReason::kConverged);
+    EXPECT_EQ(check_crack_free(*view), "") << "fov " << fov;
+    expect_converged(*view, c, 1.0);
+    if (fov != 60.0) EXPECT_FALSE(st->rebuilt) << "fov " << fov;  // coherence kept
+  }
+  // After zooming back the mesh is the same quality as a fresh view's and not much larger.
+  const Camera c = camera_at(eye, target, 45.0);
+  auto fresh = RoamView::create(l, {.threshold = 1.0}).value();
+  auto f = fresh->update(c);
+  ASSERT_TRUE(f);
+  EXPECT_LT(double(view->triangle_count()), 1.5 * double(f->triangles));
+  EXPECT_GT(first.triangles, 0u);
+}
