@@ -450,6 +450,11 @@ TEST(Landscape, ConstantTimeGeometryMatchesThePathWalk) {
       const LatticeTriangle b = l->triangle_at(a.ax, a.az, root, h);
       ASSERT_EQ(std::tie(a.lx, a.lz, a.rx, a.rz), std::tie(b.lx, b.lz, b.rx, b.rz))
           << "root " << root << " heap " << h;
+      const Landscape::LatticeBox x = l->box_at(a.ax, a.az, root, h);
+      ASSERT_EQ(x.i0, std::min({a.ax, a.lx, a.rx})) << "root " << root << " heap " << h;
+      ASSERT_EQ(x.i1, std::max({a.ax, a.lx, a.rx})) << "root " << root << " heap " << h;
+      ASSERT_EQ(x.j0, std::min({a.az, a.lz, a.rz})) << "root " << root << " heap " << h;
+      ASSERT_EQ(x.j1, std::max({a.az, a.lz, a.rz})) << "root " << root << " heap " << h;
     }
 }
 

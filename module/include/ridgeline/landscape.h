@@ -90,6 +90,26 @@ class Landscape {
             ax + (ux - px) * s2 / 2,
             az + (uz - pz) * s2 / 2};
   }
+  /// Lattice bounding box [i0, i1] x [j0, j1] of node `heap` of root `root` whose apex is
+  /// (ax, az): triangle_at()'s corners without forming them (what a priority needs).
+  struct LatticeBox {
+    std::int64_t i0, i1, j0, j1;
+  };
+  LatticeBox box_at(std::int64_t ax, std::int64_t az, std::uint32_t root,
+                    std::uint64_t heap) const noexcept {
+    // Per direction k: the box's extent in units of s2 / 2 from the apex. With u the unit
+    // step towards the hypotenuse and p = u turned +90 degrees, the corners are apex,
+    // apex + (u + p) s2 / 2 and apex + (u - p) s2 / 2: x spans [min(0, ux - |uz|),
+    // max(0, ux + |uz|)] and z [min(0, uz - |ux|), max(0, uz + |ux|)] of those units.
+    static constexpr std::int8_t kBox[8][4] = {{0, 1, -1, 1},  {0, 2, 0, 2},  {-1, 1, 0, 1},
+                                               {-2, 0, 0, 2},  {-1, 0, -1, 1}, {-2, 0, -2, 0},
+                                               {-1, 1, -1, 0}, {0, 2, -2, 0}};
+    const int level = 63 - __builtin_clzll(heap);
+    const int k = (((root & 1) ? 7 : 3) + 3 * level + 2 * (popcount64(heap) - 1)) & 7;
+    const std::int64_t s2 = patch_cells() >> (level / 2);  // as in triangle_at()
+    const std::int8_t* b = kBox[k];
+    return {ax + b[0] * s2 / 2, ax + b[1] * s2 / 2, az + b[2] * s2 / 2, az + b[3] * s2 / 2};
+  }
   /// Bits set in x, inline (without -mpopcnt the builtin is a libgcc call; triangle_at runs
   /// for every priority).
   static constexpr int popcount64(std::uint64_t x) noexcept {
