@@ -3,6 +3,7 @@
 # error along camera paths, on the 1025 x 1025 value-noise field the peer figures were measured on
 # (written by ../shared/tools/make-noise-field when present) and on the built-in default terrain.
 # Usage: scripts/bench.sh [OUT_DIR]   (default docs/benchmarks; per-frame JSON goes to build/bench)
+# BENCH_ONLY=lod runs only the ROAM part (lod_summary.json, tables.md).
 set -euo pipefail
 source "$(dirname "$0")/lib/common.sh"
 cd "$RIDGELINE_ROOT"
@@ -21,12 +22,14 @@ fi
 
 echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)" | tee "$out/machine.txt"
 
-# Queries.
-"$ridge" bench queries --default-terrain --json "$out/queries_default.json"
-[ ${#noise[@]} -gt 0 ] && "$ridge" bench queries "${noise[@]}" --json "$out/queries_noise1025.json"
-
-# Lua calls (when the binding is built).
-[ -x build/release/bindings/lua/bench_lua ] && build/release/bindings/lua/bench_lua > "$out/lua.json"
+only=${BENCH_ONLY:-all}
+if [ "$only" = all ]; then
+  # Queries.
+  "$ridge" bench queries --default-terrain --json "$out/queries_default.json"
+  [ ${#noise[@]} -gt 0 ] && "$ridge" bench queries "${noise[@]}" --json "$out/queries_noise1025.json"
+  # Lua calls (when the binding is built).
+  [ -x build/release/bindings/lua/bench_lua ] && build/release/bindings/lua/bench_lua > "$out/lua.json"
+fi
 
 # ROAM along paths. Error measured every 10th frame on every vertex in view.
 lod() {  # NAME ARGS...
@@ -50,17 +53,28 @@ if [ ${#noise[@]} -gt 0 ]; then
   for n in 5250 53000; do
     lod "noise_coherent_n$n" "${noise[@]}" --path "$path" --triangles "$n" --warmup 60
   done
+  # Time budgets on the flyover at 1 px (wall and thread-CPU percentiles).
+  for b in 2 0.5; do
+    lod "noise_coherent_t1_budget${b}ms" "${noise[@]}" --path "$path" --threshold 1 --budget-ms "$b" \
+      --warmup 60
+  done
 fi
 for p in flyover drive fast_yaw zoom down fast_pass; do
   lod "default_${p}_t2" --default-terrain --path "tests/data/paths/$p.json" --threshold 2
 done
-lod "default_fast_yaw_t1_budget1ms" --default-terrain --path tests/data/paths/fast_yaw.json \
-  --threshold 1 --budget-ms 1
+for p in fast_yaw zoom fast_pass; do
+  for b in 1 0.5; do
+    lod "default_${p}_t1_budget${b}ms" --default-terrain --path "tests/data/paths/$p.json" \
+      --threshold 1 --budget-ms "$b"
+  done
+done
 python3 - "$work/summaries.jsonl" > "$out/lod_summary.json" <<'PY'
 import json, sys
 print(json.dumps([json.loads(l) for l in open(sys.argv[1])], indent=1))
 PY
 python3 docs/benchmarks/tables.py "$out" > "$out/tables.md"
+
+[ "$only" = all ] || { echo "wrote $out/lod_summary.json, $out/tables.md"; exit 0; }
 
 # Detail streaming (issue 4): a 100 km x 100 km world (the default terrain stretched to
 # 3126 x 3126 samples at 32 m, heights x 4) with 7 detail levels (0.25 m, 1.6e11 virtual

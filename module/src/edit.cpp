@@ -389,14 +389,17 @@ Status save_edits(const Terrain& terrain, const std::string& path) {
     }
     done += std::size_t(n);
   }
-  if (::fsync(fd) != 0 || ::close(fd) != 0) {
-    const int err = errno;
+  // A full disk may show only here (delayed allocation, network file systems). The descriptor
+  // is closed whatever fsync answered.
+  int err = ::fsync(fd) != 0 ? errno : 0;
+  if (::close(fd) != 0 && err == 0) err = errno;
+  if (err != 0) {
     ::unlink(tmp.c_str());
     return Error{"save edits '" + path + "': flushing failed (" + std::strerror(err) +
                  "); the previous file is unchanged"};
   }
   if (::rename(tmp.c_str(), path.c_str()) != 0) {
-    const int err = errno;
+    err = errno;
     ::unlink(tmp.c_str());
     return Error{"save edits '" + path + "': rename failed (" + std::strerror(err) +
                  "); the previous file is unchanged"};

@@ -1263,11 +1263,20 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
     if (behind && !m.has_deadline) {
       m.by_distance.compact(live_d);  // rare: the round-robin sweep below fell behind
       m.by_angle.compact(live_a);
+    } else if (!m.has_deadline) {
+      m.by_distance.compact_some(live_d, 4096);
+      m.by_angle.compact_some(live_a, 4096);
     } else {
-      // Under a time budget a full compaction (milliseconds) would break it: sweep faster.
+      // Under a time budget a full compaction (milliseconds) would break it, and even the
+      // regular sweep reads a node per record (a cache miss each: 4,096 of them cost ~0.2 ms):
+      // sweep in slices until 5 % of the budget is spent (more records when behind).
+      const auto until = deadline_at(0.05);
       const std::size_t quota = behind ? 32768 : 4096;
-      m.by_distance.compact_some(live_d, quota);
-      m.by_angle.compact_some(live_a, quota);
+      for (std::size_t done = 0; done < quota; done += 512) {
+        m.by_distance.compact_some(live_d, 384);
+        m.by_angle.compact_some(live_a, 128);
+        if (std::chrono::steady_clock::now() >= until) break;
+      }
     }
     // Culling gets a small share of a time budget (it resumes where it stopped next update).
     constexpr double kCullShare = 0.15;

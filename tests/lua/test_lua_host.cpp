@@ -2,10 +2,15 @@
 // keeps running; callbacks; attaching to an engine's state; symbolic links out of the folder.
 #include <gtest/gtest.h>
 
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <lua.hpp>
 #include <string>
 
+#include "../unit/file_limit_child.h"
 #include "ridgeline/lua/host.h"
 
 namespace {
@@ -281,6 +286,141 @@ TEST(LuaHost, SymlinkOutOfTheGrantedFolderIsRefused) {
     assert(t == nil and err:find("file access is not granted", 1, true), err))",
                                 "none");
   EXPECT_TRUE(c.ok()) << c.message();
+}
+
+// Lua 5.4.4 bug 9 (lua.org/bugs.html, "C-stack overflow with deep nesting of coroutine.close"):
+// each coroutine's __close closes the previous one; stock 5.4.4 recurses in C once per link and
+// crashes the whole process (30,000 links did in this host with an 8 MiB stack). The sandbox
+// bounds the nesting: the chain ends in an error, as in Lua 5.4.6, and the host keeps running.
+TEST(LuaHost, Lua544NestedCoroutineCloseIsBoundedNotACrash) {
+  HostOptions o;
+  o.memory_limit = std::size_t{512} << 20;  // room for the chain: memory must not stop it first
+  auto host = make_host(o);
+  const auto s = host->run(R"lua(
+    local count = 0
+    local coro = false
+    for i = 1, 100000 do
+      local previous = coro
+      coro = coroutine.create(function()
+        local cc <close> = setmetatable({}, {__close = function()
+          count = count + 1
+          if previous then assert(coroutine.close(previous)) end
+        end})
+        coroutine.yield()  -- leaves cc pending
+      end)
+      assert(coroutine.resume(coro))
+    end
+    local ok, msg = coroutine.close(coro)
+    assert(ok == false and msg:find("C stack overflow", 1, true), tostring(msg))
+    assert(count == 8, count)
+    -- Closing still works, nested a little, and as before otherwise.
+    local inner = coroutine.create(function() local c <close> = setmetatable({}, {
+      __close = function() count = -1 end}) coroutine.yield() end)
+    assert(coroutine.resume(inner))
+    local outer = coroutine.create(function() local c <close> = setmetatable({}, {
+      __close = function() assert(coroutine.close(inner)) end}) coroutine.yield() end)
+    assert(coroutine.resume(outer))
+    assert(coroutine.close(outer) == true and count == -1)
+    local ok2, e2 = pcall(coroutine.close, coroutine.running())
+    assert(not ok2 and e2:find("cannot close a running coroutine", 1, true), e2)
+    -- The other way Lua closes a coroutine (coroutine.wrap after an error) resumes it first,
+    -- which counts C calls: stock Lua bounds that chain itself.
+    local wrapped, n = false, 0
+    for i = 1, 100000 do
+      local previous = wrapped
+      wrapped = coroutine.wrap(function()
+        local cc <close> = setmetatable({}, {__close = function()
+          n = n + 1
+          if previous then previous() end
+        end})
+        coroutine.yield()
+        error("boom")
+      end)
+      wrapped()
+    end
+    local ok3, e3 = pcall(wrapped)
+    assert(not ok3 and n < 1000, n))lua",
+                           "close_chain");
+  EXPECT_TRUE(s.ok()) << s.message();
+  expect_alive(*host);
+}
+
+std::string read_bytes(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// A full disk under terrain:save_edits and ridgeline.save_edits (issue 9): a forked child whose
+// files may not grow past `limit` bytes (RLIMIT_FSIZE, SIGXFSZ ignored: write() fails with EFBIG)
+// runs the saving script; the script must get nil and a message naming the cause, the host must
+// keep running, and the previous save must stay as it was (tests/unit/test_faults.cpp does the
+// same for the C++ call at more limits).
+TEST(LuaHost, DiskFullDuringSaveIsAnErrorForTheScript) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(RIDGELINE_TEST_TMP) / "lua_full";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  fs::copy_file(fs::path(RIDGELINE_TEST_DATA) / "ramp16.png", dir / "ramp16.png");
+  HostOptions o;
+  o.data_root = dir.string();
+  o.time_limit_seconds = 0;
+  {
+    auto host = Host::create(o);
+    ASSERT_TRUE(host.ok());
+    const auto s = (*host)->run(R"lua(
+      local t = assert(ridgeline.load{heightmap = "ramp16.png"})
+      assert(t:deform{brush = "raise", x = 1, z = 1, radius = 2, depth = 1})
+      assert(t:save_edits("state.bin"))
+      assert(t:deform{brush = "lower", x = 3, z = 2, radius = 3, depth = 2})
+      assert(t:save_edits("new.bin")))lua",
+                                "previous");
+    ASSERT_TRUE(s.ok()) << s.message();
+  }
+  const std::string previous = read_bytes(dir / "state.bin");
+  const std::size_t new_size = fs::file_size(dir / "new.bin");
+  ASSERT_GT(new_size, std::size_t{16});
+  const std::string efbig = std::strerror(EFBIG);
+  for (const std::size_t limit : {std::size_t{0}, std::size_t{5}, new_size / 2, new_size - 1}) {
+    SCOPED_TRACE("file size limit " + std::to_string(limit));
+    const std::string msg = ridgeline::test::in_child_with_file_limit(limit, [&] {
+      auto host = Host::create(o);
+      if (!host.ok()) return host.error().message;
+      const auto full = (*host)->run(R"lua(
+        local t = assert(ridgeline.load{heightmap = "ramp16.png"})
+        assert(t:deform{brush = "raise", x = 1, z = 1, radius = 2, depth = 1})
+        assert(t:deform{brush = "lower", x = 3, z = 2, radius = 3, depth = 2})
+        local ok, err = t:save_edits("state.bin")
+        assert(ok == nil and type(err) == "string", "save_edits did not fail")
+        local ok2, err2 = ridgeline.save_edits(t, "state.bin")
+        assert(ok2 == nil and err2 == err, tostring(err2))
+        error(err, 0))lua",
+                                     "full");
+      std::string m = full.message();
+      // The host keeps running after the failed saves.
+      const auto alive = (*host)->run(
+          "local t = assert(ridgeline.load{heightmap = 'ramp16.png'}) assert(t:height(1, 1))",
+          "alive");
+      if (!alive.ok()) m += "\nhost not usable: " + alive.message();
+      return m;
+    });
+    ASSERT_EQ(msg.find("child died"), std::string::npos) << msg;
+    EXPECT_EQ(msg.rfind("save edits '", 0), 0u) << msg;  // the script's error: the save's message
+    EXPECT_NE(msg.find("state.bin"), std::string::npos) << msg;
+    EXPECT_NE(msg.find(efbig), std::string::npos) << msg;
+    EXPECT_EQ(msg.find("host not usable"), std::string::npos) << msg;
+    EXPECT_EQ(read_bytes(dir / "state.bin"), previous);
+    for (const auto& e : fs::directory_iterator(dir))
+      EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos)
+          << "temporary file left: " << e.path();
+  }
+  // The previous save still loads in a fresh host.
+  auto host = Host::create(o);
+  ASSERT_TRUE(host.ok());
+  const auto s = (*host)->run(R"lua(
+    local t = assert(ridgeline.load{heightmap = "ramp16.png"})
+    assert(t:load_edits("state.bin")))lua",
+                              "reload");
+  EXPECT_TRUE(s.ok()) << s.message();
 }
 
 }  // namespace

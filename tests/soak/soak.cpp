@@ -12,9 +12,11 @@
 // seed, frame and the violation).
 //
 // Usage: ridgeline_soak [--frames N] [--edits N] [--seed S] [--check-every N] [--size N]
+//                       [--progress N]  (a line on stderr every N frames: frame, edits, seconds)
 //   CI (asan stage): --frames 2000 --edits 200 --size 257; full run: --frames 100000 --edits 10000
 #include <sys/resource.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -38,6 +40,7 @@ struct Args {
   unsigned seed = 1;
   long check_every = 100;
   unsigned size = 257;
+  long progress = 0;  // frames between progress lines on stderr (0: none)
   std::size_t view_memory_budget = std::size_t{512} << 20;  // bytes
 };
 
@@ -64,6 +67,7 @@ int main(int argc, char** argv) {
     else if (k == "--seed") a.seed = static_cast<unsigned>(std::atol(v));
     else if (k == "--check-every") a.check_every = std::max(1L, std::atol(v));
     else if (k == "--size") a.size = static_cast<unsigned>(std::atol(v));
+    else if (k == "--progress") a.progress = std::max(0L, std::atol(v));
     else {
       std::fprintf(stderr, "unknown option %s\n", k.c_str());
       return 2;
@@ -104,6 +108,7 @@ int main(int argc, char** argv) {
   std::uint64_t total_triangles = 0;
   const double edit_rate = a.frames > 0 ? static_cast<double>(a.edits) / a.frames : 0;
 
+  const auto start = std::chrono::steady_clock::now();
   for (long frame = 1; frame <= a.frames; ++frame) {
     // Flight: random walk of speed, heading and pitch; occasional snap turns and zooms.
     speed = std::clamp(speed + uni(-40, 40), 0.0, kMaxSpeed);
@@ -159,6 +164,12 @@ int main(int argc, char** argv) {
     total_triangles += st->triangles;
     peak_view_memory = std::max(peak_view_memory, st->memory_bytes);
 
+    if (a.progress > 0 && frame % a.progress == 0) {
+      const double elapsed =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      std::fprintf(stderr, "progress: frame %ld, edits %ld, checks %ld, worst ratio %.4f, %.0f s\n",
+                   frame, edits_done, checks, worst_ratio, elapsed);
+    }
     if (frame % a.check_every != 0) continue;
     ++checks;
     if (std::string inv = view.check_invariants(); !inv.empty()) fail(a, frame, "cracks: " + inv);

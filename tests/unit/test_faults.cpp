@@ -1,13 +1,15 @@
 // Fault injection (issue 9, docs/reliability.md): the detail memory budget exhausted, a worker
 // task that fails, a heightmap file changing while loaded, the process killed in the middle of
-// saving the edit layer.
+// saving the edit layer, the disk filling up during a save.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -17,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "file_limit_child.h"
 #include "ridgeline/detail.h"
 #include "ridgeline/edit.h"
 #include "ridgeline/heightfield.h"
@@ -44,6 +47,26 @@ std::shared_ptr<const DetailField> make_field(std::uint32_t levels) {
   auto f = DetailField::create(make_terrain(), p);
   EXPECT_TRUE(f.ok()) << (f.ok() ? "" : f.error().message);
   return std::move(f).value();
+}
+
+// An empty folder for one test under the build's test tmp folder.
+fs::path fresh_dir(const char* name) {
+  const fs::path dir = fs::path(RIDGELINE_TEST_TMP) / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+// `count` edits of all five brushes at random places of the square [0, extent] m (a large edit
+// layer).
+void apply_random_edits(Terrain& t, int count, std::mt19937& rng, double extent, double radius) {
+  std::uniform_real_distribution<double> u(0, extent);
+  for (int k = 0; k < count; ++k) {
+    Edit e;
+    e.brush = static_cast<Brush>(k % 5);
+    e.x = u(rng), e.z = u(rng), e.radius = radius, e.depth = 5, e.height = 50;
+    ASSERT_TRUE(t.apply_edit(e).ok());
+  }
 }
 
 std::string read_bytes(const fs::path& p) {
@@ -165,9 +188,7 @@ TEST(Faults, HeightmapFileChangingWhileLoadedDoesNotTouchTheTerrain) {
 }
 
 TEST(Faults, KilledMidSaveLeavesThePreviousFileIntact) {
-  const fs::path dir = fs::path(RIDGELINE_TEST_TMP) / "faults_save";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = fresh_dir("faults_save");
   // Two edit states of a 513 x 513 terrain; B is much larger (many edits) so saving it takes a
   // while and the kill lands inside the write.
   auto a = make_terrain(513), b = make_terrain(513);
@@ -178,12 +199,7 @@ TEST(Faults, KilledMidSaveLeavesThePreviousFileIntact) {
     e.x = u(rng), e.z = u(rng), e.radius = 40;
     ASSERT_TRUE(a->apply_edit(e).ok());
   }
-  for (int k = 0; k < 400; ++k) {
-    Edit e;
-    e.brush = static_cast<Brush>(k % 5);
-    e.x = u(rng), e.z = u(rng), e.radius = 90, e.depth = 5, e.height = 50;
-    ASSERT_TRUE(b->apply_edit(e).ok());
-  }
+  apply_random_edits(*b, 400, rng, 2048, 90);
   const fs::path pa = dir / "a.bin", pb = dir / "b.bin", target = dir / "state.bin";
   ASSERT_TRUE(save_edits(*a, pa.string()).ok());
   ASSERT_TRUE(save_edits(*b, pb.string()).ok());
@@ -219,6 +235,104 @@ TEST(Faults, KilledMidSaveLeavesThePreviousFileIntact) {
   RecordProperty("killed_after_rename", saw_b);
   // Temporary files of killed savers may remain beside the target; they never replace it.
   std::printf("kills: %d left the previous state, %d the new one\n", saw_a, saw_b);
+}
+
+// Files in `dir` whose name starts with `prefix` (temporary files of a save of `prefix`).
+std::vector<std::string> files_starting_with(const fs::path& dir, const std::string& prefix) {
+  std::vector<std::string> out;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().filename().string().rfind(prefix, 0) == 0) out.push_back(e.path().filename());
+  return out;
+}
+
+TEST(Faults, DiskFullDuringSaveKeepsThePreviousFileAndCleansUp) {
+  const fs::path dir = fresh_dir("faults_full");
+  auto a = make_terrain(257), b = make_terrain(257);
+  std::mt19937 rng(11);
+  apply_random_edits(*b, 60, rng, 1024, 60);
+  Edit one;
+  one.x = 500, one.z = 500, one.radius = 30;
+  ASSERT_TRUE(a->apply_edit(one).ok());
+  const fs::path previous = dir / "previous.bin", target = dir / "state.bin";
+  ASSERT_TRUE(save_edits(*a, previous.string()).ok());
+  const std::string bytes_a = read_bytes(previous);
+  // The size of the new state's file, measured by saving it without a limit.
+  ASSERT_TRUE(save_edits(*b, (dir / "new.bin").string()).ok());
+  const std::size_t new_size = fs::file_size(dir / "new.bin");
+  ASSERT_GT(new_size, bytes_a.size());
+  ASSERT_GT(new_size, std::size_t{4096});
+
+  // The disk fills before the first byte, after a few bytes, in the header, in the middle, one
+  // byte before the end.
+  for (const std::size_t limit : {std::size_t{0}, std::size_t{3}, std::size_t{40},
+                                  std::size_t{4096}, new_size / 2, new_size - 1}) {
+    SCOPED_TRACE("file size limit " + std::to_string(limit));
+    fs::copy_file(previous, target, fs::copy_options::overwrite_existing);
+    const std::string msg = test::in_child_with_file_limit(limit, [&] {
+      const Status s = save_edits(*b, target.string());
+      return s ? std::string("ok") : s.message();
+    });
+    EXPECT_NE(msg.find("save edits '" + target.string() + "'"), std::string::npos) << msg;
+    EXPECT_NE(msg.find(std::strerror(EFBIG)), std::string::npos) << msg;
+    EXPECT_NE(msg.find("the previous file is unchanged"), std::string::npos) << msg;
+    EXPECT_EQ(read_bytes(target), bytes_a) << "the previous save changed";
+    EXPECT_EQ(files_starting_with(dir, "state.bin.tmp"), std::vector<std::string>{})
+        << "temporary file left behind";
+    auto fresh = make_terrain(257);
+    auto loaded = load_edits(*fresh, target.string());
+    ASSERT_TRUE(loaded.ok()) << loaded.error().message;
+    EXPECT_DOUBLE_EQ(*fresh->height(500, 500), *a->height(500, 500));
+  }
+  // The same limit set to exactly the file's size lets the save through: the failures above
+  // came from the limit, not from the child.
+  fs::copy_file(previous, target, fs::copy_options::overwrite_existing);
+  const std::string ok = test::in_child_with_file_limit(new_size, [&] {
+    const Status s = save_edits(*b, target.string());
+    return s ? std::string("ok") : s.message();
+  });
+  EXPECT_EQ(ok, "ok");
+  EXPECT_EQ(read_bytes(target), read_bytes(dir / "new.bin"));
+  EXPECT_EQ(files_starting_with(dir, "state.bin.tmp"), std::vector<std::string>{});
+}
+
+TEST(Faults, NoSpaceLeftOnDeviceDuringSaveIsReported) {
+  // A real ENOSPC from the kernel: the save's temporary file (NAME.tmp.PID, created without
+  // O_EXCL) is made a link to /dev/full, whose every write fails with ENOSPC.
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  const fs::path dir = fresh_dir("faults_enospc");
+  auto a = make_terrain(129), b = make_terrain(129);
+  Edit e;
+  e.x = 200, e.z = 200, e.radius = 40;
+  ASSERT_TRUE(a->apply_edit(e).ok());
+  e.x = 300;
+  ASSERT_TRUE(b->apply_edit(e).ok());
+  const fs::path target = dir / "state.bin";
+  ASSERT_TRUE(save_edits(*a, target.string()).ok());
+  const std::string bytes_a = read_bytes(target);
+  const fs::path tmp = dir / ("state.bin.tmp." + std::to_string(getpid()));
+  fs::create_symlink("/dev/full", tmp);
+  const Status s = save_edits(*b, target.string());
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find(std::strerror(ENOSPC)), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("state.bin"), std::string::npos) << s.message();
+  EXPECT_EQ(read_bytes(target), bytes_a);
+  EXPECT_FALSE(fs::exists(fs::symlink_status(tmp))) << "temporary name left behind";
+  EXPECT_TRUE(fs::exists("/dev/full"));
+  auto fresh = make_terrain(129);
+  ASSERT_TRUE(load_edits(*fresh, target.string()).ok());
+}
+
+TEST(Faults, RenameFailingDuringSaveCleansUp) {
+  // The target is a folder that is not empty: rename() fails after the data was written.
+  const fs::path dir = fresh_dir("faults_rename");
+  fs::create_directories(dir / "state.bin");
+  std::ofstream(dir / "state.bin" / "keep") << "kept";
+  auto t = make_terrain(129);
+  const Status s = save_edits(*t, (dir / "state.bin").string());
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("rename failed"), std::string::npos) << s.message();
+  EXPECT_EQ(read_bytes(dir / "state.bin" / "keep"), "kept");
+  EXPECT_EQ(files_starting_with(dir, "state.bin.tmp"), std::vector<std::string>{});
 }
 
 }  // namespace

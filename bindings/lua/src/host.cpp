@@ -238,6 +238,8 @@ int setup_state(lua_State* L) {
     // Guards in the library tables themselves (the string metatable indexes the original).
     if (lib->func == luaopen_string) detail::install_string_guards(L, lua_absindex(L, -1));
     if (lib->func == luaopen_table) detail::install_table_guards(L, lua_absindex(L, -1));
+    if (lib->func == luaopen_coroutine) detail::install_coroutine_guards(L, lua_absindex(L, -1));
+    if (lib->func == luaopen_utf8) detail::install_utf8_guards(L, lua_absindex(L, -1));
     if (lib == kLibs) {  // base: copy the allowed functions only
       static const char* const kBase[] = {
           "assert",   "error",  "ipairs",       "next",     "pairs",  "pcall",    "print",

@@ -325,6 +325,74 @@ int guarded_sort(lua_State* L) {
   return lua_gettop(L);
 }
 
+// coroutine.close(co) with its nesting bounded (Lua 5.4.4 bug 9 on lua.org/bugs.html,
+// "C-stack overflow with deep nesting of coroutine.close"): closing a coroutine runs its pending
+// __close handlers on the coroutine's own C-call count, so a __close that closes another
+// coroutine, whose __close closes another... recurses in C without limit and crashes the
+// process (30,000 levels did with an 8 MiB stack). Lua 5.4.6 counts the closing against the
+// caller's C calls; the C API of 5.4.4 cannot, so the sandbox bounds the nesting instead. The
+// depth lives in a userdata upvalue (2); the original call runs under lua_pcall so that the depth
+// is restored whatever it raises.
+constexpr int kMaxCloseNesting = 8;
+
+int guarded_coroutine_close(lua_State* L) {
+  int* depth = static_cast<int*>(lua_touserdata(L, lua_upvalueindex(2)));
+  if (*depth >= kMaxCloseNesting)
+    return luaL_error(L, "C stack overflow (coroutine.close nested more than %d deep)",
+                      kMaxCloseNesting);
+  lua_pushvalue(L, lua_upvalueindex(1));
+  lua_insert(L, 1);
+  ++*depth;
+  const int rc = lua_pcall(L, lua_gettop(L) - 1, LUA_MULTRET, 0);
+  --*depth;
+  if (rc != LUA_OK) return lua_error(L);
+  return lua_gettop(L);
+}
+
+// utf8.codes(s [, lax]) raising on stray continuation bytes (Lua 5.4.4 bug 8, "'utf8.codes' does
+// not raise an error on spurious continuation bytes": 5.4.4's iterator skips them silently, so
+// "a\x80" iterates as "a"). As Lua 5.4.6 does: the string may not start with one, and none may
+// follow a decoded character. The iterator (upvalue 1: the stock one) is wrapped.
+bool is_continuation(const char* s, std::size_t len, std::size_t at) {
+  return at < len && (static_cast<uchar>(s[at]) & 0xC0) == 0x80;
+}
+
+int guarded_utf8_iterator(lua_State* L) {
+  lua_pushvalue(L, lua_upvalueindex(1));
+  lua_pushvalue(L, 1);
+  lua_pushvalue(L, 2);
+  lua_call(L, 2, 2);
+  if (lua_isnil(L, -2)) return 0;
+  std::size_t len = 0;
+  const char* s = lua_tolstring(L, 1, &len);
+  const lua_Integer pos = lua_tointeger(L, -2);
+  const lua_Integer code = lua_tointeger(L, -1);
+  // Bytes of the character just decoded (Lua refuses overlong encodings, so the code point
+  // fixes the length).
+  const int bytes = code < 0x80        ? 1
+                    : code < 0x800     ? 2
+                    : code < 0x10000   ? 3
+                    : code < 0x200000  ? 4
+                    : code < 0x4000000 ? 5
+                                       : 6;
+  if (s != nullptr && pos >= 1 && is_continuation(s, len, std::size_t(pos - 1 + bytes)))
+    return luaL_error(L, "invalid UTF-8 code");
+  return 2;
+}
+
+int guarded_utf8_codes(lua_State* L) {
+  std::size_t len = 0;
+  const char* s = luaL_checklstring(L, 1, &len);
+  luaL_argcheck(L, !is_continuation(s, len, 0), 1, "invalid UTF-8 code");
+  lua_pushvalue(L, lua_upvalueindex(1));
+  lua_insert(L, 1);
+  lua_call(L, lua_gettop(L) - 1, 3);
+  lua_pushvalue(L, -3);
+  lua_pushcclosure(L, guarded_utf8_iterator, 1);
+  lua_replace(L, -4);
+  return 3;
+}
+
 }  // namespace
 
 void install_string_guards(lua_State* L, int string_t) {
@@ -349,6 +417,19 @@ void install_table_guards(lua_State* L, int table_t) {
   lua_getfield(L, table_t, "sort");
   lua_pushcclosure(L, guarded_sort, 1);
   lua_setfield(L, table_t, "sort");
+}
+
+void install_coroutine_guards(lua_State* L, int coroutine_t) {
+  lua_getfield(L, coroutine_t, "close");
+  *static_cast<int*>(lua_newuserdatauv(L, sizeof(int), 0)) = 0;
+  lua_pushcclosure(L, guarded_coroutine_close, 2);
+  lua_setfield(L, coroutine_t, "close");
+}
+
+void install_utf8_guards(lua_State* L, int utf8_t) {
+  lua_getfield(L, utf8_t, "codes");
+  lua_pushcclosure(L, guarded_utf8_codes, 1);
+  lua_setfield(L, utf8_t, "codes");
 }
 
 }  // namespace ridgeline::lua::detail

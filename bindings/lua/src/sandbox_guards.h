@@ -1,5 +1,6 @@
 // Sandbox guards for work that Lua's count hook cannot see: C library functions that may run for
-// a long time inside one call (pattern matching, table.move/sort, load, collectgarbage).
+// a long time inside one call (pattern matching, table.move/sort, load, collectgarbage), and for
+// known bugs of Debian's Lua 5.4.4 that scripts can reach (coroutine.close, utf8.codes).
 // Private to Ridgeline::lua; installed by host.cpp in sandboxed states only.
 #pragma once
 
@@ -27,6 +28,12 @@ double pattern_steps_per_start(std::string_view subject, std::string_view patter
 void install_string_guards(lua_State* L, int string_t);
 /// The same for table.move and table.sort of the table library at `table_t`.
 void install_table_guards(lua_State* L, int table_t);
+/// Bounds the nesting of coroutine.close of the coroutine library at `coroutine_t` (Lua 5.4.4
+/// crashes on deep nesting: docs/reliability.md, "Lua 5.4.4's known bugs").
+void install_coroutine_guards(lua_State* L, int coroutine_t);
+/// Makes utf8.codes of the utf8 library at `utf8_t` raise on stray continuation bytes, as Lua
+/// 5.4.6 does (5.4.4 skips them).
+void install_utf8_guards(lua_State* L, int utf8_t);
 
 /// Charges `steps` VM-instruction equivalents to the running host call; raises
 /// `instruction limit exceeded (... in <what>)` when the call's budget is spent. Defined in host.cpp.
