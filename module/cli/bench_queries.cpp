@@ -5,10 +5,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <ctime>
 #include <glm/geometric.hpp>
 #include <random>
 #include <vector>
+
+#include "cli_util.h"
 
 namespace ridgeline::cli {
 
@@ -20,14 +21,6 @@ double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const std::size_t n = v.size();
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-// CPU time of the calling thread, nanoseconds: unlike wall time it does not count the time the
-// thread waits for a core, which on a shared 2-core machine can dominate.
-double thread_cpu_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return double(ts.tv_sec) * 1e9 + double(ts.tv_nsec);
 }
 
 // Wall and thread-CPU nanoseconds per item of one run of a timed loop.

@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -131,6 +132,12 @@ void install_log_sink() {
     std::fprintf(stderr, "ridge: %s: %.*s\n", tag, static_cast<int>(message.size()),
                  message.data());
   });
+}
+
+double thread_cpu_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) * 1e9 + double(ts.tv_nsec);
 }
 
 }  // namespace ridgeline::cli

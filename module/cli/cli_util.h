@@ -43,6 +43,10 @@ Status write_json(const Json& json, const std::string& path) {
 /// Prints "ridge: error: MESSAGE" to stderr and returns kExitError.
 int report_error(const std::string& message);
 
+/// CPU time of the calling thread, nanoseconds (CLOCK_THREAD_CPUTIME_ID): unlike wall time it
+/// does not count the time the thread waits for a core, which on a shared machine can dominate.
+double thread_cpu_ns();
+
 /// Installs a log sink that prints the library's info, warning and error messages to stderr.
 void install_log_sink();
 

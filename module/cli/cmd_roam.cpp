@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <ctime>
 #include <memory>
 
 #include "cli_util.h"
@@ -240,12 +239,9 @@ int run_bench_lod(const BenchLodArgs& a) {
       const Camera& c = (*frames)[k].camera;
       // CPU time of this thread as well as the wall time update() reports: on a shared machine
       // the difference is time the update was preempted, which no budget can keep.
-      timespec cpu0{}, cpu1{};
-      clock_gettime(CLOCK_THREAD_CPUTIME_ID, &cpu0);
+      const double cpu0 = thread_cpu_ns();
       auto st = v.update(c);
-      clock_gettime(CLOCK_THREAD_CPUTIME_ID, &cpu1);
-      const double cpu_ms =
-          double(cpu1.tv_sec - cpu0.tv_sec) * 1e3 + double(cpu1.tv_nsec - cpu0.tv_nsec) * 1e-6;
+      const double cpu_ms = (thread_cpu_ns() - cpu0) * 1e-6;
       if (!st) return report_error(st.error().message);
       (void)v.take_dirty_patches();
       nlohmann::ordered_json f = {

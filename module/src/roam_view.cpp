@@ -1052,10 +1052,8 @@ struct RoamView::Impl {
             const std::uint32_t n = stack.back();
             stack.pop_back();
             const Node& nd = nodes[n];
-            const LatticeTriangle t = land.triangle_at(nd.ax, nd.az, nd.root, nd.heap);
-            if (std::max({t.ax, t.lx, t.rx}) < i0 || std::min({t.ax, t.lx, t.rx}) > i1 ||
-                std::max({t.az, t.lz, t.rz}) < j0 || std::min({t.az, t.lz, t.rz}) > j1)
-              continue;
+            const Landscape::LatticeBox bx = land.box_at(nd.ax, nd.az, nd.root, nd.heap);
+            if (bx.i1 < i0 || bx.i0 > i1 || bx.j1 < j0 || bx.j0 > j1) continue;
             cache_box(n);
             ++refreshed;
             if (is_leaf(n)) {
