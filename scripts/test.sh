@@ -15,6 +15,8 @@ JOBS=$(nproc)
 total0=$SECONDS
 
 stage "packages" ensure_packages "${RIDGELINE_PACKAGES[@]}" clang-14 libclang-rt-14-dev || exit 1
+# Real DEMs for the loader tests (build/test-data; they skip when it cannot be fetched).
+fetch_test_data
 
 # Khronos' glTF-Validator for the .glb export test, when npm is there (the test skips otherwise).
 install_gltf_validator() {

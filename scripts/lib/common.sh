@@ -31,6 +31,26 @@ ensure_packages() {
   "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" > /dev/null
 }
 
+# fetch_test_data [DIR]: data no one here made, for the tests that read real files (default
+# build/test-data, the tests' RIDGELINE_TEST_EXTERNAL_DATA): Debian's r-cran-terra example
+# rasters (elev.tif: a real DEM in degrees; meuse.tif: one in projected metres), taken from the
+# package without installing R (apt-get download, dpkg -x). Prints a note and returns 0 when the
+# package cannot be fetched: those tests then skip, naming the missing file.
+fetch_test_data() {
+  local dir=${1:-$RIDGELINE_ROOT/build/test-data}
+  local ex=$dir/terra/usr/lib/R/site-library/terra/ex
+  [ -f "$ex/elev.tif" ] && [ -f "$ex/meuse.tif" ] && return 0
+  mkdir -p "$dir"
+  local sudo=()
+  [ "$(id -u)" -eq 0 ] || sudo=(sudo)
+  (cd "$dir" && rm -f r-cran-terra_*.deb &&
+    { apt-get download r-cran-terra > /dev/null 2>&1 ||
+      { "${sudo[@]}" apt-get update -qq > /dev/null && apt-get download r-cran-terra > /dev/null; }; } &&
+    rm -rf terra && dpkg -x r-cran-terra_*.deb terra && rm -f r-cran-terra_*.deb) ||
+    echo "note: could not fetch r-cran-terra; the tests on elev.tif and meuse.tif will be skipped"
+  return 0
+}
+
 # configure_and_build BUILD_DIR [cmake args...]
 configure_and_build() {
   local dir=$1; shift

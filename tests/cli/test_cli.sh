@@ -152,6 +152,45 @@ run info --default-terrain --spacing 4 --origin 100,200 --height-offset 1000
 expect "default terrain placed" 0
 [[ "$(tr -d ' \n' <<< "$out")" == *'"extent":[4096.0,4096.0]'* ]] && ok || bad "placed extent"
 
+# ---- GeoTIFF placement (real DEMs from Debian's r-cran-terra, fetched by scripts/test.sh) ----------
+EX=${EXTERNAL_DATA:-}/terra/usr/lib/R/site-library/terra/ex
+if [ -f "$EX/elev.tif" ] && [ -f "$EX/meuse.tif" ]; then
+  # elev.tif: 1/120-degree cells at 49.8 N, about 598.8 x 926.7 m; 46 % no-data outside Luxembourg.
+  run info --heightmap "$EX/elev.tif"; expect "elev.tif without a fill policy" 1 "(the no-data value)"
+  run info --heightmap "$EX/elev.tif" --fill nearest; expect "info elev.tif" 0
+  sx=$(tr -d ' \n' <<< "$out" | sed -n 's/.*"spacing":\[\([-0-9.e+]*\),\([-0-9.e+]*\)\].*/\1/p')
+  sz=$(tr -d ' \n' <<< "$out" | sed -n 's/.*"spacing":\[\([-0-9.e+]*\),\([-0-9.e+]*\)\].*/\2/p')
+  near "elev.tif spacing x within 1 % of 598.8 m" "$sx" 598.8 5.988
+  near "elev.tif spacing z within 1 % of 926.7 m" "$sz" 926.7 9.267
+  contains "elev.tif spacing source" '"spacing_source": "geotiff"'
+  contains "elev.tif origin source" '"origin_source": "default"'
+  contains "elev.tif pixel type" '"pixel_type": "int16"'
+  contains "elev.tif placement described" 'GeoTIFF geographic (EPSG 4326)'
+  contains "elev.tif filled warning in the output" '3942 of 8550 samples (46.1 %) are filled'
+  [[ "$err" == *"warning:"*"46.1 %"* ]] && ok || bad "elev.tif filled warning logged" "$err"
+  [[ "$err" == *"degrees give no origin in metres"* ]] && ok || bad "loader says the conversion" "$err"
+  run info --heightmap "$EX/elev.tif" --fill nearest --spacing 30
+  expect "info elev.tif --spacing" 0
+  contains "--spacing overrides the file" '"spacing_source": "flag"'
+  [[ "$(tr -d ' \n' <<< "$out")" == *'"spacing":[30.0,30.0]'* ]] && ok || bad "--spacing 30 used"
+  # meuse.tif: projected (RD New), 40 m cells, tie point (178400, 334000) at the corner.
+  run info --heightmap "$EX/meuse.tif" --fill nearest; expect "info meuse.tif" 0
+  [[ "$(tr -d ' \n' <<< "$out")" == *'"spacing":[40.0,40.0]'* ]] && ok || bad "meuse spacing" "$out"
+  [[ "$(tr -d ' \n' <<< "$out")" == *'"origin":[178420.0,-333980.0]'* ]] && ok || bad "meuse origin" "$out"
+  contains "meuse origin source" '"origin_source": "geotiff"'
+  run info --heightmap "$EX/meuse.tif" --fill nearest --origin 0,0; expect "meuse --origin" 0
+  contains "--origin overrides the file" '"origin_source": "flag"'
+  contains "--origin keeps the file's spacing" '"spacing_source": "geotiff"'
+else
+  echo "note: $EX/elev.tif or meuse.tif missing (scripts/test.sh fetches r-cran-terra): GeoTIFF checks skipped"
+fi
+run info --default-terrain; contains "default terrain pixel type" '"pixel_type": "float (generated)"'
+contains "default terrain spacing source" '"spacing_source": "default"'
+run info --heightmap "$T/h.r16" --raw-size 3,2; contains "raw pixel type" '"pixel_type": "u16"'
+run info --heightmap "$T/h.r16" --raw-size 3,2 --nodata 0 --fill nearest
+contains "1 of 6 filled is warned about in the output" '1 of 6 samples (16.7 %) are filled'
+[[ "$err" == *"1 of 6 samples (16.7 %) are filled"* ]] && ok || bad "raw filled warning" "$err"
+
 # ---- query ---------------------------------------------------------------------------------------
 # On the ramp with spacing 10, scale 0.1, offset -50: height = -50 + 100 + x + z / 10 where the
 # terrain is; a plane, so every face normal is (-1, 1, -0.1) / sqrt(2.01).

@@ -20,6 +20,7 @@ struct LoadArgs {
   const char* heightmap = nullptr;  // kept alive by the option table on the stack
   double spacing[2] = {1, 1};
   double origin[2] = {0, 0};
+  bool has_spacing = false, has_origin = false;  // else a GeoTIFF's own placement is used
   double height_scale = 1, height_offset = 0;
   bool has_nodata = false;
   double nodata = 0;
@@ -38,6 +39,8 @@ bool do_load(const ConfigBox& config, const LoadArgs& a, TerrainBox* box, char* 
     p.spacing_z = a.spacing[1];
     p.origin_x = a.origin[0];
     p.origin_z = a.origin[1];
+    options.spacing_from_file = !a.has_spacing;
+    options.origin_from_file = !a.has_origin;
     p.height_scale = a.height_scale;
     p.height_offset = a.height_offset;
     if (a.has_nodata) p.nodata = a.nodata;
@@ -99,12 +102,13 @@ int r_load(lua_State* L) {
     luaL_argerror(L, 1, "field 'heightmap': embedded zero in file name");
   if (lua_getfield(L, 1, "spacing") == LUA_TTABLE) {
     lua_pop(L, 1);
-    get_vector_field(L, 1, "spacing", 2, a.spacing);
+    a.has_spacing = get_vector_field(L, 1, "spacing", 2, a.spacing);
   } else {
     lua_pop(L, 1);
-    if (get_number_field(L, 1, "spacing", &a.spacing[0])) a.spacing[1] = a.spacing[0];
+    a.has_spacing = get_number_field(L, 1, "spacing", &a.spacing[0]);
+    if (a.has_spacing) a.spacing[1] = a.spacing[0];
   }
-  get_vector_field(L, 1, "origin", 2, a.origin);
+  a.has_origin = get_vector_field(L, 1, "origin", 2, a.origin);
   get_number_field(L, 1, "height_scale", &a.height_scale);
   get_number_field(L, 1, "height_offset", &a.height_offset);
   a.has_nodata = get_number_field(L, 1, "nodata", &a.nodata);
