@@ -23,7 +23,7 @@ struct LodArgs {
               slack;
   std::string json_path;
 
-  void add_to(CLI::App& app, bool with_tolerance) {
+  void add_to(CLI::App& app) {
     terrain.add_to(app);
     auto* g = app.add_option_group("Level of detail");
     g->add_option("--patch-exponent", patch_exponent,
@@ -33,11 +33,10 @@ struct LodArgs {
     g->add_option("--triangles", triangles,
                   "Hard cap on leaf triangles (alone: the best mesh of at most N triangles)")
         ->type_name("N");
-    if (with_tolerance)
-      g->add_option("--tolerance", tolerance,
-                    "View-independent mode: every triangle within METRES of the samples under it; "
-                    "whole terrain, no culling")
-          ->type_name("METRES");
+    g->add_option("--tolerance", tolerance,
+                  "View-independent mode: every triangle within METRES of the samples under it; "
+                  "whole terrain, no culling")
+        ->type_name("METRES");
     g->add_option("--budget-ms", budget_ms, "Time budget per update, milliseconds")
         ->type_name("MS");
     g->add_option("--mode", mode, "coherent (split/merge queues) or rebuild (split only, Turner)")
@@ -320,7 +319,7 @@ Command add_mesh_command(CLI::App& parent) {
   auto* app = parent.add_subcommand(
       "mesh", "Converge the ROAM mesh for one view and write it as glTF 2.0 binary (.glb)");
   auto a = std::make_shared<MeshArgs>();
-  a->lod.add_to(*app, true);
+  a->lod.add_to(*app);
   auto* g = app->add_option_group("Camera");
   g->add_option("--eye", a->eye, "Eye position")->type_name("X,Y,Z");
   g->add_option("--target", a->target, "Point looked at")->type_name("X,Y,Z");
@@ -340,7 +339,7 @@ Command add_bench_lod_command(CLI::App& bench) {
   auto* app = bench.add_subcommand(
       "lod", "Run a camera path: per-frame update ms, triangles, splits, merges and error (JSON)");
   auto a = std::make_shared<BenchLodArgs>();
-  a->lod.add_to(*app, false);
+  a->lod.add_to(*app);
   app->add_option("--path", a->path, "Camera path (SPEC.md PATH.json)")->type_name("PATH.json");
   app->add_option("--error-every", a->error_every,
                   "Measure the mesh error every K-th frame (default 1; 0 = never)")
