@@ -109,10 +109,15 @@ struct LodArgs {
   }
 };
 
+// The stop reason as every interface spells it (ridge's JSON, Lua's stats.stop; docs/cli.md).
+const char* stop_name(StopReason stop) {
+  return stop == StopReason::kConverged        ? "converged"
+         : stop == StopReason::kTriangleBudget ? "triangle_budget"
+                                               : "time_budget";
+}
+
 nlohmann::ordered_json stats_json(const RoamStats& s) {
-  const char* stop = s.stop == StopReason::kConverged        ? "converged"
-                     : s.stop == StopReason::kTriangleBudget ? "triangles"
-                                                             : "time";
+  const char* stop = stop_name(s.stop);
   return {{"triangles", s.triangles},
           {"splits", s.splits},
           {"forced_splits", s.forced_splits},
@@ -252,9 +257,7 @@ int run_bench_lod(const BenchLodArgs& a) {
           {"priority_updates", st->priority_updates},
           {"expired", st->expired},
           {"rebuilt", st->rebuilt},
-          {"stopped_by", st->stop == StopReason::kConverged        ? "converged"
-                         : st->stop == StopReason::kTriangleBudget ? "triangles"
-                                                                   : "time"}};
+          {"stopped_by", stop_name(st->stop)}};
       if (*every > 0 && k % *every == 0) {
         const auto e = v.measure_error(c, static_cast<std::uint32_t>(*stride));
         f["max_error"] = e.max_m;
