@@ -32,6 +32,12 @@ void TerrainArgs::add_to(CLI::App& app) {
       ->group(g);
   hm->excludes(dt);
   dt->excludes(hm);
+  // A terrain source is required: a usage error (exit 2) found after parsing, after --help.
+  app.parse_complete_callback([this] {
+    if (!given("--heightmap") && !default_terrain_)
+      throw CLI::RequiredError("no terrain given: pass --heightmap FILE or --default-terrain",
+                               CLI::ExitCodes::RequiredError);
+  });
   app.add_option("--raw-size", raw_size_, "Size of a raw heightmap in samples")
       ->type_name("W,H")
       ->group(g);

@@ -25,7 +25,9 @@ class TerrainArgs {
   /// --default-size and the detail flags (--detail-levels, --detail-seed, --detail-amplitude,
   /// --detail-gain, --detail-flat-shape, --detail-steep-shape, --detail-flat-slope,
   /// --detail-steep-slope, --detail-blur-radius, --detail-budget-mb) to
-  /// `app`, in an option group "Terrain". The object must outlive the parse.
+  /// `app`, in an option group "Terrain". The object must outlive the parse. Sets the app's
+  /// parse_complete_callback: a missing terrain source (neither --heightmap nor
+  /// --default-terrain) is a usage error (CLI::RequiredError, exit 2).
   void add_to(CLI::App& app);
 
   /// The heightfield the flags describe: loaded from --heightmap or generated (--default-terrain),
