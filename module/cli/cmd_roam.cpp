@@ -45,6 +45,12 @@ struct LodArgs {
         ->type_name("F");
     app.add_option("--json", json_path, "Write the JSON to FILE instead of standard output")
         ->type_name("FILE");
+    // Without any of the three there is nothing to tessellate for: a usage error (exit 2).
+    app.callback([this] {
+      if (threshold.empty() && triangles.empty() && tolerance.empty())
+        throw CLI::RequiredError("give --threshold PX, --triangles N or --tolerance METRES",
+                                 CLI::ExitCodes::RequiredError);
+    });
   }
 
   Result<RoamSettings> settings() const {
@@ -143,7 +149,7 @@ int run_mesh(const MeshArgs& a) {
   const bool tolerance = !a.lod.tolerance.empty();
   if (!tolerance || !a.eye.empty()) {
     if (a.eye.empty() || a.target.empty())
-      return report_error("give --eye X,Y,Z and --target X,Y,Z (or --tolerance alone)");
+      return report_usage("give --eye X,Y,Z and --target X,Y,Z (or --tolerance alone)");
     auto e = parse_finite_list(a.eye, "--eye", 3, 3);
     if (!e) return report_error(e.error().message);
     auto t = parse_finite_list(a.target, "--target", 3, 3);
@@ -257,7 +263,8 @@ int run_bench_lod(const BenchLodArgs& a) {
           {"priority_updates", st->priority_updates},
           {"expired", st->expired},
           {"rebuilt", st->rebuilt},
-          {"stopped_by", stop_name(st->stop)}};
+          {"stopped_by", stop_name(st->stop)},
+      };
       if (*every > 0 && k % *every == 0) {
         const auto e = v.measure_error(c, static_cast<std::uint32_t>(*stride));
         f["max_error"] = e.max_m;
@@ -332,7 +339,7 @@ Command add_mesh_command(CLI::App& parent) {
   g->add_option("--viewport", a->viewport, "Viewport in pixels (default 1280,720)")
       ->type_name("W,H");
   g->add_option("--far", a->far, "Far plane, metres (default 50000)")->type_name("M");
-  app->add_option("--out", a->out, "Output .glb file")->type_name("FILE.glb");
+  app->add_option("--out", a->out, "Output .glb file")->type_name("FILE.glb")->required();
   app->add_flag("--include-padding", a->include_padding,
                 "Also write triangles over the edge padding of the last patches");
   return {app, [a] { return run_mesh(*a); }};
@@ -343,7 +350,9 @@ Command add_bench_lod_command(CLI::App& bench) {
       "lod", "Run a camera path: per-frame update ms, triangles, splits, merges and error (JSON)");
   auto a = std::make_shared<BenchLodArgs>();
   a->lod.add_to(*app);
-  app->add_option("--path", a->path, "Camera path (SPEC.md PATH.json)")->type_name("PATH.json");
+  app->add_option("--path", a->path, "Camera path (PATH.json, docs/cli.md)")
+      ->type_name("PATH.json")
+      ->required();
   app->add_option("--error-every", a->error_every,
                   "Measure the mesh error every K-th frame (default 1; 0 = never)")
       ->type_name("K");

@@ -61,12 +61,45 @@ for s in info query profile bench "bench queries"; do
   run $s --help; expect "ridge $s --help" 0
 done
 run info --help; contains "info --help shows the terrain flags" "--raw-size"
-run; expect "no subcommand" 2
-run frobnicate; expect "unknown subcommand" 2
-run info --default-terrain --no-such-flag; expect "unknown flag" 2
+run; expect "no subcommand" 2 "A subcommand is required"
+run --version; expect "ridge --version" 0
+[[ "$out" =~ ^ridge\ [0-9]+\.[0-9]+\.[0-9]+$ ]] && ok || bad "--version prints 'ridge X.Y.Z'" "$out"
+run frobnicate; expect "unknown subcommand" 2 "unknown subcommand 'frobnicate' of ridge"
+[[ "$err" == *"info, query, profile"* ]] && ok || bad "unknown subcommand lists the subcommands" "$err"
+run bench frobnicate --default-terrain; expect "unknown benchmark" 2 "unknown subcommand 'frobnicate' of ridge bench"
+run info --default-terrain --no-such-flag; expect "unknown flag" 2 "--no-such-flag (see ridge info --help)"
 run bench --default-terrain; expect "bench without a benchmark" 2
 run info --default-terrain --heightmap "$PNG"; expect "--heightmap with --default-terrain" 2
-run info; expect "no terrain" 1 "no terrain given"
+# Missing required flags are usage errors (exit 2), as docs/cli.md says.
+run info; expect "no terrain" 2 "no terrain given: pass --heightmap FILE or --default-terrain"
+run info --help; expect "--help without a terrain" 0
+run mesh --default-terrain --threshold 2; expect "mesh without --out" 2 "--out is required"
+run mesh --default-terrain --out "$T/m.glb"; expect "mesh without a LOD setting" 2 "give --threshold PX, --triangles N or --tolerance METRES"
+run mesh --default-terrain --threshold 2 --out "$T/m.glb"; expect "mesh without a camera" 2 "give --eye X,Y,Z and --target X,Y,Z"
+run bench lod --default-terrain --threshold 2; expect "bench lod without --path" 2 "--path is required"
+run bench lod --default-terrain --path "$TEST_DATA/paths/flyover.json"; expect "bench lod without a LOD setting" 2 "--tolerance METRES"
+
+# ---- output files ----------------------------------------------------------------------------------
+run info --default-terrain --json "$T/no/such/dir/info.json"
+expect "--json into a missing folder" 1 "the folder '$T/no/such/dir' does not exist"
+run mesh --default-terrain --tolerance 20 --out "$T/no/such/dir/x.glb"
+expect "--out into a missing folder" 1 "the folder '$T/no/such/dir' does not exist"
+[ ! -e "$T/no" ] && ok || bad "nothing created for a missing folder"
+
+# ---- mesh and bench lod: --tolerance, the stop reason --------------------------------------------
+run bench lod --default-terrain --path "$TEST_DATA/paths/flyover.json" --tolerance 4 --error-every 0
+expect "bench lod --tolerance" 0
+contains "bench lod --tolerance converges" '"stopped_by": "converged"'
+tris_tol=$(json_num triangles_median)
+run mesh --default-terrain --tolerance 4 --out "$T/tol.glb"; expect "mesh --tolerance" 0
+near "bench lod --tolerance gives the view-independent mesh of ridge mesh" "$(json_num triangles)" "$tris_tol" 0
+run bench lod --default-terrain --path "$TEST_DATA/paths/flyover.json" --triangles 2000 --error-every 0
+expect "bench lod --triangles" 0
+contains "triangle cap stop reason" '"stopped_by": "triangle_budget"'
+[[ "$out" != *'"stopped_by": "triangles"'* ]] && ok || bad "old stop reason spelling" "$out"
+run mesh --default-terrain --eye 100,290,100 --target 600,170,500 --triangles 2000 --out "$T/capped.glb"
+expect "mesh --triangles" 0
+contains "mesh stop reason" '"stopped_by": "triangle_budget"'
 
 # ---- info ----------------------------------------------------------------------------------------
 run info --default-terrain; expect "info default" 0
