@@ -28,7 +28,7 @@ install_gltf_validator() {
 }
 
 release() {
-  configure_and_build build/release -DCMAKE_BUILD_TYPE=Release || return 1
+  build_release || return 1
   install_gltf_validator build/release
   # Under Xvfb when there is no display: the game's OpenGL tests need an X server for GLFW
   # (they skip with exit 77 where no context can be made; EGL needs none).

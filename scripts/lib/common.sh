@@ -60,6 +60,24 @@ configure_and_build() {
   cmake --build "$dir" -j "$(nproc)"
 }
 
+# The one Release build every script and the README's commands share: build/release, configured
+# with the defaults (everything on), so that no script's options undo another's.
+RIDGELINE_RELEASE_DIR=build/release
+RIDGELINE_RELEASE_ARGS=(-DCMAKE_BUILD_TYPE=Release -DRIDGELINE_BUILD_TESTS=ON
+  -DRIDGELINE_BUILD_BENCHMARKS=ON -DRIDGELINE_BUILD_TOOLS=ON -DRIDGELINE_BUILD_LUA=ON
+  -DRIDGELINE_BUILD_GAME=ON)
+
+# build_release [TARGET...]: configures build/release and builds the given targets (all when
+# none is given).
+build_release() {
+  local dir=$RIDGELINE_ROOT/$RIDGELINE_RELEASE_DIR targets=()
+  [ $# -gt 0 ] && targets=(--target "$@")
+  mkdir -p "$dir"
+  cmake -S "$RIDGELINE_ROOT" -B "$dir" -G Ninja "${RIDGELINE_RELEASE_ARGS[@]}" \
+    > "$dir.configure.log" 2>&1 || { cat "$dir.configure.log"; return 1; }
+  cmake --build "$dir" -j "$(nproc)" "${targets[@]}"
+}
+
 # stage NAME COMMAND...: runs a stage and prints its wall time.
 stage() {
   local name=$1; shift
