@@ -23,7 +23,7 @@ struct LodArgs {
               slack;
   std::string json_path;
 
-  void add_to(CLI::App& app, bool with_tolerance) {
+  void add_to(CLI::App& app) {
     terrain.add_to(app);
     auto* g = app.add_option_group("Level of detail");
     g->add_option("--patch-exponent", patch_exponent,
@@ -33,11 +33,10 @@ struct LodArgs {
     g->add_option("--triangles", triangles,
                   "Hard cap on leaf triangles (alone: the best mesh of at most N triangles)")
         ->type_name("N");
-    if (with_tolerance)
-      g->add_option("--tolerance", tolerance,
-                    "View-independent mode: every triangle within METRES of the samples under it; "
-                    "whole terrain, no culling")
-          ->type_name("METRES");
+    g->add_option("--tolerance", tolerance,
+                  "View-independent mode: every triangle within METRES of the samples under it; "
+                  "whole terrain, no culling")
+        ->type_name("METRES");
     g->add_option("--budget-ms", budget_ms, "Time budget per update, milliseconds")
         ->type_name("MS");
     g->add_option("--mode", mode, "coherent (split/merge queues) or rebuild (split only, Turner)")
@@ -46,6 +45,12 @@ struct LodArgs {
         ->type_name("F");
     app.add_option("--json", json_path, "Write the JSON to FILE instead of standard output")
         ->type_name("FILE");
+    // Without any of the three there is nothing to tessellate for: a usage error (exit 2).
+    app.callback([this] {
+      if (threshold.empty() && triangles.empty() && tolerance.empty())
+        throw CLI::RequiredError("give --threshold PX, --triangles N or --tolerance METRES",
+                                 CLI::ExitCodes::RequiredError);
+    });
   }
 
   Result<RoamSettings> settings() const {
@@ -110,10 +115,15 @@ struct LodArgs {
   }
 };
 
+// The stop reason as every interface spells it (ridge's JSON, Lua's stats.stop; docs/cli.md).
+const char* stop_name(StopReason stop) {
+  return stop == StopReason::kConverged        ? "converged"
+         : stop == StopReason::kTriangleBudget ? "triangle_budget"
+                                               : "time_budget";
+}
+
 nlohmann::ordered_json stats_json(const RoamStats& s) {
-  const char* stop = s.stop == StopReason::kConverged        ? "converged"
-                     : s.stop == StopReason::kTriangleBudget ? "triangles"
-                                                             : "time";
+  const char* stop = stop_name(s.stop);
   return {{"triangles", s.triangles},
           {"splits", s.splits},
           {"forced_splits", s.forced_splits},
@@ -139,7 +149,7 @@ int run_mesh(const MeshArgs& a) {
   const bool tolerance = !a.lod.tolerance.empty();
   if (!tolerance || !a.eye.empty()) {
     if (a.eye.empty() || a.target.empty())
-      return report_error("give --eye X,Y,Z and --target X,Y,Z (or --tolerance alone)");
+      return report_usage("give --eye X,Y,Z and --target X,Y,Z (or --tolerance alone)");
     auto e = parse_finite_list(a.eye, "--eye", 3, 3);
     if (!e) return report_error(e.error().message);
     auto t = parse_finite_list(a.target, "--target", 3, 3);
@@ -253,9 +263,8 @@ int run_bench_lod(const BenchLodArgs& a) {
           {"priority_updates", st->priority_updates},
           {"expired", st->expired},
           {"rebuilt", st->rebuilt},
-          {"stopped_by", st->stop == StopReason::kConverged        ? "converged"
-                         : st->stop == StopReason::kTriangleBudget ? "triangles"
-                                                                   : "time"}};
+          {"stopped_by", stop_name(st->stop)},
+      };
       if (*every > 0 && k % *every == 0) {
         const auto e = v.measure_error(c, static_cast<std::uint32_t>(*stride));
         f["max_error"] = e.max_m;
@@ -320,7 +329,7 @@ Command add_mesh_command(CLI::App& parent) {
   auto* app = parent.add_subcommand(
       "mesh", "Converge the ROAM mesh for one view and write it as glTF 2.0 binary (.glb)");
   auto a = std::make_shared<MeshArgs>();
-  a->lod.add_to(*app, true);
+  a->lod.add_to(*app);
   auto* g = app->add_option_group("Camera");
   g->add_option("--eye", a->eye, "Eye position")->type_name("X,Y,Z");
   g->add_option("--target", a->target, "Point looked at")->type_name("X,Y,Z");
@@ -330,7 +339,7 @@ Command add_mesh_command(CLI::App& parent) {
   g->add_option("--viewport", a->viewport, "Viewport in pixels (default 1280,720)")
       ->type_name("W,H");
   g->add_option("--far", a->far, "Far plane, metres (default 50000)")->type_name("M");
-  app->add_option("--out", a->out, "Output .glb file")->type_name("FILE.glb");
+  app->add_option("--out", a->out, "Output .glb file")->type_name("FILE.glb")->required();
   app->add_flag("--include-padding", a->include_padding,
                 "Also write triangles over the edge padding of the last patches");
   return {app, [a] { return run_mesh(*a); }};
@@ -340,8 +349,10 @@ Command add_bench_lod_command(CLI::App& bench) {
   auto* app = bench.add_subcommand(
       "lod", "Run a camera path: per-frame update ms, triangles, splits, merges and error (JSON)");
   auto a = std::make_shared<BenchLodArgs>();
-  a->lod.add_to(*app, false);
-  app->add_option("--path", a->path, "Camera path (SPEC.md PATH.json)")->type_name("PATH.json");
+  a->lod.add_to(*app);
+  app->add_option("--path", a->path, "Camera path (PATH.json, docs/cli.md)")
+      ->type_name("PATH.json")
+      ->required();
   app->add_option("--error-every", a->error_every,
                   "Measure the mesh error every K-th frame (default 1; 0 = never)")
       ->type_name("K");

@@ -31,7 +31,9 @@ struct ConfigBox {
   bool confine_paths = false;
   std::uint64_t max_samples = 0;
   char root[4096] = {};
-  std::shared_ptr<Terrain> default_terrain;  // built once, shared by default_terrain()
+  // Built on the first default_terrain() call and never handed out: every call returns a clone,
+  // so one script's craters never reach another's terrain.
+  std::shared_ptr<const Terrain> default_terrain;
 };
 
 /// A terrain userdata. Released: `terrain` is empty.
@@ -54,7 +56,8 @@ struct ViewBox {
 /// Copies `text` into `err` (kErrSize bytes), truncating.
 void copy_error(char* err, const char* text) noexcept;
 
-/// luaL_checknumber that also refuses NaN and infinities ("finite number expected, got nan").
+/// A number argument: refuses every other type, strings that look like numbers included
+/// ("number expected, got string"), and NaN and infinities ("finite number expected, got nan").
 double check_finite(lua_State* L, int arg);
 /// Optional finite number: `def` when the argument is none or nil.
 double opt_finite(lua_State* L, int arg, double def);

@@ -132,7 +132,8 @@ int t_raycast(lua_State* L) {
   for (int i = 0; i < 6; ++i) v[i] = check_finite(L, i + 2);
   double max = INFINITY;
   if (!lua_isnoneornil(L, 8)) {
-    max = luaL_checknumber(L, 8);
+    if (lua_type(L, 8) != LUA_TNUMBER) luaL_typeerror(L, 8, "number");
+    max = lua_tonumber(L, 8);
     if (std::isnan(max)) luaL_argerror(L, 8, "number or math.huge expected, got nan");
   }
   const std::optional<RayHit> hit = t.raycast({v[0], v[1], v[2]}, {v[3], v[4], v[5]}, max);
@@ -253,8 +254,8 @@ int t_contacts(lua_State* L) {
     for (int c = 0; c < 2; ++c) {
       int isnum = 0;
       if (lua_type(L, -1) == LUA_TTABLE) {
-        lua_rawgeti(L, -1, c + 1);
-        o[c] = lua_tonumberx(L, -1, &isnum);
+        isnum = lua_rawgeti(L, -1, c + 1) == LUA_TNUMBER;  // no string coercion
+        o[c] = lua_tonumber(L, -1);
         lua_pop(L, 1);
       }
       if (!isnum || !std::isfinite(o[c]))

@@ -33,6 +33,17 @@ int add_view(tinygltf::Model& model, const void* data, std::size_t bytes, int ta
 
 Status write_glb(RoamView& view, const std::string& path, const GltfExportOptions& options) {
   if (path.empty()) return Error{"glTF export: empty output path"};
+  {  // A missing folder is named as such (the writer would only fail at the rename).
+    const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+    std::error_code ec;
+    const auto type = std::filesystem::status(folder, ec).type();
+    if (!folder.empty() && type == std::filesystem::file_type::not_found)
+      return Error{fmt("glTF export '%s': the folder '%s' does not exist", path.c_str(),
+                       folder.string().c_str())};
+    if (!folder.empty() && !ec && type != std::filesystem::file_type::directory)
+      return Error{
+          fmt("glTF export '%s': '%s' is not a folder", path.c_str(), folder.string().c_str())};
+  }
   tinygltf::Model model;
   model.asset.version = "2.0";
   model.asset.generator = "Ridgeline";
@@ -117,11 +128,13 @@ Status write_glb(RoamView& view, const std::string& path, const GltfExportOption
 
   const std::string tmp = path + ".tmp";
   tinygltf::TinyGLTF writer;
-  if (!writer.WriteGltfSceneToFile(&model, tmp, true, true, false, true)) {
-    std::remove(tmp.c_str());
-    return Error{fmt("glTF export '%s': cannot write", path.c_str())};
-  }
   std::error_code ec;
+  // tinygltf reports success for some failed writes: check that the file is there.
+  if (!writer.WriteGltfSceneToFile(&model, tmp, true, true, false, true) ||
+      std::filesystem::file_size(tmp, ec) == 0 || ec) {
+    std::remove(tmp.c_str());
+    return Error{fmt("glTF export '%s': cannot write '%s'", path.c_str(), tmp.c_str())};
+  }
   std::filesystem::rename(tmp, path, ec);
   if (ec) {
     std::remove(tmp.c_str());
