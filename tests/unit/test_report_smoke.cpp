@@ -33,7 +33,8 @@ TEST(ReportSmoke, JsonAndCsvAreCompleteAndSane) {
   const json r = json::parse(slurp(out + "/report.json"));
   ASSERT_TRUE(r["smoke"].get<bool>());
 
-  // Every scene, path and setting has the four modes with finite figures.
+  // Every scene, path and setting has the five modes (the storm four: no SOAR) with finite
+  // figures.
   std::size_t rows = 0;
   auto check_scene = [&](const json& sc, bool all_paths, bool storm = false) {
     SCOPED_TRACE(sc["name"].get<std::string>());
@@ -43,19 +44,32 @@ TEST(ReportSmoke, JsonAndCsvAreCompleteAndSane) {
       for (const json& st : p["settings"]) {
         const std::string kind = st["kind"];
         const double value = st["value"];
-        ASSERT_EQ(st["modes"].size(), 4u);
+        ASSERT_EQ(st["modes"].size(), storm ? 4u : 5u);
         std::map<std::string, json> m;
         for (const json& x : st["modes"]) m[x["mode"]] = x;
-        for (const char* name : {"roam_coherent", "roam_rebuild", "uniform_grid", "cdlod"}) {
+        for (const char* name :
+             {"roam_coherent", "roam_rebuild", "uniform_grid", "cdlod", "soar"}) {
           SCOPED_TRACE(name);
+          if (storm && std::string(name) == "soar") continue;
           ASSERT_TRUE(m.count(name));
           const json& x = m[name];
           ++rows;
           for (const char* f :
-               {"triangles_median", "update_ms_median", "update_ms_p99", "changes_per_frame_median",
-                "error_max_m", "error_rms_m", "screen_error_max_px", "screen_error_p99_px",
-                "popping_max_px", "memory_bytes"})
+               {"triangles_median", "triangles_in_view_median", "update_ms_median", "update_ms_p99",
+                "update_cpu_ms_median", "error_max_m", "error_rms_m", "screen_error_max_px",
+                "screen_error_p99_px", "popping_max_px", "pop_max_px", "memory_bytes"})
             EXPECT_TRUE(finite_number(x[f])) << f << " = " << x[f];
+          if (std::string(name) != "soar") {
+            EXPECT_TRUE(finite_number(x["changes_per_frame_median"])) << x;
+          }
+          EXPECT_LE(x["triangles_in_view_median"].get<double>(),
+                    x["triangles_median"].get<double>() + 1e-9);
+          // A geomorphing mode reports its morphed error and its morphed jump and pop.
+          const bool morphs = std::string(name) == "cdlod" ||
+                              (std::string(name).rfind("roam_", 0) == 0 && kind != "triangles");
+          for (const char* f :
+               {"screen_error_geomorph_max_px", "popping_geomorph_max_px", "pop_geomorph_max_px"})
+            EXPECT_EQ(finite_number(x[f]), morphs) << f << " = " << x[f];
           EXPECT_GT(x["measured_frames"].get<int>(), 0);
           EXPECT_GT(x["measured_vertices_median"].get<double>(), 0);
           EXPECT_EQ(x["uncovered_vertices"].get<int>(), 0) << "holes in the drawn mesh";
@@ -85,6 +99,9 @@ TEST(ReportSmoke, JsonAndCsvAreCompleteAndSane) {
           EXPECT_GT(m["uniform_grid"]["popping_max_px"].get<double>(), 0.0);
         } else {
           EXPECT_EQ(m["uniform_grid"]["popping_max_px"].get<double>(), 0.0);
+          EXPECT_EQ(m["uniform_grid"]["pop_max_px"].get<double>(), 0.0);
+          // SOAR refines at the same threshold (or to the same triangle count).
+          EXPECT_GT(m["soar"]["triangles_median"].get<double>(), 0.0);
         }
       }
     }
@@ -106,7 +123,7 @@ TEST(ReportSmoke, JsonAndCsvAreCompleteAndSane) {
         EXPECT_GT(m["tiles_resident_max"].get<double>(), 0) << m;
         EXPECT_GT(m["detail_memory_bytes_median"].get<double>(), 0) << m;
         EXPECT_GT(m["tiles_generated"].get<double>(), 0) << m;
-        EXPECT_TRUE(m["popping_geomorph_max_px"].is_null()) << m;
+        EXPECT_TRUE(finite_number(m["pop_geomorph_max_px"])) << m;  // measured there too
       }
   // The deformation storm: craters every frame, flyover and drive; apply_edit timed per mode.
   const json& storm = r["scenes"][2];
@@ -146,11 +163,11 @@ TEST(ReportSmoke, JsonAndCsvAreCompleteAndSane) {
       << hard["huge_f32"]["loader_messages"];
   EXPECT_FALSE(r.contains("not_done"));
 
-  // CSV: one row per scene, path, setting and mode, 17 fields, no header.
+  // CSV: one row per scene, path, setting and mode, 23 fields, no header.
   std::ifstream csv(out + "/report.csv");
   std::size_t lines = 0;
   for (std::string line; std::getline(csv, line); ++lines) {
-    EXPECT_EQ(std::count(line.begin(), line.end(), ','), 16) << line;
+    EXPECT_EQ(std::count(line.begin(), line.end(), ','), 22) << line;
     if (lines == 0) {
       EXPECT_EQ(line.rfind("synthetic129,flyover,threshold,2,roam_coherent,", 0), 0u) << line;
     }
