@@ -5,6 +5,7 @@
 #include <cmath>
 #include <memory>
 
+#include "bench_soar.h"
 #include "cli_util.h"
 #include "commands.h"
 #include "ridgeline/camera_path.h"
@@ -40,7 +41,9 @@ struct LodArgs {
           ->type_name("METRES");
     g->add_option("--budget-ms", budget_ms, "Time budget per update, milliseconds")
         ->type_name("MS");
-    g->add_option("--mode", mode, "coherent (split/merge queues) or rebuild (split only, Turner)")
+    g->add_option("--mode", mode,
+                  "coherent (split/merge queues) or rebuild (split only, Turner); bench lod "
+                  "also soar (the stateless SOAR comparator)")
         ->type_name("MODE");
     g->add_option("--slack", slack, "Priority window as a fraction of distance (default 0.05)")
         ->type_name("F");
@@ -210,6 +213,10 @@ double percentile(std::vector<double> v, double q) {
 }
 
 int run_bench_lod(const BenchLodArgs& a) {
+  if (a.lod.mode == "soar")  // the stateless comparator (bench_soar.h)
+    return run_bench_lod_soar({&a.lod.terrain, a.path, a.lod.threshold, a.lod.triangles,
+                               a.lod.budget_ms, a.error_every, a.error_stride, a.warmup, a.repeat,
+                               a.lod.json_path});
   if (a.path.empty()) return report_error("give --path PATH.json");
   auto frames = io::load_camera_path(a.path);
   if (!frames) return report_error(frames.error().message);
