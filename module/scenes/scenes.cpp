@@ -44,6 +44,26 @@ Result<Heightfield> shaped(Shape shape, std::uint32_t n, double spacing, double 
   return field(d, [&](int i, int j) { return shape_height(shape, n, i, j); });
 }
 
+Result<Heightfield> flight_world() {
+  DefaultTerrainParams p;
+  p.size = 3126;
+  auto base = make_default_heightfield(p);
+  if (!base) return base.error();
+  std::vector<std::uint8_t> mats;
+  mats.reserve(std::size_t{p.size - 1} * (p.size - 1));
+  for (std::uint32_t j = 0; j + 1 < p.size; ++j)
+    for (std::uint32_t i = 0; i + 1 < p.size; ++i) mats.push_back(base->material(i, j));
+  const Heightfield& b = *base;
+  return field(
+      {.width = p.size,
+       .height = p.size,
+       .spacing_x = 32,
+       .spacing_z = 32,
+       .name = "default terrain"},
+      [&](int i, int j) { return 4.0 * double(b.local(std::uint32_t(i), std::uint32_t(j))); },
+      mats);
+}
+
 namespace {
 constexpr std::uint64_t kMask = 0xffffffffu;
 

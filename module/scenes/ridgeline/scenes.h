@@ -45,6 +45,11 @@ double shape_height(Shape shape, std::uint32_t n, int i, int j);
 Result<Heightfield> shaped(Shape shape, std::uint32_t n, double spacing, double origin = 0,
                            const std::string& name = "synthetic");
 
+/// The world of the detail flight benchmark (`ridge bench detail --default-terrain --default-size
+/// 3126 --spacing 32 --height-scale 4`): the built-in default terrain at 3126 x 3126 samples,
+/// 32 m apart (100 km square), heights x 4, with its materials.
+Result<Heightfield> flight_world();
+
 // ---- the peers' noise field and circle path ------------------------------------------------
 // The inputs other terrain systems were measured on (figures quoted in docs/benchmarks.md): a
 // 1025 x 1025 value-noise field of 8 octaves (frequency 1/256 per sample doubling per octave,
