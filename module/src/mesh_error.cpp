@@ -36,27 +36,21 @@ DrawnMesh leaves_mesh(const RoamView& view) {
 
 MeshErrorMeter::MeshErrorMeter(const Terrain& terrain, std::uint32_t stride)
     : terrain_(&terrain), stride_(std::max<std::uint32_t>(stride, 1)) {
-  const Heightfield& hf = terrain.heightfield();
   const double f = double(std::uint64_t{1} << terrain.detail_levels());
-  width_ = terrain.fine_width();
-  height_ = terrain.fine_height();
-  spacing_x_ = hf.spacing_x() / f;
-  spacing_z_ = hf.spacing_z() / f;
-  origin_x_ = hf.origin_x();
-  origin_z_ = hf.origin_z();
-  offset_ = hf.height_offset();
-  nx_ = sampled(width_, stride_);
-  nz_ = sampled(height_, stride_);
-  surface_.assign(std::size_t(nx_) * nz_, 0.0);
-  if (nx_ && nz_) read(0, 0, nx_ - 1, nz_ - 1);
+  init(terrain.heightfield(), terrain.fine_width(), terrain.fine_height(), f);
 }
 
 MeshErrorMeter::MeshErrorMeter(const Heightfield& hf, std::uint32_t stride)
     : heightfield_(&hf), stride_(std::max<std::uint32_t>(stride, 1)) {
-  width_ = hf.width();
-  height_ = hf.height();
-  spacing_x_ = hf.spacing_x();
-  spacing_z_ = hf.spacing_z();
+  init(hf, hf.width(), hf.height(), 1.0);
+}
+
+void MeshErrorMeter::init(const Heightfield& hf, std::int64_t width, std::int64_t height,
+                          double subdivision) {
+  width_ = width;
+  height_ = height;
+  spacing_x_ = hf.spacing_x() / subdivision;
+  spacing_z_ = hf.spacing_z() / subdivision;
   origin_x_ = hf.origin_x();
   origin_z_ = hf.origin_z();
   offset_ = hf.height_offset();

@@ -92,15 +92,17 @@ void run_mode(const MeshErrorMeter& meter, const std::vector<Camera>& frames, co
       // serves both the per-vertex jump and the pop.
       meter.rasterize(before(frames[k - 1], false), prev);
       r.jump.push_back(meter.jump_px(prev, now, c, &frames[k - 1]));
-      r.pop.push_back(meter.jump_px(prev, now, c));
+      r.pop.push_back(meter.jump_px(prev, now, c, &frames[k - 1]));
       if (r.has_morph) {
         meter.rasterize(cur(c, true), now_m);
         r.morph_max_px.push_back(meter.measure(now_m, c).max_px);
         meter.rasterize(before(frames[k - 1], true), prev_m);
         r.jump_morph.push_back(meter.jump_px(prev_m, now_m, c, &frames[k - 1]));
-        // The pop: both meshes morphed for the current camera, so only the topology differs.
+        // The pop: both meshes morphed for the current camera, so only the topology differs;
+        // over the vertices in view in both frames, like the jump (a region coming into view
+        // refines unseen).
         meter.rasterize(before(c, true), prev_m);
-        r.pop_morph.push_back(meter.jump_px(prev_m, now_m, c));
+        r.pop_morph.push_back(meter.jump_px(prev_m, now_m, c, &frames[k - 1]));
       }
     }
     r.measure_s += ms_since(t_measure) / 1000;

@@ -121,6 +121,7 @@ class MeshErrorMeter {
   std::uint64_t triangles_in_view(const DrawnMesh& mesh, const Camera& camera) const;
 
  private:
+  void init(const Heightfield& hf, std::int64_t width, std::int64_t height, double subdivision);
   void read(std::uint32_t k0, std::uint32_t l0, std::uint32_t k1, std::uint32_t l1);
   MeshError finish(std::vector<float>& px, double sum2, MeshError out) const;
 
