@@ -62,6 +62,11 @@ int run_bench_lod_soar(const SoarBenchArgs& a) {
   // The vertex data (heights, nested errors and radii) of the finest lattice: the preprocess,
   // reported apart like ROAM's bounds.
   const auto t_pre = Clock::now();
+  if (std::max(t.fine_width(), t.fine_height()) > std::int64_t{report::Soar::kMaxSide})
+    return report_error("--mode soar: the finest lattice is " + std::to_string(t.fine_width()) +
+                        " x " + std::to_string(t.fine_height()) +
+                        " vertices; the comparator takes at most " +
+                        std::to_string(report::Soar::kMaxSide) + " per side");
   std::shared_ptr<const Heightfield> fine;
   if (t.detail_levels() > 0) {
     auto hf = report::finest_lattice(t);

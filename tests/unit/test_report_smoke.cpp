@@ -178,4 +178,51 @@ TEST(ReportSmoke, JsonAndCsvAreCompleteAndSane) {
   EXPECT_EQ(lines, rows);
 }
 
+// `ridge report --write-noise-field` and `ridge bench lod --mode soar` end to end: the files load
+// as the peers' inputs, the SOAR mode prints the same summary fields as the ROAM modes, and every
+// bad input is refused naming the flag.
+TEST(BenchLodSoar, RunsOnTheNoiseFieldAndRefusesBadInput) {
+  const std::string dir = std::string(RIDGELINE_TEST_TMP) + "/soar_bench";
+  const std::string log = dir + ".log";
+  const std::string ridge = RIDGE;
+  ASSERT_EQ(std::system((ridge + " report --write-noise-field " + dir + " 2> " + log).c_str()), 0)
+      << slurp(log);
+  const std::string terrain = " --heightmap " + dir + "/noise1025.png --spacing 1 --height-scale " +
+                              "0.005 --path " + dir + "/noise1025_circle.json";
+  const std::string cmd = ridge + " bench lod" + terrain +
+                          " --mode soar --threshold 2.048 --error-every 40 --json " + dir +
+                          "/soar.json 2> " + log;
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << slurp(log);
+  const json s = json::parse(slurp(dir + "/soar.json"))["summary"];
+  EXPECT_EQ(s["mode"], "soar");
+  EXPECT_EQ(s["frames"], 360);
+  for (const char* f :
+       {"update_ms_median", "update_cpu_ms_median", "triangles_median", "triangles_in_view_median",
+        "rms_error_median", "max_error_max", "output_ms_median", "upload_bytes_median"})
+    EXPECT_TRUE(finite_number(s[f])) << f << " = " << s[f];
+  // The peers' nu = 250 setting: 20.8k triangles and 0.64 m RMS (within 5 %).
+  EXPECT_NEAR(s["triangles_median"].get<double>() / 20800.0, 1.0, 0.05);
+  EXPECT_NEAR(s["rms_error_median"].get<double>() / 0.64, 1.0, 0.05);
+  EXPECT_LE(s["triangles_in_view_median"].get<double>(), s["triangles_median"].get<double>());
+  // The whole strip every frame: at least one 4-byte index per triangle.
+  EXPECT_GT(s["upload_bytes_median"].get<double>(), 4 * s["triangles_median"].get<double>());
+  // Bad input: each refused with a message naming the flag, exit code non-zero.
+  const std::pair<const char*, const char*> bad[] = {
+      {" --mode soar --threshold 2 --budget-ms 1", "--budget-ms"},
+      {" --mode soar", "--threshold"},
+      {" --mode soar --triangles 0", "--triangles"},
+      {" --mode soar --threshold -1", "--threshold"},
+      {" --mode soar --threshold 2 --error-stride 0", "--error-stride"}};
+  for (const auto& [flags, word] : bad) {
+    const int rc = std::system((ridge + " bench lod" + terrain + flags + " 2> " + log).c_str());
+    EXPECT_NE(rc, 0) << flags;
+    EXPECT_NE(slurp(log).find(word), std::string::npos) << flags << ": " << slurp(log);
+  }
+  const int rc = std::system((ridge + " bench lod --default-terrain --detail-levels 4 --path " +
+                              dir + "/noise1025_circle.json --mode soar --threshold 2 2> " + log)
+                                 .c_str());
+  EXPECT_NE(rc, 0);
+  EXPECT_NE(slurp(log).find("at most 8193"), std::string::npos) << slurp(log);
+}
+
 }  // namespace

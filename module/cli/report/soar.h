@@ -25,9 +25,14 @@ namespace ridgeline::report {
 
 class Soar {
  public:
+  /// Largest lattice side the comparator takes (vertex indices are 32-bit; 8193^2 vertices hold
+  /// 1.3 GB of vertex records).
+  static constexpr std::uint32_t kMaxSide = 8193;
+
   /// Builds the vertex data of `hf` (or of a terrain's finest lattice baked into one): a grid of
   /// (2^n + 1)^2 vertices covering it (the smallest such; samples beyond the heightfield repeat
   /// its edge samples, the padding rule), their heights, and the nested errors and radii.
+  /// Precondition: both sides of `hf` at most kMaxSide (callers check; see bench_soar.cpp).
   explicit Soar(const Heightfield& hf);
 
   /// Result of one refinement.
