@@ -25,7 +25,6 @@ double percentile(std::vector<double> v, double q) {
 }  // namespace
 
 int run_bench_lod_soar(const SoarBenchArgs& a) {
-  if (a.path.empty()) return report_error("give --path PATH.json");
   if (!a.budget_ms.empty())
     return report_error("--budget-ms: the soar mode has no time budget (one full pass a frame)");
   if (a.threshold.empty() && a.triangles.empty())
@@ -43,21 +42,11 @@ int run_bench_lod_soar(const SoarBenchArgs& a) {
     if (!n) return report_error(n.error().message);
     cap = *n;
   }
-  auto frames = io::load_camera_path(a.path);
-  if (!frames) return report_error(frames.error().message);
-  auto every = parse_count(a.error_every, "--error-every", 0, 1000000);
-  if (!every) return report_error(every.error().message);
-  auto stride = parse_count(a.error_stride, "--error-stride", 1, 1024);
-  if (!stride) return report_error(stride.error().message);
-  auto warmup = parse_count(a.warmup, "--warmup", 0, 10000000);
-  if (!warmup) return report_error(warmup.error().message);
-  auto repeat = parse_count(a.repeat, "--repeat", 1, 1000);
-  if (!repeat) return report_error(repeat.error().message);
   auto terrain = a.terrain->load_terrain();
   if (!terrain) return report_error(terrain.error().message);
   const Terrain& t = **terrain;
   std::vector<Camera> cams;
-  for (const auto& f : *frames) cams.push_back(f.camera);
+  for (const auto& f : *a.frames) cams.push_back(f.camera);
 
   // The vertex data (heights, nested errors and radii) of the finest lattice: the preprocess,
   // reported apart like ROAM's bounds.
@@ -88,15 +77,15 @@ int run_bench_lod_soar(const SoarBenchArgs& a) {
                                   : std::numeric_limits<double>::infinity(),
                     path_kappa);
   };
-  const MeshErrorMeter meter(lattice, static_cast<std::uint32_t>(*stride));
+  const MeshErrorMeter meter(lattice, static_cast<std::uint32_t>(a.error_stride));
 
   std::vector<std::uint32_t> strip;
-  for (std::uint64_t k = 0; k < *warmup; ++k)
+  for (std::uint64_t k = 0; k < a.warmup; ++k)
     (void)soar.refine(cams[k % cams.size()], kappa_of(cams[k % cams.size()]), strip);
   nlohmann::ordered_json out_frames = nlohmann::ordered_json::array();
   std::vector<double> ms, cpu, refine_only, tris, in_view, upload, max_err, rms_err, px_err;
   DrawnHeights drawn;
-  for (std::uint64_t rep = 0; rep < *repeat; ++rep) {
+  for (std::uint64_t rep = 0; rep < a.repeat; ++rep) {
     for (std::size_t k = 0; k < cams.size(); ++k) {
       const Camera& c = cams[k];
       const double kappa = kappa_of(c);
@@ -116,7 +105,7 @@ int run_bench_lod_soar(const SoarBenchArgs& a) {
                                    {"upload_bytes", strip.size() * sizeof(std::uint32_t)},
                                    {"triangles", f.triangles},
                                    {"kappa", report::num(kappa)}};
-      if (*every > 0 && k % *every == 0) {
+      if (a.error_every > 0 && k % a.error_every == 0) {
         const DrawnMesh mesh = soar.mesh(strip);
         meter.rasterize(mesh, drawn);
         const MeshError e = meter.measure(drawn, c);
@@ -168,8 +157,8 @@ int run_bench_lod_soar(const SoarBenchArgs& a) {
       {"max_screen_error_px_median", percentile(px_err, 0.5)},
       {"bounds_build_ms", preprocess_ms},
       {"bounds_bytes", soar.memory_bytes()},
-      {"error_every", *every},
-      {"error_stride", *stride},
+      {"error_every", a.error_every},
+      {"error_stride", a.error_stride},
       {"emitted",
        "one generalised triangle strip of 32-bit vertex indices (the whole mesh, every "
        "frame, inside update_ms; output_ms is 0); vertices static"},

@@ -2,17 +2,23 @@
 // JSON fields as the ROAM modes so that their figures compare like for like (docs/cli.md).
 #pragma once
 
+#include <cstdint>
 #include <string>
+#include <vector>
 
+#include "ridgeline/camera_path.h"
 #include "terrain_args.h"
 
 namespace ridgeline::cli {
 
-/// The flags of `ridge bench lod` that the SOAR mode reads (strings as given; validated here).
+/// What the SOAR mode of `ridge bench lod` reads: the path and counts bench lod parsed already,
+/// the LOD flags as given (validated here).
 struct SoarBenchArgs {
   const TerrainArgs* terrain = nullptr;
-  std::string path, threshold, triangles, budget_ms, error_every, error_stride, warmup, repeat,
-      json_path;
+  const std::vector<io::PathFrame>* frames = nullptr;
+  std::string threshold, triangles, budget_ms;
+  std::uint64_t error_every = 1, error_stride = 1, warmup = 0, repeat = 1;
+  std::string json_path;
 };
 
 /// Runs it; returns the exit code (errors go to stderr naming the flag).
