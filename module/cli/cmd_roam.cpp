@@ -213,10 +213,6 @@ double percentile(std::vector<double> v, double q) {
 }
 
 int run_bench_lod(const BenchLodArgs& a) {
-  if (a.lod.mode == "soar")  // the stateless comparator (bench_soar.h)
-    return run_bench_lod_soar({&a.lod.terrain, a.path, a.lod.threshold, a.lod.triangles,
-                               a.lod.budget_ms, a.error_every, a.error_stride, a.warmup, a.repeat,
-                               a.lod.json_path});
   if (a.path.empty()) return report_error("give --path PATH.json");
   auto frames = io::load_camera_path(a.path);
   if (!frames) return report_error(frames.error().message);
@@ -228,6 +224,10 @@ int run_bench_lod(const BenchLodArgs& a) {
   if (!warmup) return report_error(warmup.error().message);
   auto repeat = parse_count(a.repeat, "--repeat", 1, 1000);
   if (!repeat) return report_error(repeat.error().message);
+  if (a.lod.mode == "soar")  // the stateless comparator (bench_soar.h)
+    return run_bench_lod_soar({&a.lod.terrain, &*frames, a.lod.threshold, a.lod.triangles,
+                               a.lod.budget_ms, *every, *stride, *warmup, *repeat,
+                               a.lod.json_path});
   double bounds_ms = 0;
   std::size_t bound_bytes = 0;
   auto view = a.lod.view(&bounds_ms, &bound_bytes);
