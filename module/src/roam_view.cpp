@@ -17,8 +17,6 @@
 // lower threshold); due keys are recomputed within the time budget, the rest next update.
 #include "ridgeline/roam_view.h"
 
-#include "ridgeline/mesh_error.h"
-
 #include <algorithm>
 #include <bit>
 #include <chrono>
@@ -35,6 +33,7 @@
 #include "ridgeline/log.h"
 #include "edit_listener.h"
 #include "ridgeline/detail.h"
+#include "ridgeline/mesh_error.h"
 #include "surface_eval.h"
 
 namespace ridgeline {
