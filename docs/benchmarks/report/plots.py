@@ -57,7 +57,7 @@ def main():
             png = os.path.join(pdir, f"{sc}_{p}.png")
             ths = ", ".join("%g" % v for v in sorted({r["value"] for r in by[(sc, p, "roam_coherent", "threshold")]}))
             gp = [
-                "set terminal pngcairo size 1500,460 font 'sans,10'",
+                "set terminal pngcairo size 1500,460 font 'sans,10' noenhanced",
                 f"set output '{png}'",
                 "set multiplot layout 1,3 title "
                 f"'{sc}, {p}: thresholds {ths} px, grid and CDLOD at the median triangles of ROAM coherent, SOAR at the same threshold'",
