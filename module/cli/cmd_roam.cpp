@@ -5,6 +5,7 @@
 #include <cmath>
 #include <memory>
 
+#include "bench_soar.h"
 #include "cli_util.h"
 #include "commands.h"
 #include "ridgeline/camera_path.h"
@@ -39,7 +40,9 @@ struct LodArgs {
         ->type_name("METRES");
     g->add_option("--budget-ms", budget_ms, "Time budget per update, milliseconds")
         ->type_name("MS");
-    g->add_option("--mode", mode, "coherent (split/merge queues) or rebuild (split only, Turner)")
+    g->add_option("--mode", mode,
+                  "coherent (split/merge queues) or rebuild (split only, Turner); bench lod "
+                  "also soar (the stateless SOAR comparator)")
         ->type_name("MODE");
     g->add_option("--slack", slack, "Priority window as a fraction of distance (default 0.05)")
         ->type_name("F");
@@ -231,6 +234,10 @@ int run_bench_lod(const BenchLodArgs& a) {
   if (!warmup) return report_error(warmup.error().message);
   auto repeat = parse_count(a.repeat, "--repeat", 1, 1000);
   if (!repeat) return report_error(repeat.error().message);
+  if (a.lod.mode == "soar")  // the stateless comparator (bench_soar.h)
+    return run_bench_lod_soar({&a.lod.terrain, &*frames, a.lod.threshold, a.lod.triangles,
+                               a.lod.budget_ms, *every, *stride, *warmup, *repeat,
+                               a.lod.json_path});
   double bounds_ms = 0;
   std::size_t bound_bytes = 0;
   auto view = a.lod.view(&bounds_ms, &bound_bytes);

@@ -33,6 +33,7 @@
 #include "ridgeline/log.h"
 #include "edit_listener.h"
 #include "ridgeline/detail.h"
+#include "ridgeline/mesh_error.h"
 #include "surface_eval.h"
 
 namespace ridgeline {
@@ -1563,81 +1564,12 @@ const PatchMesh& RoamView::patch_mesh(std::uint32_t patch) {
 namespace ridgeline {
 
 RoamView::MeasuredError RoamView::measure_error(const Camera& camera, std::uint32_t stride) const {
-  const Impl& m = *impl_;
-  const Landscape& l = *landscape_;
-  const Heightfield& hf = l.terrain().heightfield();
-  MeasuredError out;
-  stride = std::max<std::uint32_t>(stride, 1);
-  const bool screen = settings_.metric == ErrorMetric::kScreenPixels;
-  Frame fr{};
-  double tv = 1, th = 1, k = 1;
-  if (screen) {
-    fr = frame_of(camera);
-    tv = std::tan(camera.fov_y_deg * 3.14159265358979323846 / 360.0);
-    th = tv * double(camera.viewport.x) / double(camera.viewport.y);
-    k = projection_scale(camera);
-  }
-  const std::int64_t P = l.patch_cells();
-  double sum2 = 0;
-  std::vector<float> px;
-  for (std::int64_t j = 0; j <= l.last_j(); j += stride) {
-    for (std::int64_t i = 0; i <= l.last_i(); i += stride) {
-      const double surface = l.terrain().fine_local_height(i, j);
-      const double y = hf.height_offset() + surface;
-      const glm::dvec3 p(l.world_x(i), y, l.world_z(j));
-      double dist = 0;
-      if (screen) {
-        const glm::dvec3 q = p - camera.eye;
-        const double z = glm::dot(q, fr.f);
-        dist = glm::length(q);
-        if (!(z > 0 && std::abs(glm::dot(q, fr.r)) <= th * z &&
-              std::abs(glm::dot(q, fr.u)) <= tv * z && dist <= camera.far_m))
-          continue;
-      }
-      // Locate the leaf holding (i, j): the patch, the root (side of the main diagonal), then
-      // down the tree by the side of each split line.
-      const std::int64_t px_ = std::min<std::int64_t>(i / P, l.patches_x() - 1);
-      const std::int64_t pz_ = std::min<std::int64_t>(j / P, l.patches_z() - 1);
-      const std::uint32_t patch = static_cast<std::uint32_t>(px_ + pz_ * l.patches_x());
-      const std::int64_t li = i - px_ * P, lj = j - pz_ * P;
-      std::uint32_t n = 2 * patch + (li >= lj ? 0 : 1);
-      LatticeTriangle t = l.triangle(n, 1);
-      while (m.nodes[n].child != kNone) {
-        // Child 0 is (M, A, L): the point is in it when it lies on L's side of the line A-M.
-        const std::int64_t mx = (t.lx + t.rx) / 2, mz = (t.lz + t.rz) / 2;
-        const std::int64_t side_p =
-            (mx - t.ax) * (std::int64_t(j) - t.az) - (mz - t.az) * (std::int64_t(i) - t.ax);
-        const std::int64_t side_l = (mx - t.ax) * (t.lz - t.az) - (mz - t.az) * (t.lx - t.ax);
-        const int c = (side_p == 0 || (side_p > 0) == (side_l > 0)) ? 0 : 1;
-        n = m.nodes[n].child + c;
-        t = Landscape::child_triangle(t, c);
-      }
-      // Plane of the leaf at (i, j).
-      const double w = double((t.lx - t.ax) * (t.rz - t.az) - (t.lz - t.az) * (t.rx - t.ax));
-      const double wr = double((t.lx - t.ax) * (std::int64_t(j) - t.az) -
-                               (t.lz - t.az) * (std::int64_t(i) - t.ax)) /
-                        w;
-      const double wa = double((t.rx - t.lx) * (std::int64_t(j) - t.lz) -
-                               (t.rz - t.lz) * (std::int64_t(i) - t.lx)) /
-                        w;
-      const double plane = wa * l.lattice_height(t.ax, t.az) +
-                           (1.0 - wa - wr) * l.lattice_height(t.lx, t.lz) +
-                           wr * l.lattice_height(t.rx, t.rz);
-      const double err = std::abs(plane - surface);
-      out.max_m = std::max(out.max_m, err);
-      sum2 += err * err;
-      ++out.vertices;
-      if (screen) px.push_back(static_cast<float>(dist > 0 ? err * k / dist : 0.0));
-    }
-  }
-  if (out.vertices) out.rms_m = std::sqrt(sum2 / double(out.vertices));
-  if (!px.empty()) {
-    const std::size_t q = std::min(px.size() - 1, px.size() * 99 / 100);
-    std::nth_element(px.begin(), px.begin() + q, px.end());
-    out.p99_px = px[q];
-    out.max_px = *std::max_element(px.begin(), px.end());
-  }
-  return out;
+  // One measurement for tests, `bench lod` and `ridge report` (mesh_error.h).
+  const MeshErrorMeter meter(landscape_->terrain(), stride);
+  const DrawnHeights drawn = meter.rasterize(leaves_mesh(*this));
+  const MeshError e = settings_.metric == ErrorMetric::kScreenPixels ? meter.measure(drawn, camera)
+                                                                      : meter.measure_all(drawn);
+  return {e.max_m, e.rms_m, e.max_px, e.p99_px, e.vertices - e.uncovered};
 }
 
 }  // namespace ridgeline

@@ -22,6 +22,7 @@
 #include <tuple>
 #include <vector>
 
+#include "ridgeline/scenes.h"
 #include "ridgeline/surface.h"
 #include "ridgeline/terrain.h"
 
@@ -40,19 +41,15 @@ struct FieldSpec {
 std::shared_ptr<const Terrain> make_terrain(const FieldSpec& s,
                                             const std::function<double(int, int)>& f,
                                             std::vector<std::uint8_t> materials = {}) {
-  HeightfieldDesc d;
-  d.width = s.w;
-  d.height = s.h;
-  d.spacing_x = s.sx;
-  d.spacing_z = s.sz;
-  d.origin_x = s.ox;
-  d.origin_z = s.oz;
-  d.height_offset = s.offset;
-  d.name = "test";
-  std::vector<float> v(std::size_t{s.w} * s.h);
-  for (std::uint32_t j = 0; j < s.h; ++j)
-    for (std::uint32_t i = 0; i < s.w; ++i) v[i + j * s.w] = float(f(int(i), int(j)));
-  auto hf = Heightfield::create(d, v, materials);
+  auto hf = scenes::field({.width = s.w,
+                           .height = s.h,
+                           .spacing_x = s.sx,
+                           .spacing_z = s.sz,
+                           .origin_x = s.ox,
+                           .origin_z = s.oz,
+                           .height_offset = s.offset,
+                           .name = "test"},
+                          f, materials);
   EXPECT_TRUE(hf) << (hf ? "" : hf.error().message);
   return Terrain::create(std::move(hf).value());
 }
@@ -246,12 +243,7 @@ bool near_vec(glm::vec3 a, glm::dvec3 b, double tol) {
 // ---- Analytic cases ---------------------------------------------------------------------------
 
 TEST(Queries, PlaneHeight) {
-  HeightfieldDesc d;
-  d.width = d.height = 5;
-  std::vector<float> v(25);
-  for (int j = 0; j < 5; ++j)
-    for (int i = 0; i < 5; ++i) v[i + j * 5] = float(2 * i + 3 * j);
-  auto t = Terrain::create(std::move(Heightfield::create(d, v)).value());
+  auto t = make_terrain({}, [](int i, int j) { return 2 * i + 3 * j; });
   EXPECT_NEAR(*t->height(1.25, 2.5), 2 * 1.25 + 3 * 2.5, 1e-5);
   EXPECT_FALSE(t->height(-0.1, 1.0));
 }
