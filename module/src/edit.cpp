@@ -2,19 +2,21 @@
 // (docs/deformation.md).
 #include "ridgeline/edit.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <bit>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fcntl.h>
 #include <mutex>
 #include <numbers>
-#include <unistd.h>
 
 #include "edit_layer.h"
 #include "edit_listener.h"
+#include "edit_log.h"
 #include "format.h"
 #include "ray_hierarchy.h"
 #include "ridgeline/detail.h"
@@ -163,9 +165,46 @@ struct Changes {
 
 }  // namespace
 
-// After the heights changed: ray pyramid, listeners, version, and the result's box.
-static void finish_transaction(Terrain& t, const Changes& c, EditResult& r,
-                               RayHierarchy& rays, std::uint64_t& version,
+// What the changed stored samples of `c` changed on `t`'s surface: the cells touching them, the
+// surface's height range there before and after, the finest-lattice vertices that moved.
+static TerrainChange describe_change(const Terrain& t, const Changes& c) {
+  const Heightfield& hf = t.heightfield();
+  const int L = int(t.detail_levels());
+  // Corners of the cells touching a changed sample (unchanged corners keep their height).
+  const std::uint32_t vi0 = c.i0 > 0 ? c.i0 - 1 : 0, vj0 = c.j0 > 0 ? c.j0 - 1 : 0;
+  const std::uint32_t vi1 = std::min(c.i1 + 1, hf.width() - 1),
+                      vj1 = std::min(c.j1 + 1, hf.height() - 1);
+  float lo = c.lo, hi = c.hi;  // the changed samples, before and after
+  for (std::uint32_t j = vj0; j <= vj1; ++j)
+    for (std::uint32_t i = vi0; i <= vi1; ++i)
+      lo = std::min(lo, hf.local(i, j)), hi = std::max(hi, hf.local(i, j));
+  // The surface is piecewise linear over those corners, plus detail below the stored resolution.
+  const std::int64_t s = std::int64_t{1} << L;
+  const double pad = L == 0 ? 0.0
+                            : t.detail()->contribution_bound(1, std::uint32_t(L), vi0 * s, vj0 * s,
+                                                             vi1 * s, vj1 * s);
+  TerrainChange ch;
+  ch.box.min = {hf.origin_x() + vi0 * hf.spacing_x(), hf.height_offset() + double(lo) - pad,
+                hf.origin_z() + vj0 * hf.spacing_z()};
+  ch.box.max = {hf.origin_x() + vi1 * hf.spacing_x(), hf.height_offset() + double(hi) + pad,
+                hf.origin_z() + vj1 * hf.spacing_z()};
+  if (L == 0) {
+    ch.vertices = {c.i0, c.j0, c.i1, c.j1};
+  } else {
+    // Detail-lattice vertices strictly inside those cells are interpolated from the changed
+    // samples; the unchanged corners themselves stay.
+    const std::int64_t last_i = t.fine_width() - 1, last_j = t.fine_height() - 1;
+    ch.vertices = {std::max<std::int64_t>(0, (std::int64_t(c.i0) - 1) * s + 1),
+                   std::max<std::int64_t>(0, (std::int64_t(c.j0) - 1) * s + 1),
+                   std::min(last_i, (std::int64_t(c.i1) + 1) * s - 1),
+                   std::min(last_j, (std::int64_t(c.j1) + 1) * s - 1)};
+  }
+  return ch;
+}
+
+// After the heights changed: ray pyramid, listeners, version, change log and the result's box.
+static void finish_transaction(Terrain& t, const Changes& c, EditResult& r, RayHierarchy& rays,
+                               std::uint64_t& version, ChangeLog& log,
                                const std::vector<detail::EditListener*>& listeners) {
   r.samples_changed = c.samples;
   if (c.samples == 0) return;
@@ -174,13 +213,30 @@ static void finish_transaction(Terrain& t, const Changes& c, EditResult& r,
   const std::uint32_t ci0 = c.i0 > 0 ? c.i0 - 1 : 0, cj0 = c.j0 > 0 ? c.j0 - 1 : 0;
   const std::uint32_t ci1 = std::min(c.i1, hf.width() - 2), cj1 = std::min(c.j1, hf.height() - 2);
   rays.update_cells(hf, ci0, cj0, ci1, cj1);
-  ++version;
+  TerrainChange ch = describe_change(t, c);
+  ch.version = ++version;
+  log.record(ch);
+  r.changed = ch.box;
   const detail::EditRegion region{c.i0, c.j0, c.i1, c.j1};
   for (detail::EditListener* l : listeners) l->on_edit(region, r);
-  r.changed.min = {hf.origin_x() + ci0 * hf.spacing_x(), hf.height_offset() + double(c.lo),
-                   hf.origin_z() + cj0 * hf.spacing_z()};
-  r.changed.max = {hf.origin_x() + (ci1 + 1) * hf.spacing_x(), hf.height_offset() + double(c.hi),
-                   hf.origin_z() + (cj1 + 1) * hf.spacing_z()};
+}
+
+TerrainChanges Terrain::changes_since(std::uint64_t version) const {
+  if (version <= edit_version_) return log_->since(version, edit_version_);
+  // Not a version of this terrain: everything may differ.
+  const Heightfield& hf = heightfield_;
+  const double pad = detail_ ? detail_->contribution_bound(1) : 0.0;
+  TerrainChange whole;
+  whole.version = edit_version_;
+  whole.box.min = {hf.origin_x(), hf.height_offset() + double(hf.min_local()) - pad, hf.origin_z()};
+  whole.box.max = {hf.origin_x() + hf.extent_x(), hf.height_offset() + double(hf.max_local()) + pad,
+                   hf.origin_z() + hf.extent_z()};
+  whole.vertices = {0, 0, fine_width() - 1, fine_height() - 1};
+  TerrainChanges out;
+  out.version = edit_version_;
+  out.changes.push_back(whole);
+  out.trimmed = true;
+  return out;
 }
 
 Result<EditResult> Terrain::apply_edit(const Edit& e) {
@@ -268,7 +324,7 @@ Result<EditResult> Terrain::apply_edit(const Edit& e) {
     std::lock_guard lock(listeners_->mutex);
     listeners = listeners_->list;
   }
-  finish_transaction(*this, c, r, *rays_, edit_version_, listeners);
+  finish_transaction(*this, c, r, *rays_, edit_version_, *log_, listeners);
   return r;
 }
 
@@ -307,6 +363,7 @@ std::shared_ptr<Terrain> Terrain::clone() const {
   *t->edits_ = *edits_;
   t->base_hash_ = base_hash_;
   t->edit_version_ = edit_version_;
+  *t->log_ = *log_;
   return t;
 }
 
@@ -518,7 +575,8 @@ Result<EditResult> load_edits_from_memory(Terrain& terrain, std::string_view in)
     std::lock_guard lock(terrain.listeners_->mutex);
     listeners = terrain.listeners_->list;
   }
-  finish_transaction(terrain, changes, r, *terrain.rays_, terrain.edit_version_, listeners);
+  finish_transaction(terrain, changes, r, *terrain.rays_, terrain.edit_version_, *terrain.log_,
+                     listeners);
   return r;
 }
 
