@@ -9,6 +9,7 @@
 #include <fstream>
 #include <glm/common.hpp>
 #include <random>
+#include <thread>
 
 #include "ridgeline/detail.h"
 #include "ridgeline/edit.h"
@@ -36,8 +37,11 @@ std::shared_ptr<Terrain> noise_terrain(std::uint32_t n, std::uint32_t seed = 7) 
 
 std::string tmp_path(const std::string& name) { return std::string(RIDGELINE_TEST_TMP) + "/" + name; }
 
-// Every stored bound of `l` equals the one a fresh Landscape over the same heights computes.
+// Every stored bound of `l`, once synced, equals the one a fresh Landscape over the same heights
+// computes.
 void expect_bounds_equal_rebuild(const Landscape& l) {
+  l.sync();
+  EXPECT_EQ(l.synced_version(), l.terrain().edit_version());
   auto fresh = Landscape::create(l.terrain_ptr(), {.patch_exponent = l.patch_exponent()}).value();
   const std::uint64_t per_root = (std::uint64_t{1} << l.max_level()) - 1;
   std::uint64_t bad = 0;
@@ -165,16 +169,17 @@ TEST(Transaction, ViewsStayCrackFreeAndHonestAndQueriesSeeTheEdit) {
                             .radius = 6.0 + k % 13, .depth = 3});
     ASSERT_TRUE(r);
     if (r->empty()) continue;
-    EXPECT_GT(r->view_nodes_updated, 0u);
-    // The patch under the edit's centre is dirty.
-    const auto dirty = v->take_dirty_patches();
-    const std::uint32_t p = std::uint32_t(std::min(x / 64.0, 7.0)) + 8 * std::uint32_t(std::min(z / 64.0, 7.0));
-    EXPECT_NE(std::find(dirty.begin(), dirty.end(), p), dirty.end());
+    // Pulled, not pushed: the view hears of the edit at its next update.
+    EXPECT_TRUE(v->take_dirty_patches().empty());
     // Rays see the new surface (the pyramid was refreshed): straight down hits at height().
     auto hit = t->raycast({x, 1000, z}, {0, -1, 0}, 5000);
     ASSERT_TRUE(hit);
     EXPECT_NEAR(hit->point.y, *t->height(x, z), 1e-4);  // height() interpolates in float
     ASSERT_TRUE(v->converge(cam));
+    // The patch under the edit's centre is dirty.
+    const auto dirty = v->take_dirty_patches();
+    const std::uint32_t p = std::uint32_t(std::min(x / 64.0, 7.0)) + 8 * std::uint32_t(std::min(z / 64.0, 7.0));
+    EXPECT_NE(std::find(dirty.begin(), dirty.end(), p), dirty.end());
     ASSERT_EQ(v->check_invariants(), "");
     ASSERT_EQ(check_crack_free(*v), "");
     const auto err = v->measure_error(cam);
@@ -502,4 +507,49 @@ TEST(ChangeLog, IsBoundedAndMergesWhatItNoLongerHolds) {
   auto c = t->clone();
   EXPECT_EQ(c->edit_version(), n);
   EXPECT_EQ(c->changes_since(n - 3).changes.size(), 3u);
+}
+
+TEST(ChangeLog, ViewsOnSeveralThreadsPullTheSameEditsThroughOneLandscape) {
+  auto t = noise_terrain(257, 4);
+  auto l = Landscape::create(t, {.patch_exponent = 5}).value();
+  const Camera cams[] = {camera_at({256, 260, -60}, {256, 0, 256}),
+                         camera_at({-40, 200, 300}, {300, 0, 200}),
+                         camera_at({500, 150, 500}, {200, 0, 220})};
+  std::vector<std::unique_ptr<RoamView>> views;
+  for (int k = 0; k < 3; ++k) {
+    views.push_back(RoamView::create(l, {.threshold = 1.0}).value());
+    ASSERT_TRUE(views.back()->converge(cams[k]));
+  }
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(0, 512);
+  for (int round = 0; round < 12; ++round) {
+    // Edits from this thread while no view runs, then the views update at once on three
+    // threads: the first to arrive syncs the landscape, the others wait for it.
+    for (int k = 0; k < 4; ++k)
+      ASSERT_TRUE(t->apply_edit({.brush = k % 2 ? Brush::kRaise : Brush::kCrater, .x = u(rng),
+                                 .z = u(rng), .radius = 5.0 + 3 * k, .depth = 4}));
+    EXPECT_NE(l->synced_version(), t->edit_version());
+    std::vector<std::thread> threads;
+    std::atomic<int> failures{0};
+    for (int k = 0; k < 3; ++k)
+      threads.emplace_back([&, k] {
+        if (!views[k]->converge(cams[k])) ++failures;
+      });
+    for (auto& th : threads) th.join();
+    ASSERT_EQ(failures.load(), 0);
+    EXPECT_EQ(l->synced_version(), t->edit_version());
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_EQ(views[k]->check_invariants(), "") << "view " << k << ", round " << round;
+      ASSERT_EQ(check_crack_free(*views[k]), "");
+      EXPECT_LE(views[k]->measure_error(cams[k], 3).max_px, 1.0 + 1e-3);
+    }
+  }
+  expect_bounds_equal_rebuild(*l);
+  // A landscape and a view made after the edits start from the current surface.
+  auto late = Landscape::create(t, {.patch_exponent = 5}).value();
+  EXPECT_EQ(late->synced_version(), t->edit_version());
+  auto v = RoamView::create(late, {.threshold = 1.0}).value();
+  ASSERT_TRUE(v->converge(cams[0]));
+  ASSERT_EQ(v->check_invariants(), "");
+  EXPECT_LE(v->measure_error(cams[0], 3).max_px, 1.0 + 1e-3);
 }
