@@ -11,11 +11,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <mutex>
 #include <numbers>
 
 #include "edit_layer.h"
-#include "edit_listener.h"
 #include "edit_log.h"
 #include "format.h"
 #include "ray_hierarchy.h"
@@ -133,19 +131,6 @@ void EditLayer::restore_all(Heightfield& hf) {
   originals_.clear();
 }
 
-// ---- listeners -------------------------------------------------------------------------------
-
-void Terrain::add_listener(detail::EditListener* l) const {
-  std::lock_guard lock(listeners_->mutex);
-  listeners_->list.push_back(l);
-}
-
-void Terrain::remove_listener(detail::EditListener* l) const {
-  std::lock_guard lock(listeners_->mutex);
-  auto& v = listeners_->list;
-  v.erase(std::remove(v.begin(), v.end(), l), v.end());
-}
-
 // ---- the transaction -------------------------------------------------------------------------
 
 namespace {
@@ -202,10 +187,10 @@ static TerrainChange describe_change(const Terrain& t, const Changes& c) {
   return ch;
 }
 
-// After the heights changed: ray pyramid, listeners, version, change log and the result's box.
+// After the heights changed: ray pyramid, version, change log and the result's box. Nothing is
+// called back: landscapes, views and engines pull the log (Terrain::changes_since).
 static void finish_transaction(Terrain& t, const Changes& c, EditResult& r, RayHierarchy& rays,
-                               std::uint64_t& version, ChangeLog& log,
-                               const std::vector<detail::EditListener*>& listeners) {
+                               std::uint64_t& version, ChangeLog& log) {
   r.samples_changed = c.samples;
   if (c.samples == 0) return;
   const Heightfield& hf = t.heightfield();
@@ -217,8 +202,6 @@ static void finish_transaction(Terrain& t, const Changes& c, EditResult& r, RayH
   ch.version = ++version;
   log.record(ch);
   r.changed = ch.box;
-  const detail::EditRegion region{c.i0, c.j0, c.i1, c.j1};
-  for (detail::EditListener* l : listeners) l->on_edit(region, r);
 }
 
 TerrainChanges Terrain::changes_since(std::uint64_t version) const {
@@ -319,12 +302,7 @@ Result<EditResult> Terrain::apply_edit(const Edit& e) {
     }
   }
   r.clamped = r.samples_clamped > 0;
-  std::vector<detail::EditListener*> listeners;
-  {
-    std::lock_guard lock(listeners_->mutex);
-    listeners = listeners_->list;
-  }
-  finish_transaction(*this, c, r, *rays_, edit_version_, *log_, listeners);
+  finish_transaction(*this, c, r, *rays_, edit_version_, *log_);
   return r;
 }
 
@@ -570,13 +548,7 @@ Result<EditResult> load_edits_from_memory(Terrain& terrain, std::string_view in)
         changes.add(i, j, before, after);
     }
   EditResult r;
-  std::vector<detail::EditListener*> listeners;
-  {
-    std::lock_guard lock(terrain.listeners_->mutex);
-    listeners = terrain.listeners_->list;
-  }
-  finish_transaction(terrain, changes, r, *terrain.rays_, terrain.edit_version_, *terrain.log_,
-                     listeners);
+  finish_transaction(terrain, changes, r, *terrain.rays_, terrain.edit_version_, *terrain.log_);
   return r;
 }
 

@@ -6,7 +6,6 @@
 #include <limits>
 
 #include "edit_layer.h"
-#include "edit_listener.h"
 #include "edit_log.h"
 #include "ray_hierarchy.h"
 #include "ridgeline/detail.h"
@@ -36,8 +35,7 @@ Terrain::Terrain(Heightfield heightfield)
       log_(std::make_unique<ChangeLog>()),
       base_hash_(heightfield_.content_hash()),
       inv_spacing_x_(1.0 / heightfield_.spacing_x()),
-      inv_spacing_z_(1.0 / heightfield_.spacing_z()),
-      listeners_(std::make_unique<Listeners>()) {}
+      inv_spacing_z_(1.0 / heightfield_.spacing_z()) {}
 
 Terrain::~Terrain() = default;
 

@@ -1,10 +1,10 @@
-// Runtime deformation (SPEC.md "Edits", docs/deformation.md): brushes, the edit transaction's
-// result and limits, and saving / loading the edit layer.
+// Runtime deformation (docs/deformation.md): brushes, the edit transaction's result and limits,
+// and saving / loading the edit layer.
 //
 // The transaction itself is Terrain::apply_edit() (terrain.h): it changes the heights, refreshes
-// the ray pyramid, the error bounds of every Landscape built on the terrain and the queues and
-// dirty patches of every RoamView on those landscapes, all inside the call, and returns the
-// changed region.
+// the ray pyramid, bumps the terrain's edit_version() and records the changed region in its
+// change log, all inside the call, and returns that region. Landscapes, views, physics and
+// engines learn of it by pulling Terrain::changes_since(); nothing is called back.
 #pragma once
 
 #include <cstdint>
@@ -17,7 +17,7 @@
 
 namespace ridgeline {
 
-/// The brushes of SPEC.md.
+/// The brushes (docs/deformation.md gives each one's formula).
 enum class Brush : std::uint8_t {
   kCrater,   ///< bowl of `depth` metres with a raised rim (`rim` x depth) out to 1.5 x radius
   kRaise,    ///< adds strength x depth metres at the centre, smooth falloff to 0 at the radius
@@ -31,7 +31,7 @@ const char* brush_name(Brush b) noexcept;
 /// The brush named `name`; empty for anything else.
 std::optional<Brush> parse_brush(std::string_view name) noexcept;
 
-/// One edit, the schema of SPEC.md (the same fields in JSON, Lua tables and the save file).
+/// One edit: the same fields in C++, JSON (edit_json.h), Lua tables and the save file.
 struct Edit {
   Brush brush = Brush::kCrater;
   double x = 0, z = 0;    ///< centre, world metres
@@ -75,9 +75,6 @@ struct EditResult {
   /// Some samples hit EditLimits' height range and were clamped (`samples_clamped` of them).
   bool clamped = false;
   std::size_t samples_clamped = 0;
-  /// Bound entries recomputed over all landscapes, view nodes refreshed over all views.
-  std::uint64_t bounds_updated = 0;
-  std::uint64_t view_nodes_updated = 0;
   bool empty() const noexcept { return samples_changed == 0; }
 };
 

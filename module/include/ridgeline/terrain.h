@@ -29,9 +29,6 @@ struct Edit;
 struct EditLimits;
 struct EditResult;
 class ChangeLog;
-namespace detail {
-class EditListener;
-}
 
 /// Height, both normals and the material at a point of the surface.
 struct SurfaceSample {
@@ -309,15 +306,9 @@ class Terrain {
   // Cached for the query fast path.
   double inv_spacing_x_ = 1, inv_spacing_z_ = 1;
 
-  // Landscapes register here to hear of edits (internal; Landscape and edit.cpp only).
-  friend class Landscape;
-  friend class EditLayer;
+  // The edit file's reader and writer (edit.cpp) reach the edit layer and the transaction.
   friend Result<EditResult> load_edits_from_memory(Terrain&, std::string_view);
   friend Status save_edits(const Terrain&, const std::string&);
-  void add_listener(detail::EditListener* l) const;
-  void remove_listener(detail::EditListener* l) const;
-  struct Listeners;
-  std::unique_ptr<Listeners> listeners_;
 };
 
 }  // namespace ridgeline
