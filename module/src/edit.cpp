@@ -495,6 +495,10 @@ Result<EditResult> load_edits_from_memory(Terrain& terrain, std::string_view in)
                      static_cast<unsigned long long>(count), expected)};
   if (fnv1a(in.data(), in.size() - 8) != get<std::uint64_t>(in, in.size() - 8))
     return Error{what + ": checksum mismatch (the file is corrupted)"};
+  if (get<std::uint64_t>(in, 48) != 0 || get<std::uint64_t>(in, 56) != 0)
+    return Error{what +
+                 ": reserved header bytes 48..63 are not zero (written by a newer version, "
+                 "or corrupted)"};
   const EditLimits& lim = terrain.edits_->limits;
   std::uint64_t prev_key = 0;
   for (std::uint64_t c = 0; c < count; ++c) {

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <glm/common.hpp>
 #include <random>
@@ -407,6 +408,7 @@ TEST(ChangeLog, EveryBrushAndEveryLoadIsRecordedUnderTheVersionItProduced) {
     ASSERT_EQ(c.changes.size(), 1u) << file;
     EXPECT_EQ(c.version, v + 1);
     EXPECT_GT(expect_change_describes(*t, c.changes[0], before, after), 0u);
+    EXPECT_EQ(t->check_invariants(), "") << "the ray pyramid after loading " << file;
     v = c.version;
   }
   // The whole history, in order; nothing after the current version.
@@ -455,6 +457,7 @@ TEST(ChangeLog, ADetailLatticeMovesAroundTheEditedSamples) {
     const TerrainChanges c = t->changes_since(v);
     ASSERT_EQ(c.changes.size(), 1u);
     EXPECT_GT(expect_change_describes(*t, c.changes[0], before, after), 0u);
+    EXPECT_EQ(t->check_invariants(), "");
     v = c.version;
   }
 }
@@ -552,4 +555,104 @@ TEST(ChangeLog, ViewsOnSeveralThreadsPullTheSameEditsThroughOneLandscape) {
   ASSERT_TRUE(v->converge(cams[0]));
   ASSERT_EQ(v->check_invariants(), "");
   EXPECT_LE(v->measure_error(cams[0], 3).max_px, 1.0 + 1e-3);
+}
+
+TEST(EditFile, EveryRegionOfTheHeaderAndBodyIsGuarded) {
+  auto t = noise_terrain(129);
+  ASSERT_TRUE(t->apply_edit({.x = 40, .z = 60, .radius = 12, .depth = 4}));
+  ASSERT_TRUE(t->apply_edit({.brush = Brush::kRaise, .x = 200, .z = 230, .radius = 9, .depth = 3}));
+  const std::string file = tmp_path("edits_guarded.bin");
+  ASSERT_TRUE(save_edits(*t, file));
+  std::ifstream in(file, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t chunk = 8 + 4 * 32 * 32;
+  ASSERT_GE(t->edited_chunks(), 2u);
+  ASSERT_EQ(bytes.size(), 64 + t->edited_chunks() * chunk + 8);
+  // The fresh terrain the file is loaded onto; every refusal leaves it as it was.
+  auto target = noise_terrain(129);
+  const auto h0 = target->heights_hash();
+  ASSERT_TRUE(load_edits_from_memory(*target, bytes)) << "the intact file loads";
+  ASSERT_EQ(target->heights_hash(), t->heights_hash());
+  ASSERT_EQ(target->check_invariants(), "");
+  target = noise_terrain(129);
+  auto fnv = [](const std::string& b) {
+    std::uint64_t h = 1469598103934665603ull;
+    for (std::size_t k = 0; k + 8 < b.size(); ++k)
+      h = (h ^ static_cast<unsigned char>(b[k])) * 1099511628211ull;
+    return h;
+  };
+  auto reseal = [&](std::string b) {  // recompute the trailing checksum, little-endian
+    const std::uint64_t h = fnv(b);
+    std::memcpy(b.data() + b.size() - 8, &h, 8);
+    return b;
+  };
+  auto refused = [&](const std::string& b, const std::string& why, std::size_t at) {
+    auto r = load_edits_from_memory(*target, b);
+    if (r) {
+      ADD_FAILURE() << "byte " << at << ": accepted";
+      return;
+    }
+    EXPECT_NE(r.error().message.find(why), std::string::npos)
+        << "byte " << at << ": " << r.error().message << " (wanted '" << why << "')";
+    EXPECT_EQ(r.error().message.rfind("edit file", 0), 0u) << r.error().message;
+    EXPECT_EQ(target->heights_hash(), h0) << "byte " << at << " changed the terrain";
+    EXPECT_EQ(target->edit_version(), 0u);
+  };
+  // The header field each byte belongs to, and what a change there must say when the checksum is
+  // left alone (fields checked before it) and when it is recomputed (the field's own check).
+  struct Region {
+    std::size_t from, to;
+    const char *stale, *resealed;
+  };
+  const Region header[] = {
+      {0, 8, "bad magic", "bad magic"},
+      {8, 12, "version", "version"},
+      {12, 16, "chunk size", "chunk size"},
+      {16, 24, "another terrain", "another terrain"},
+      {24, 32, "detail", "detail"},
+      {32, 40, "terrain; this one is", "terrain; this one is"},
+      {40, 48, "chunk", "chunk"},
+      {48, 64, "checksum mismatch", "reserved header bytes"},
+  };
+  for (const Region& g : header)
+    for (std::size_t at = g.from; at < g.to; ++at) {
+      std::string c = bytes;
+      c[at] = char(c[at] ^ 0x10);
+      refused(c, g.stale, at);
+      refused(reseal(c), g.resealed, at);
+    }
+  // The body: every chunk's indices and its first, a middle and its last value, and the checksum.
+  for (std::size_t k = 0; k < t->edited_chunks(); ++k) {
+    const std::size_t base = 64 + k * chunk;
+    for (std::size_t at = base; at < base + 8; ++at) {
+      std::string c = bytes;
+      c[at] = char(c[at] ^ 0x40);
+      refused(c, "checksum mismatch", at);
+      refused(reseal(c), "lies outside the terrain", at);  // 0x40 moves it off a 5 x 5 grid
+    }
+    for (std::size_t v : {std::size_t{0}, std::size_t{517}, std::size_t{1023}}) {
+      const std::size_t at = base + 8 + 4 * v;
+      std::string c = bytes;
+      c[at + 1] = char(c[at + 1] ^ 0x01);
+      refused(c, "checksum mismatch", at);
+      for (float bad : {NAN, INFINITY, 3e5f}) {  // past the edit limits even when resealed
+        std::memcpy(c.data() + at, &bad, 4);
+        refused(reseal(c), "outside the edit limits", at);
+      }
+    }
+  }
+  for (std::size_t at = bytes.size() - 8; at < bytes.size(); ++at) {
+    std::string c = bytes;
+    c[at] = char(c[at] ^ 0x01);
+    refused(c, "checksum mismatch", at);
+  }
+  // Chunks repeated or out of order (the second chunk's indices copied onto the first).
+  {
+    std::string c = bytes;
+    std::memcpy(c.data() + 64, c.data() + 64 + chunk, 8);
+    refused(reseal(c), "out of order or repeated", 64);
+  }
+  // Lengths: one byte short or long of what the chunk count says.
+  refused(reseal(bytes.substr(0, bytes.size() - 1)), "truncated", bytes.size() - 1);
+  refused(reseal(bytes + std::string(1, '\0')), "trailing bytes", bytes.size());
 }
