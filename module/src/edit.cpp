@@ -225,6 +225,14 @@ TerrainChanges Terrain::changes_since(std::uint64_t version) const {
 Result<EditResult> Terrain::apply_edit(const Edit& e) {
   if (auto s = validate_edit(e); !s) return Error{s.message()};
   Heightfield& hf = heightfield_;
+  if (!e.keep_detail && detail_levels_ != 0)
+    // Replacing the detail would need deltas on the detail lattice and error bounds (views,
+    // rays) that include them; docs/deformation.md, "keep_detail".
+    return Error{
+        fmt("edit: keep_detail = false is not supported on a terrain with procedural "
+            "detail (%u levels): edits are stored at the base spacing (%s m) and the "
+            "detail always rides on top of them; use keep_detail = true",
+            detail_levels_, num(std::min(hf.spacing_x(), hf.spacing_z())).c_str())};
   const double extent = std::max(hf.extent_x(), hf.extent_z());
   if (e.radius > extent)
     return Error{"edit: radius " + num(e.radius) + " m is larger than the terrain (" +

@@ -115,3 +115,18 @@ T.case("edit_version and changes_since: every edit is a changed box under its ve
   T.raises("released", u.edit_version, u)
   T.raises("released", u.changes_since, u, 0)
 end)
+
+T.case("keep_detail = false: refused over procedural detail, the same edit without", function()
+  local d = assert(ridgeline.load{heightmap = DATA .. "ramp16.png", spacing = 8, detail_levels = 3})
+  local h = d:height(12, 12)
+  local r, err = d:deform{brush = "flatten", x = 12, z = 12, radius = 10, height = 5,
+                          keep_detail = false}
+  T.eq(r, nil); T.truthy(err:find("keep_detail = false is not supported", 1, true), err)
+  T.eq(d:height(12, 12), h, "nothing changed"); T.eq(d:edit_version(), 0)
+  assert(d:deform{brush = "flatten", x = 12, z = 12, radius = 10, height = 5})  -- detail kept
+  T.eq(d:edit_version(), 1)
+  local plain = ridgeline.default_terrain()
+  assert(plain:deform{brush = "flatten", x = 800, z = 800, radius = 10, height = 5,
+                      keep_detail = false})
+  T.near(plain:height(800, 800), 5, 1e-4, "without detail there is nothing to keep")
+end)

@@ -656,3 +656,44 @@ TEST(EditFile, EveryRegionOfTheHeaderAndBodyIsGuarded) {
   refused(reseal(bytes.substr(0, bytes.size() - 1)), "truncated", bytes.size() - 1);
   refused(reseal(bytes + std::string(1, '\0')), "trailing bytes", bytes.size());
 }
+
+TEST(Brushes, KeepDetailFalseIsRefusedOverDetailAndNeedsNothingWithout) {
+  // With detail: refused with the reason, and nothing changes (heights, version, log).
+  auto hf = make_default_heightfield({.size = 65, .spacing = 4.0, .seed = 3});
+  DetailParams p;
+  p.levels = 2;
+  DetailCacheDesc cache;
+  cache.worker_threads = 0;
+  cache.budget_bytes = std::size_t{16} << 20;
+  auto t = Terrain::create(std::move(hf).value(), p, cache).value();
+  const auto h0 = t->heights_hash();
+  const double y0 = *t->height(100, 80);
+  for (Brush b : {Brush::kFlatten, Brush::kSmooth, Brush::kCrater}) {
+    auto r = t->apply_edit(
+        {.brush = b, .x = 100, .z = 80, .radius = 20, .height = 10, .keep_detail = false});
+    ASSERT_FALSE(r) << brush_name(b);
+    EXPECT_NE(r.error().message.find("keep_detail = false is not supported"), std::string::npos)
+        << r.error().message;
+    EXPECT_NE(r.error().message.find("2 levels"), std::string::npos) << r.error().message;
+  }
+  EXPECT_EQ(t->heights_hash(), h0);
+  EXPECT_EQ(*t->height(100, 80), y0);
+  EXPECT_EQ(t->edit_version(), 0u);
+  EXPECT_TRUE(t->changes_since(0).empty());
+  // keep_detail = true there: the detail rides on top of the flattened site.
+  ASSERT_TRUE(
+      t->apply_edit({.brush = Brush::kFlatten, .x = 100, .z = 80, .radius = 20, .height = 10}));
+  const double fs = 1.0;  // finest spacing: 4 m / 2^2
+  double spread = 0;
+  for (int k = 1; k < 8; ++k)
+    spread = std::max(spread, std::abs(*t->height(100 + k * fs * 0.5, 80) - 10));
+  EXPECT_GT(spread, 1e-3) << "detail shows through a flattened site";
+  // Without detail there is nothing to replace: false and true give the same surface.
+  auto a = noise_terrain(65), b = noise_terrain(65);
+  const Edit flat{.brush = Brush::kFlatten, .x = 60, .z = 60, .radius = 15, .height = 30};
+  Edit flat_false = flat;
+  flat_false.keep_detail = false;
+  ASSERT_TRUE(a->apply_edit(flat));
+  ASSERT_TRUE(b->apply_edit(flat_false));
+  EXPECT_EQ(a->heights_hash(), b->heights_hash());
+}

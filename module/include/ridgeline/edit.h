@@ -40,9 +40,11 @@ struct Edit {
   double depth = 2;       ///< metres: crater depth (negative makes a mound), raise / lower amount
   double rim = 0.2;       ///< crater rim height as a fraction of depth, 0..1
   double height = 0;      ///< flatten: target world height, metres
-  /// Edits are deltas over base + detail, so detail shows through (SPEC.md). false is accepted
-  /// for the schema's sake and has no other effect in this version: the edit layer lives at the
-  /// stored resolution, below which procedural detail always rides on top (docs/deformation.md).
+  /// Edits are stored at the base spacing and procedural detail rides on top of them, so the
+  /// detail shows through an edited site (a flattened one included). false asks for the brush to
+  /// replace the detail under it: Terrain::apply_edit() refuses that on a terrain with detail
+  /// (an error saying so; nothing changes), and on a terrain without detail, where there is no
+  /// detail to replace, it is the same edit as true (docs/deformation.md, "keep_detail").
   bool keep_detail = true;
 };
 

@@ -240,7 +240,8 @@ class Terrain {
   /// Landscapes and RoamViews catch up at their next sync() / update(). Cost follows the edited
   /// area, never the terrain size.
   /// Errors (nothing changes): a field fails validate_edit(), the radius exceeds the terrain's
-  /// larger extent, or the area cap is exceeded with EditLimits::refuse_oversize. A brush wholly
+  /// larger extent, the area cap is exceeded with EditLimits::refuse_oversize, or keep_detail is
+  /// false on a terrain with detail (edit.h). A brush wholly
   /// outside the terrain, or one that changes no height, is a no-op with an empty result (no
   /// version, no log entry). Exclusive access (see above).
   Result<EditResult> apply_edit(const Edit& edit);
