@@ -241,9 +241,9 @@ class Terrain {
   /// area, never the terrain size.
   /// Errors (nothing changes): a field fails validate_edit(), the radius exceeds the terrain's
   /// larger extent, the area cap is exceeded with EditLimits::refuse_oversize, or keep_detail is
-  /// false on a terrain with detail (edit.h). A brush wholly
-  /// outside the terrain, or one that changes no height, is a no-op with an empty result (no
-  /// version, no log entry). Exclusive access (see above).
+  /// false on a terrain with detail (edit.h). A brush wholly outside the terrain, or one that
+  /// changes no height, is a no-op with an empty result (no version, no log entry). Exclusive
+  /// access (see above).
   Result<EditResult> apply_edit(const Edit& edit);
   /// Limits for later edits (validated: finite, area > 0, min < max; else an error and no change).
   Status set_edit_limits(const EditLimits& limits);
