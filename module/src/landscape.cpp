@@ -10,63 +10,54 @@
 #include "ridgeline/landscape.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <mutex>
 #include <thread>
 
-#include "edit_listener.h"
-#include "ridgeline/detail.h"
 #include "format.h"
+#include "ridgeline/detail.h"
 
 namespace ridgeline {
 
-struct Landscape::Views {
+struct Landscape::Sync {
   std::mutex mutex;
-  std::vector<detail::EditListener*> list;
+  std::atomic<std::uint64_t> version{0};  // the terrain version the bounds reflect
 };
 
-// Hears the terrain's edits: bounds first, then the views.
-struct Landscape::Hook final : detail::EditListener {
-  explicit Hook(Landscape& l) : self(l) {}
-  void on_edit(const detail::EditRegion& r, EditResult& result) override {
-    result.bounds_updated +=
-        self.update_bounds(r.i0, r.j0, self.edited_end_i(r.i1), self.edited_end_j(r.j1));
-    std::vector<detail::EditListener*> views;
-    {
-      std::lock_guard lock(self.views_->mutex);
-      views = self.views_->list;
-    }
-    for (detail::EditListener* v : views) v->on_edit(r, result);
+Landscape::~Landscape() = default;
+
+std::uint64_t Landscape::synced_version() const noexcept {
+  return sync_->version.load(std::memory_order_acquire);
+}
+
+Landscape::LatticeBox Landscape::changed_box(const TerrainChange& c) const noexcept {
+  LatticeBox b{c.vertices.i0, c.vertices.i1, c.vertices.j0, c.vertices.j1};
+  if (b.i1 >= last_i_) b.i1 = std::int64_t(patches_x_) * patch_cells();
+  if (b.j1 >= last_j_) b.j1 = std::int64_t(patches_z_) * patch_cells();
+  return b;
+}
+
+void Landscape::sync() const {
+  const std::uint64_t now = terrain_->edit_version();
+  if (sync_->version.load(std::memory_order_acquire) == now) return;
+  std::lock_guard lock(sync_->mutex);
+  const std::uint64_t have = sync_->version.load(std::memory_order_relaxed);
+  if (have == now) return;  // another view synced meanwhile
+  // Stored bounds over the stored samples inside each change (the finer levels' bounds come
+  // from the detail field when asked for).
+  const int d = int(detail_);
+  const std::int64_t s = std::int64_t{1} << d;
+  for (const TerrainChange& c : terrain_->changes_since(have).changes) {
+    const LatticeBox b = changed_box(c);
+    update_bounds((b.i0 + s - 1) >> d, (b.j0 + s - 1) >> d, b.i1 >> d, b.j1 >> d);
   }
-  Landscape& self;
-};
-
-std::int64_t Landscape::edited_end_i(std::uint32_t i1) const noexcept {
-  return i1 + 1 >= terrain_->heightfield().width() ? std::int64_t(patches_x_) * (std::int64_t{1} << exponent_) : i1;
-}
-
-std::int64_t Landscape::edited_end_j(std::uint32_t j1) const noexcept {
-  return j1 + 1 >= terrain_->heightfield().height() ? std::int64_t(patches_z_) * (std::int64_t{1} << exponent_) : j1;
-}
-
-Landscape::~Landscape() {
-  if (hook_ && terrain_) terrain_->remove_listener(hook_.get());
-}
-
-void Landscape::add_listener(detail::EditListener* l) const {
-  std::lock_guard lock(views_->mutex);
-  views_->list.push_back(l);
-}
-
-void Landscape::remove_listener(detail::EditListener* l) const {
-  std::lock_guard lock(views_->mutex);
-  auto& v = views_->list;
-  v.erase(std::remove(v.begin(), v.end(), l), v.end());
+  sync_->version.store(now, std::memory_order_release);
 }
 
 std::uint64_t Landscape::update_bounds(std::int64_t i0, std::int64_t j0, std::int64_t i1,
-                                       std::int64_t j1) {
+                                       std::int64_t j1) const {
   const std::int64_t p = std::int64_t{1} << exponent_;
   // Patches whose closed square holds part of the region.
   const std::int64_t px0 = std::max<std::int64_t>(0, (i0 + p - 1) / p - 1),
@@ -183,9 +174,8 @@ Result<std::shared_ptr<const Landscape>> Landscape::create(std::shared_ptr<const
   }
   l->build_ms_ =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  l->views_ = std::make_unique<Views>();
-  l->hook_ = std::make_unique<Hook>(*l);
-  l->terrain_->add_listener(l->hook_.get());
+  l->sync_ = std::make_unique<Sync>();
+  l->sync_->version.store(l->terrain_->edit_version(), std::memory_order_release);
   return std::shared_ptr<const Landscape>(std::move(l));
 }
 

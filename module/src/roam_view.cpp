@@ -25,15 +25,14 @@
 #include <glm/geometric.hpp>
 #include <limits>
 #include <new>
-#include <type_traits>
 #include <queue>
+#include <type_traits>
 #include <unordered_map>
 
 #include "format.h"
-#include "ridgeline/log.h"
-#include "edit_listener.h"
 #include "ridgeline/detail.h"
 #include "ridgeline/mesh_error.h"
+#include "ridgeline/log.h"
 #include "surface_eval.h"
 
 namespace ridgeline {
@@ -405,6 +404,7 @@ struct RoamView::Impl {
   double keyed_threshold = 0.0;  // threshold of the previous update
   double height_offset = land.terrain().heightfield().height_offset();
   bool reset_pending = true;
+  std::uint64_t seen_version = 0;  // the terrain edit version this view's nodes reflect
 
   // Output.
   std::vector<std::uint64_t> patch_version;
@@ -1021,9 +1021,9 @@ struct RoamView::Impl {
     return std::chrono::steady_clock::now() >= deadline;
   }
 
-  // An edit changed the samples in [i0, i1] x [j0, j1] (padding-extended by the landscape):
-  // refresh every node whose triangle's box meets the region (bound, box, visibility), requeue
-  // the queued ones, mark the patches whose vertices or vertex normals changed dirty.
+  // An edit changed the lattice vertices in [i0, i1] x [j0, j1] (padding-extended by the
+  // landscape): refresh every node whose triangle's box meets the region (bound, box, visibility),
+  // requeue the queued ones, mark the patches whose vertices or vertex normals changed dirty.
   std::uint64_t on_edit(std::int64_t i0, std::int64_t j0, std::int64_t i1, std::int64_t j1) {
     const std::int64_t p = land.patch_cells();
     // Vertex normals read the samples one step around a vertex: one more sample for dirtiness.
@@ -1070,6 +1070,16 @@ struct RoamView::Impl {
       }
     }
     return refreshed;
+  }
+
+  // Refreshes the nodes over every change since the last pull (the landscape synced first).
+  void pull_edits() {
+    const TerrainChanges c = land.terrain().changes_since(seen_version);
+    for (const TerrainChange& ch : c.changes) {
+      const Landscape::LatticeBox b = land.changed_box(ch);
+      on_edit(b.i0, b.j0, b.i1, b.j1);
+    }
+    seen_version = c.version;
   }
 
   enum class Refresh { kDone, kRebuild, kOutOfTime };
@@ -1148,29 +1158,14 @@ float morph_factor(float morph_bound, double distance_m, double k, double thresh
   return static_cast<float>(std::clamp(p / threshold_px - 1.0, 0.0, 1.0));
 }
 
-struct RoamView::EditHook final : detail::EditListener {
-  explicit EditHook(RoamView& v) : view(v) {}
-  void on_edit(const detail::EditRegion& r, EditResult& result) override {
-    const Landscape& l = *view.landscape_;
-    const int d = int(l.detail_levels());
-    std::int64_t i0 = r.i0, j0 = r.j0, i1 = l.edited_end_i(r.i1), j1 = l.edited_end_j(r.j1);
-    if (d > 0) {
-      // Finest-lattice vertices inside the cells around the changed samples moved too (the stored
-      // surface is interpolated there).
-      i0 = std::max<std::int64_t>(i0 - 1, 0) << d, j0 = std::max<std::int64_t>(j0 - 1, 0) << d;
-      i1 = (i1 + 1) << d, j1 = (j1 + 1) << d;
-    }
-    result.view_nodes_updated += view.impl_->on_edit(i0, j0, i1, j1);
-  }
-  RoamView& view;
-};
-
 Result<std::unique_ptr<RoamView>> RoamView::create(std::shared_ptr<const Landscape> landscape,
                                                    const RoamSettings& settings) {
   if (!landscape) return Error{"roam view: no landscape given"};
   std::unique_ptr<RoamView> v(new RoamView());
   v->landscape_ = std::move(landscape);
+  v->landscape_->sync();  // the roots below take current bounds
   v->impl_ = std::make_unique<Impl>(*v->landscape_);
+  v->impl_->seen_version = v->landscape_->synced_version();
   if (auto s = v->set_settings(settings); !s) return Error{s.message()};
   Impl& m = *v->impl_;
   const std::uint32_t np = v->landscape_->patch_count();
@@ -1180,14 +1175,10 @@ Result<std::unique_ptr<RoamView>> RoamView::create(std::shared_ptr<const Landsca
   m.mesh_built_version.assign(np, ~std::uint64_t{0});
   m.reset_to_roots();
   v->triangles_ = m.triangles;
-  v->hook_ = std::make_unique<EditHook>(*v);
-  v->landscape_->add_listener(v->hook_.get());
   return v;
 }
 
-RoamView::~RoamView() {
-  if (hook_) landscape_->remove_listener(hook_.get());
-}
+RoamView::~RoamView() = default;
 
 Status RoamView::set_settings(const RoamSettings& s) {
   if (!std::isfinite(s.threshold) || s.threshold < 0.0)
@@ -1223,6 +1214,9 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
     if (auto s = validate_camera(camera); !s) return Error{s.message()};
   const auto t0 = std::chrono::steady_clock::now();
   Impl& m = *impl_;
+  // Edits since the last update: the shared bounds first, then this view's nodes.
+  landscape_->sync();
+  m.pull_edits();
   m.st = RoamStats{};
   m.metric = settings_.metric;
   m.slack = settings_.slack;

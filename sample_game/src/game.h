@@ -72,7 +72,6 @@ struct VehicleEntry {
 struct CraterRecord {
   double x = 0, z = 0, radius = 0, depth = 0;
   std::uint64_t frame = 0;
-  double max_lift_m = 0;  ///< largest lift applied to a vehicle inside the changed box
 };
 
 /// Per-frame statistics of the active view and the controller.
@@ -107,7 +106,9 @@ class Game {
   std::vector<std::string> script_names() const;
 
   // ---- simulation ----------------------------------------------------------------------------
-  /// One fixed step: scripts' tick handlers, autopilots, vehicle physics.
+  /// One fixed step: scripts' tick handlers, autopilots, the vehicles' reaction to every terrain
+  /// edit since the last step (from any brush, C++ or Lua, or a loaded edit state: the terrain's
+  /// change log is polled once here), vehicle physics.
   void step();
   std::uint64_t frame() const noexcept { return frame_; }  ///< steps taken
   double time() const noexcept { return double(frame_) * options_.dt; }
@@ -123,8 +124,8 @@ class Game {
   const VehicleModel* model(const std::string& name) const;
   std::vector<std::string> model_names() const;
 
-  /// Deforms the terrain with a crater (the edit layer); bodies inside the changed box are lifted
-  /// out of the surface. Returns the number of lattice samples changed.
+  /// Deforms the terrain with a crater (the edit layer). Vehicles follow it at the next step(),
+  /// as they follow every edit. Returns the number of lattice samples changed.
   ridgeline::Result<std::size_t> crater(double x, double z, double radius, double depth);
   const std::vector<CraterRecord>& craters() const noexcept { return craters_; }
 
@@ -174,6 +175,8 @@ class Game {
   Game() = default;
   ridgeline::Status run_script(int index);
   void clamp_to_terrain(VehicleEntry& e);
+  // Pulls the terrain's change log: vehicles near a changed box follow the new ground.
+  void follow_terrain_edits();
 
   GameOptions options_;
   std::shared_ptr<ridgeline::Terrain> terrain_;
@@ -192,6 +195,7 @@ class Game {
   double tess_budget_ms_ = 8;
   ViewFrame last_view_;
   std::uint64_t frame_ = 0;
+  std::uint64_t seen_edit_version_ = 0;  // the terrain edit version the vehicles have followed
   double burned_ms_ = 0;
   std::unique_ptr<ridgeline::lua::Host> host_;
   std::deque<ScriptError> errors_;

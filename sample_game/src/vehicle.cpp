@@ -251,7 +251,25 @@ void Vehicle::measure_contacts(const ridgeline::Terrain& terrain) {
     const glm::dvec3 bottom = w.centre - up * params_.wheel_radius;
     const auto h = terrain.height(bottom.x, bottom.z);
     w.surface_gap = h ? bottom.y - *h : 0.0;
+    ground_[i] = {a.x, a.z, terrain.height(a.x, a.z).value_or(std::nan(""))};
   }
+}
+
+double Vehicle::follow_ground(const ridgeline::Terrain& terrain) {
+  // The wheels carry the body: it rises with the ground under them (the chassis is kept out of
+  // the ground by resolve_penetration below).
+  double rise = 0;
+  for (const GroundPoint& g : ground_) {
+    const auto h = terrain.height(g.x, g.z);
+    if (h && std::isfinite(g.height)) rise = std::max(rise, *h - g.height);
+  }
+  if (rise > 0) {
+    pos_.y += rise;
+    for (WheelState& w : wheels_) w.centre.y += rise;
+  }
+  const double lift = rise + resolve_penetration(terrain);
+  measure_contacts(terrain);
+  return lift;
 }
 
 bool Autopilot::drive(Vehicle& v) {

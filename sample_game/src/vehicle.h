@@ -69,8 +69,15 @@ class Vehicle {
   /// velocity into the surface: what keeps a body out of the ground, also when an edit removes
   /// the ground under it. Returns the lift applied, metres.
   double resolve_penetration(const ridgeline::Terrain& terrain);
-  /// Updates every wheel's surface_gap (see WheelState).
+  /// Updates every wheel's surface_gap (see WheelState) and records the ground height under the
+  /// suspension tops, for follow_ground().
   void measure_contacts(const ridgeline::Terrain& terrain);
+  /// The terrain was edited under the body since the last measure_contacts(): where the ground
+  /// under its wheels rose, the body rises by the largest rise (suspension, velocity and tilt
+  /// kept, so it keeps resting instead of being launched by fully compressed springs); where it
+  /// fell, the body is left to fall. Then resolves any remaining penetration and measures again.
+  /// Returns the lift applied, metres.
+  double follow_ground(const ridgeline::Terrain& terrain);
 
   Controls controls;
   const VehicleParams& params() const noexcept { return params_; }
@@ -99,6 +106,12 @@ class Vehicle {
   glm::dquat q_{1, 0, 0, 0};
   glm::dvec3 inertia_{1};  // body-frame diagonal
   std::array<WheelState, 4> wheels_{};
+  // Ground under the four suspension tops at the last measure_contacts() (height NaN
+  // off-terrain).
+  struct GroundPoint {
+    double x = 0, z = 0, height = 0;
+  };
+  std::array<GroundPoint, 4> ground_{};
 };
 
 /// Steers a vehicle along waypoints (pure pursuit on the xz plane).

@@ -37,12 +37,13 @@ struct LatticeTriangle {
 /// lattice vertex under the node's triangle (the exact error), then made nested by taking the
 /// maximum with the children's bounds. Finest-level nodes (half cells) have bound 0.
 ///
-/// Edits: the landscape registers with its terrain; Terrain::apply_edit() recomputes the bounds
-/// of exactly the nodes whose triangles hold a changed sample (bottom-up, then nested) and tells
-/// the RoamViews on this landscape, inside the edit call.
+/// Edits: the bounds are a cache of the terrain's current surface, brought up to date by sync(),
+/// which pulls the terrain's change log (Terrain::changes_since) and recomputes the bounds of
+/// exactly the nodes whose triangles hold a changed vertex (bottom-up, then nested). Every
+/// RoamView calls it at the start of its update(); nothing is pushed from inside an edit.
 ///
-/// Threading: read-only between edits; every method may run concurrently. Edits need exclusive
-/// access (terrain.h).
+/// Threading: between edits every method may run concurrently, sync() included (it locks
+/// internally). Edits need exclusive access (terrain.h): no landscape call during one.
 class Landscape {
  public:
   static Result<std::shared_ptr<const Landscape>> create(std::shared_ptr<const Terrain> terrain,
@@ -167,6 +168,22 @@ class Landscape {
   std::int64_t last_i() const noexcept { return last_i_; }
   std::int64_t last_j() const noexcept { return last_j_; }
 
+  /// Brings the bounds up to date with the terrain's edits: pulls
+  /// Terrain::changes_since(synced_version()) and recomputes the bounds over each change's
+  /// changed_box(), so that they equal a fresh build's. Logically const: the bounds are a cache
+  /// of the terrain's current surface, and the landscape is shared read-only by its views.
+  /// Internally locked: views updating on several threads may call it at once; one does the
+  /// work while the others wait, and each returns with the bounds at the terrain's current
+  /// version (a cheap check when nothing changed). RoamView::update() calls it first; call it
+  /// yourself before reading bound() after an edit. Never during an edit.
+  void sync() const;
+  /// The Terrain::edit_version() the bounds reflect (that of the last sync(), or of creation).
+  std::uint64_t synced_version() const noexcept;
+  /// The finest-lattice box [i0, i1] x [j0, j1] a change covers in this landscape: its vertex
+  /// range, extended over the padding patches when it reaches the terrain's last column or row
+  /// (the padding repeats the edge vertices, so it moves with them).
+  LatticeBox changed_box(const TerrainChange& change) const noexcept;
+
   /// Bytes of the bound arrays, and how long building them took.
   std::size_t bound_bytes() const noexcept { return bounds_.size() * sizeof(float); }
   double build_ms() const noexcept { return build_ms_; }
@@ -181,26 +198,19 @@ class Landscape {
     return terrain_->heightfield().local_clamped(i, j);
   }
   float detail_bound(int level, const LatticeTriangle& t) const noexcept;
-  // Edits (edit.cpp's transaction calls the hook; RoamViews register to hear of them).
-  friend class RoamView;
-  struct Hook;
-  struct Views;
-  std::unique_ptr<Hook> hook_;
-  std::unique_ptr<Views> views_;
-  void add_listener(detail::EditListener* l) const;
-  void remove_listener(detail::EditListener* l) const;
-  // The last lattice column and row an edit of samples up to (i1, j1) changes: the padding
-  // repeats the edge samples, so an edited edge sample moves the padding too.
-  std::int64_t edited_end_i(std::uint32_t i1) const noexcept;
-  std::int64_t edited_end_j(std::uint32_t j1) const noexcept;
-  // Recomputes the bounds over an edit's region; returns the entries recomputed.
-  std::uint64_t update_bounds(std::int64_t i0, std::int64_t j0, std::int64_t i1, std::int64_t j1);
+  // sync()'s lock and the version the bounds reflect.
+  struct Sync;
+  std::unique_ptr<Sync> sync_;
+  // Recomputes the stored bounds over the stored-lattice samples [i0, i1] x [j0, j1] (under
+  // sync()'s lock); returns the entries recomputed.
+  std::uint64_t update_bounds(std::int64_t i0, std::int64_t j0, std::int64_t i1,
+                              std::int64_t j1) const;
 
   std::shared_ptr<const Terrain> terrain_;
   std::uint32_t exponent_ = 6, detail_ = 0, patches_x_ = 0, patches_z_ = 0;
   std::int64_t last_i_ = 0, last_j_ = 0;
   std::uint64_t nodes_per_root_plus_one_ = 0;  // 2^(2k): heaps 1 .. 2^(2k) - 1 are stored
-  std::vector<float> bounds_;
+  mutable std::vector<float> bounds_;          // written only by create() and sync()
   double origin_x_ = 0, origin_z_ = 0, spacing_x_ = 1, spacing_z_ = 1;
   double build_ms_ = 0;
 };

@@ -104,10 +104,12 @@ float morph_factor(float morph_bound, double distance_m, double projection_scale
 /// Threading: one thread updates a view; several views over one Landscape may update on
 /// different threads at once. Output accessors must not run during update() of the same view.
 ///
-/// Edits: Terrain::apply_edit() reaches every view on the terrain's landscapes inside the call:
-/// the view refreshes its nodes over the changed region (bounds, boxes), requeues the queued
-/// ones with fresh priorities and marks the patches whose vertices or normals changed dirty;
-/// the next update() splits and merges accordingly. No view call may run during an edit.
+/// Edits: update() pulls them. It first calls Landscape::sync() (the shared bounds), then asks
+/// Terrain::changes_since() the version this view last saw, and over each change's
+/// Landscape::changed_box() refreshes its nodes (bounds, boxes), requeues the queued ones with
+/// fresh priorities and marks the patches whose vertices or normals changed dirty, before it
+/// splits and merges. Until then the mesh and take_dirty_patches() show the surface of the
+/// previous update. No view call may run during an edit.
 class RoamView {
  public:
   static Result<std::unique_ptr<RoamView>> create(std::shared_ptr<const Landscape> landscape,
@@ -168,8 +170,6 @@ class RoamView {
   RoamSettings settings_;
   std::uint32_t triangles_ = 0;
   std::unique_ptr<Impl> impl_;
-  struct EditHook;
-  std::unique_ptr<EditHook> hook_;
 };
 
 }  // namespace ridgeline
