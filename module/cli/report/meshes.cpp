@@ -200,15 +200,16 @@ DrawnMesh roam_mesh(RoamView& view, const Heightfield& hf, const Camera& camera,
   DrawnMesh out;
   for (std::uint32_t p = 0; p < l.patch_count(); ++p) {
     const PatchMesh& m = view.patch_mesh(p);
+    const glm::vec3 eye(camera.eye.x - m.origin_x, camera.eye.y - m.origin_y,
+                        camera.eye.z - m.origin_z);
     for (std::size_t t = 0; t + 2 < m.indices.size(); t += 3) {
+      if (m.indices[t] == m.indices[t + 1]) continue;  // unused slot or padding
       for (int c = 0; c < 3; ++c) {
         const MeshVertex& v = m.vertices[m.indices[t + std::size_t(c)]];
         const glm::dvec3 w(m.origin_x + v.x, m.origin_y + v.y, m.origin_z + v.z);
         double y = w.y;
-        if (morph && threshold > 0) {
-          const double d = glm::length(w - camera.eye);
-          y += (1.0 - morph_factor(v.morph_bound, d, k, threshold)) * v.morph_dy;
-        }
+        if (morph && threshold > 0)
+          y = m.origin_y + morphed_height(v, eye, k, threshold, l.morph_window());
         out.corners.emplace_back((w.x - hf.origin_x()) / hf.spacing_x(), y,
                                  (w.z - hf.origin_z()) / hf.spacing_z());
       }
