@@ -298,15 +298,9 @@ void Renderer::upload_patch(PatchGpu& gpu, const ridgeline::PatchMesh& mesh) {
     glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, stride, (void*)offsetof(V, morph_dy));
   }
   glBindVertexArray(gpu.vao);
-  // Triangles whose centre lies in the padding are not terrain: leave them out.
-  std::vector<std::uint32_t> idx;
-  idx.reserve(mesh.indices.size());
-  std::uint32_t tris = 0;
-  for (std::size_t t = 0; t * 3 < mesh.indices.size(); ++t) {
-    if (t < mesh.padding.size() && mesh.padding[t]) continue;
-    idx.insert(idx.end(), mesh.indices.begin() + t * 3, mesh.indices.begin() + t * 3 + 3);
-    ++tris;
-  }
+  // Unused slots and triangles over the padding are degenerate (0, 0, 0): draw the array as is.
+  const std::vector<std::uint32_t>& idx = mesh.indices;
+  const std::uint32_t tris = mesh.triangles;
   glBindBuffer(GL_ARRAY_BUFFER, gpu.vbo);
   glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(mesh.vertices.size() * sizeof(ridgeline::MeshVertex)),
                mesh.vertices.data(), GL_DYNAMIC_DRAW);

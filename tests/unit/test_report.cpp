@@ -329,13 +329,13 @@ TEST(ReportRoamDrawn, UnmorphedIsTheTrueHeightAndAFreshSplitStartsOnItsEdge) {
   v.morph_bound = 1.0f;
   Camera c = look({0, 0, -1000}, {0, 0, 0});
   const glm::dvec3 w(0, 10, 0);
-  EXPECT_EQ(roam_drawn_y(v, w, c, 2.0, false), 10.0);
-  EXPECT_EQ(roam_drawn_y(v, w, c, 0.0, true), 10.0);  // no pixel threshold: no morph
+  EXPECT_EQ(roam_drawn_y(v, w, c, 2.0, 0.5, false), 10.0);
+  EXPECT_EQ(roam_drawn_y(v, w, c, 0.0, 0.5, true), 10.0);  // no pixel threshold: no morph
   // Far away the bound projects below the threshold: the vertex sits on the coarser edge.
-  EXPECT_DOUBLE_EQ(roam_drawn_y(v, w, c, 2.0, true), 12.0);
+  EXPECT_DOUBLE_EQ(roam_drawn_y(v, w, c, 2.0, 0.5, true), 12.0);
   // Close, the projected bound is over twice the threshold: the true height.
   c.eye = {0, 0, -1};
-  EXPECT_DOUBLE_EQ(roam_drawn_y(v, w, c, 2.0, true), 10.0);
+  EXPECT_DOUBLE_EQ(roam_drawn_y(v, w, c, 2.0, 0.5, true), 10.0);
 }
 
 // ---- SOAR -------------------------------------------------------------------------------

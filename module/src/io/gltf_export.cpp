@@ -59,8 +59,10 @@ Status write_glb(RoamView& view, const std::string& path, const GltfExportOption
     nrm.clear();
     idx.clear();
     remap.assign(pm.vertices.size(), std::numeric_limits<std::uint32_t>::max());
-    for (std::size_t t = 0; t < pm.padding.size(); ++t) {
-      if (pm.padding[t] && !options.include_padding) continue;
+    for (std::size_t t = 0; 3 * t + 2 < pm.indices.size(); ++t) {
+      // Unused slots and triangles over the padding are degenerate (0, 0, 0): the mesh ends on
+      // the border of the sampled data.
+      if (pm.indices[3 * t] == pm.indices[3 * t + 1]) continue;
       for (int k = 0; k < 3; ++k) {
         const std::uint32_t v = pm.indices[3 * t + k];
         if (remap[v] == std::numeric_limits<std::uint32_t>::max()) {
