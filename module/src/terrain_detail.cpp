@@ -1,5 +1,5 @@
 // A Terrain with procedural detail: the finest lattice (spacing / 2^L) whose vertex heights are
-// base + detail (SPEC.md "The surface"), and the point queries on it.
+// base + detail (docs/surface.md, "Detail and edits"), and the point queries on it.
 #include <algorithm>
 #include <bit>
 #include <cmath>

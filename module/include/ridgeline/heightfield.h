@@ -1,4 +1,4 @@
-// Heightfield: the stored samples of a terrain, validated, placed in the world (SPEC.md, Coordinates).
+// Heightfield: the stored samples of a terrain, validated, placed in the world (docs/surface.md, Coordinates).
 #pragma once
 
 #include <cstdint>
@@ -85,7 +85,7 @@ class Heightfield {
   float local(std::uint32_t i, std::uint32_t j) const noexcept {
     return heights_[i + static_cast<std::size_t>(j) * width_];
   }
-  /// Like local() but clamps (i, j) into the grid: the edge-repeating padding of SPEC.md.
+  /// Like local() but clamps (i, j) into the grid: the edge-repeating padding of docs/surface.md.
   float local_clamped(std::int64_t i, std::int64_t j) const noexcept;
   /// World height of sample (i, j), metres.
   double world(std::uint32_t i, std::uint32_t j) const noexcept {

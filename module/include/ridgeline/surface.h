@@ -1,4 +1,4 @@
-// The surface contract, defined once (SPEC.md "The surface"; docs/surface.md).
+// The surface contract, defined once (docs/surface.md).
 //
 // Every consumer (the full-detail mesh, height/normal/ray queries, error measurement, tests)
 // locates triangles through the functions in this header, so what physics sees and what the

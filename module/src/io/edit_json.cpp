@@ -1,4 +1,4 @@
-// Edit lists as JSON (SPEC.md "Edits"), parsed with nlohmann-json.
+// Edit lists as JSON (docs/deformation.md, "Brushes"), parsed with nlohmann-json.
 #include "ridgeline/edit_json.h"
 
 #include <algorithm>
