@@ -25,9 +25,9 @@
 #include <tuple>
 #include <vector>
 
-#include "ridgeline/scenes.h"
 #include "ridgeline/detail.h"
 #include "ridgeline/edit.h"
+#include "ridgeline/scenes.h"
 #include "ridgeline/surface.h"
 #include "ridgeline/terrain.h"
 

@@ -169,7 +169,8 @@ class DetailField {
   /// Generates a tile from its parent tile (the recurrence). `parent` must be the tile
   /// key.parent() for level >= 2 and null for level 1 (whose parent is the zero base detail);
   /// asserted (null is returned past the asserts). 1 <= key.level <= levels(). Thread-safe;
-  /// allocates one tile (about 73 KB; finest tiles also measure their per-level increments, about 0.08 ms).
+  /// allocates one tile (about 73 KB; finest tiles also measure their per-level increments, about
+  /// 0.08 ms).
   std::shared_ptr<const DetailTile> make_tile(const DetailTileKey& key,
                                               const DetailTile* parent) const;
   /// Generates a tile and every ancestor it needs, synchronously (tools and tests).
