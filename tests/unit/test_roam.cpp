@@ -145,7 +145,7 @@ TEST(Roam, ConvergedMeshMeetsTheThresholdInView) {
   EXPECT_EQ(st->stop, StopReason::kConverged);
   EXPECT_LE(st->max_remaining_error, 2.0);
   expect_converged(*view, c, 2.0);
-  // Move a little and update again: still converged (lazy keys stay conservative).
+  // Move a little and update again: still converged (the front is tested afresh every update).
   for (int k = 1; k <= 20; ++k) {
     Camera c2 = c;
     c2.eye += glm::dvec3(3.0 * k, -1.0 * k, 2.0 * k);
@@ -464,7 +464,8 @@ TEST(Roam, MeasuredErrorAgreesWithTheBoundsAndTheThreshold) {
 
 TEST(Roam, TimeBudgetStopsTheUpdateAndTheRestContinuesNextUpdate) {
   auto l = make_landscape(257, 5);
-  // A budget far below what converging takes: the first check (after 16 operations) stops it.
+  // A budget far below what converging takes: the first clock check (after 8 operations) stops
+  // it.
   auto view = RoamView::create(l, {.threshold = 1.0, .budget_ms = 1e-6}).value();
   const Camera c = camera_at({20, 120, 30}, {300, 60, 260});
   auto st = view->update(c);
@@ -523,7 +524,7 @@ TEST(Roam, DetailThatTurnsOutOfViewIsMergedBack) {
   auto look = [&](double yaw) {
     return camera_at(eye, eye + glm::dvec3(std::cos(yaw), -0.5, std::sin(yaw)), 50.0);
   };
-  // Turn on the spot by 180 degrees in 5-degree steps (no translation: only rotation moves keys).
+  // Turn on the spot by 180 degrees in 5-degree steps (no translation: only the frustum moves).
   RoamStats st{};
   for (int k = 0; k <= 36; ++k) {
     auto r = view->update(look(k * M_PI / 36));
@@ -562,15 +563,16 @@ TEST(Roam, ViewsUpdateOnDifferentThreadsOverOneLandscape) {
 }
 
 TEST(Roam, ATightTimeBudgetStillSplitsAndMerges) {
-  // A camera moving faster than a tiny budget can re-key: the refresh of expired keys may use
-  // only part of the budget, so splits and merges still happen and the mesh follows the camera
-  // (it froze before: every frame's budget went to re-keying).
+  // A camera moving fast under a tiny budget: splits and merges still happen every frame and the
+  // mesh follows the camera (with the old core's lazy keys it froze: every frame's budget went to
+  // re-keying).
   auto l = make_landscape(257, 5);
   auto view = RoamView::create(l, {.threshold = 1.0, .budget_ms = 0.02}).value();
   std::uint64_t changes = 0;
   for (int f = 0; f < 120; ++f) {
     const double a = f * 0.05;
-    const Camera c = camera_at({256 + 200 * std::cos(a), 90, 256 + 200 * std::sin(a)}, {256, 40, 256});
+    const Camera c =
+        camera_at({256 + 200 * std::cos(a), 90, 256 + 200 * std::sin(a)}, {256, 40, 256});
     auto st = view->update(c);
     ASSERT_TRUE(st);
     if (f >= 20) changes += st->splits + st->merges;
