@@ -442,6 +442,46 @@ TEST(Roam, OutputBuffersMatchTheLeavesAndSeamsShareHeightBits) {
   EXPECT_LT(dirty.size(), l->patch_count());
 }
 
+// On a field whose size is not 2^k + 1 (and not square) the drawn mesh covers exactly the data:
+// no vertex beyond the last sample, and the drawn triangles' areas add up to the data's area, so
+// there is neither a gap nor an overhang; at a fine threshold and at the coarsest tolerance.
+TEST(Roam, MeshEndsExactlyOnTheDataBorder) {
+  HeightfieldDesc d;
+  d.width = 83;
+  d.height = 57;
+  d.spacing_x = d.spacing_z = 2.0;
+  std::vector<float> h(std::size_t(d.width) * d.height);
+  for (std::uint32_t j = 0; j < d.height; ++j)
+    for (std::uint32_t i = 0; i < d.width; ++i)
+      h[i + j * d.width] = float(10 * std::sin(0.3 * i) * std::cos(0.21 * j) + 0.05 * i * j);
+  auto terrain = Terrain::create(Heightfield::create(d, h).value());
+  auto l = Landscape::create(terrain, {.patch_exponent = 4}).value();
+  const double w = (d.width - 1) * 2.0, hz = (d.height - 1) * 2.0;
+  for (const RoamSettings& s :
+       {RoamSettings{.threshold = 1.0},
+        RoamSettings{.metric = ErrorMetric::kWorldMetres, .threshold = 1000.0}}) {
+    auto view = RoamView::create(l, s).value();
+    ASSERT_TRUE(view->converge(camera_at({-20, 60, -30}, {80, 0, 60})));
+    double area = 0;
+    for (std::uint32_t p = 0; p < l->patch_count(); ++p) {
+      const PatchMesh& m = view->patch_mesh(p);
+      for (std::size_t k = 0; k + 2 < m.indices.size(); k += 3) {
+        if (m.indices[k] == m.indices[k + 1]) continue;  // an unused or padding slot
+        const MeshVertex* v[3] = {&m.vertices[m.indices[k]], &m.vertices[m.indices[k + 1]],
+                                  &m.vertices[m.indices[k + 2]]};
+        for (const MeshVertex* x : v) {
+          EXPECT_LE(m.origin_x + x->x, w + 1e-4) << "overhang past the last column";
+          EXPECT_LE(m.origin_z + x->z, hz + 1e-4) << "overhang past the last row";
+        }
+        area += 0.5 * (double(v[1]->z - v[0]->z) * (v[2]->x - v[0]->x) -
+                       double(v[1]->x - v[0]->x) * (v[2]->z - v[0]->z));
+      }
+    }
+    EXPECT_NEAR(area, w * hz, 1e-6 * w * hz) << "threshold " << s.threshold;
+    EXPECT_EQ(check_crack_free(*view), "");
+  }
+}
+
 TEST(Roam, BadSettingsAndCamerasAreRefused) {
   auto l = make_landscape(65, 4);
   EXPECT_FALSE(RoamView::create(l, {.threshold = -1.0}));
