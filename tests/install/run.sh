@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the build tree into a scratch prefix, then configures, builds and runs an outside
-# project that uses find_package(Ridgeline CONFIG REQUIRED) and, separately, pkg-config.
+# project that uses find_package(Ridgeline CONFIG REQUIRED) (all three targets) and, separately,
+# pkg-config (the core), and loads the installed ridgeline.so into the stock lua5.4.
 set -euo pipefail
 build=$1 work=$2 cxx=$3
 here=$(cd "$(dirname "$0")" && pwd)
@@ -10,6 +11,14 @@ cmake -S "$here/consumer" -B "$work/build" -G Ninja -DCMAKE_CXX_COMPILER="$cxx" 
   -DCMAKE_PREFIX_PATH="$work/prefix" > "$work/configure.log"
 cmake --build "$work/build" > "$work/build.log"
 "$work/build/consumer"
+# Ridgeline::io and Ridgeline::lua, and ridgeline.so from the stock interpreter.
+if [ -f "$work/prefix/lib/lua/5.4/ridgeline.so" ]; then
+  "$work/build/consumer_full" "$work/flat.r16"
+  LUA_CPATH="$work/prefix/lib/lua/5.4/?.so" lua5.4 -e \
+    'local r = require "ridgeline"; local t = r.default_terrain(); assert(type(t:height(10, 10)) == "number"); print("lua5.4: require ridgeline ok")'
+else
+  echo "install consumer: the package was built without Ridgeline::lua" >&2; exit 1
+fi
 # pkg-config route
 PKG_CONFIG_PATH="$work/prefix/lib/pkgconfig:$work/prefix/lib/x86_64-linux-gnu/pkgconfig" \
   "$cxx" -std=c++20 "$here/consumer/main.cpp" -o "$work/consumer_pc" \
