@@ -285,6 +285,10 @@ int run(const Args& a) {
     rec.panel_ms = panel_ms;
     rec.burn_ms = burn;
     rec.threshold = vf.threshold;
+    rec.wall_s =
+        std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+    rec.smoothed_ms = g.controller().state().smoothed_ms;
+    rec.reversals = g.controller().state().reversals;
     rec.render_scale = vf.render_scale;
     rec.triangles = vf.stats.triangles;
     rec.splits = vf.stats.splits + vf.stats.forced_splits;

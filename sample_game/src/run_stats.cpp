@@ -59,6 +59,9 @@ ridgeline::Status RunStats::write(const std::string& path, const std::string& mo
                     {"collisions", v.collisions}});
     frames.push_back({{"frame", f.frame},
                       {"time_s", f.time_s},
+                      {"wall_s", f.wall_s},
+                      {"smoothed_ms", f.smoothed_ms},
+                      {"controller_reversals", f.reversals},
                       {"frame_ms", f.frame_ms},
                       {"cpu_ms", f.cpu_ms},
                       {"main_thread_cpu_ms", f.main_cpu_ms},
@@ -165,6 +168,9 @@ ridgeline::Status RunStats::write(const std::string& path, const std::string& mo
       {"detail_tiles_generated", generated_last - generated_first},
       {"frames_with_vehicle_contacts", contact_frames},
       {"target_ms", game.controller().desc().target_ms},
+      {"controller_range_px",
+       {game.controller().desc().min_threshold, game.controller().desc().max_threshold}},
+      {"controller_min_render_scale", game.controller().desc().min_render_scale},
       {"controller", game.controller_on()},
       {"craters", game.craters().size()},
       {"script_errors", game.error_count()}};

@@ -22,6 +22,9 @@ struct FrameRecord {
   /// CPU milliseconds during the frame: every thread of the process, and the game's thread.
   double cpu_ms = 0, main_cpu_ms = 0;
   double threshold = 0, render_scale = 1;
+  double wall_s = 0;            ///< wall clock (seconds since the Unix epoch) at the frame's end
+  double smoothed_ms = 0;       ///< the controller's moving average after this frame
+  std::uint64_t reversals = 0;  ///< the controller's direction reversals so far
   std::uint32_t triangles = 0, splits = 0, merges = 0, patches_uploaded = 0, pending_splits = 0;
   int stop = -1;             ///< ridgeline::StopReason of the view update, -1 when none ran
   std::size_t contacts = 0;  ///< vehicle-vehicle contacts in the last step

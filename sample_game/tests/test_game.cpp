@@ -40,7 +40,7 @@ std::string write_script(const std::string& name, const std::string& text) {
 
 TEST(Game, DefaultScenarioRuns600FramesWithWheelsOnTheSurface) {
   auto g = make_game();
-  for (const char* s : {"default.lua", "artillery.lua", "budget.lua"})
+  for (const char* s : {"default.lua", "artillery.lua", "budget.lua", "earthworks.lua"})
     ASSERT_TRUE(g->load_script(kScripts + "/" + s).ok()) << s;
   ASSERT_EQ(g->vehicles().size(), 4u);
   std::map<int, glm::dvec3> start;
