@@ -32,6 +32,11 @@ VehicleEntry& check_vehicle(lua_State* L, int arg);
 /// The id of the vehicle handle at stack index `index`, or -1 when it is none.
 int test_vehicle(lua_State* L, int index);
 
+/// Sets field `k` of the table on top of the stack.
+void set_number(lua_State* L, const char* k, double v);
+void set_bool(lua_State* L, const char* k, bool v);
+void set_string(lua_State* L, const char* k, const std::string& v);
+
 /// Pushes the `game` table (vehicle type registered, game.terrain set). May raise (memory).
 void push_game_table(lua_State* L, Context* ctx);
 

@@ -30,14 +30,6 @@ ScriptRunner& runner_of(lua_State* L) {
   return *context(L).runner;
 }
 
-void set_number(lua_State* L, const char* k, double v) {
-  lua_pushnumber(L, v);
-  lua_setfield(L, -2, k);
-}
-void set_bool(lua_State* L, const char* k, bool v) {
-  lua_pushboolean(L, v);
-  lua_setfield(L, -2, k);
-}
 
 // game.spawn{model=, x=, z=, heading=, name=} -> vehicle or nil, message
 int g_spawn(lua_State* L) {

@@ -26,18 +26,6 @@ GameApi& game_of(lua_State* L) {
   return *context(L).game;
 }
 
-void set_number(lua_State* L, const char* k, double v) {
-  lua_pushnumber(L, v);
-  lua_setfield(L, -2, k);
-}
-void set_bool(lua_State* L, const char* k, bool v) {
-  lua_pushboolean(L, v);
-  lua_setfield(L, -2, k);
-}
-void set_string(lua_State* L, const char* k, const std::string& v) {
-  lua_pushlstring(L, v.data(), v.size());
-  lua_setfield(L, -2, k);
-}
 
 VehicleHandle* check_handle(lua_State* L, int arg) {
   return static_cast<VehicleHandle*>(luaL_checkudata(L, arg, kVehicleMeta));
@@ -215,6 +203,19 @@ const luaL_Reg kVehicleMethods[] = {{"set_controls", v_set_controls},
                                     {nullptr, nullptr}};
 
 }  // namespace
+
+void set_number(lua_State* L, const char* k, double v) {
+  lua_pushnumber(L, v);
+  lua_setfield(L, -2, k);
+}
+void set_bool(lua_State* L, const char* k, bool v) {
+  lua_pushboolean(L, v);
+  lua_setfield(L, -2, k);
+}
+void set_string(lua_State* L, const char* k, const std::string& v) {
+  lua_pushlstring(L, v.data(), v.size());
+  lua_setfield(L, -2, k);
+}
 
 Context& context(lua_State* L) {
   return *static_cast<Context*>(lua_touserdata(L, lua_upvalueindex(1)));
