@@ -45,7 +45,11 @@ struct GameOptions {
   double tessellation_budget_ms = 8;         ///< time budget of one view update
   bool tessellate = true;  ///< update the active view each frame (off: pure simulation)
   std::uint64_t instruction_limit = 20'000'000;  ///< per script call (an infinite loop ends)
-  std::uint32_t patch_exponent = 6;
+  /// ROAM patches of 2^k stored cells per side. 4 (32 m patches): a dirty patch's mesh is
+  /// rebuilt whole (RoamView::patch_mesh), and with detail the patches near the camera hold most
+  /// triangles; measured at 2 px, 1280 x 720: 3.5 ms of mesh building per frame with k = 4,
+  /// 16 ms with 5, 25 ms with 6 (docs/game.md, "Where the frame goes").
+  std::uint32_t patch_exponent = 4;
   /// Procedural detail of the world (levels 0: none).
   ridgeline::DetailParams detail = default_world_detail();
   std::uint32_t detail_workers = 2;                          ///< the tile cache's worker threads
@@ -151,6 +155,7 @@ class Game final : public GameApi {
   BudgetSettings budget() const noexcept override;
   void set_budget(const BudgetSettings& settings) override;
   const ViewFrame& last_view_frame() const noexcept override { return last_view_; }
+  std::uint32_t root_triangles() const noexcept override { return 2 * landscape_->patch_count(); }
 
  private:
   Game() = default;

@@ -110,6 +110,8 @@ class GameApi {
   /// only with the controller off (with it on they restart it there).
   virtual void set_budget(const BudgetSettings& settings) = 0;
   virtual const ViewFrame& last_view_frame() const noexcept = 0;
+  /// The views' root triangles: the smallest triangle budget a view accepts.
+  virtual std::uint32_t root_triangles() const noexcept = 0;
 };
 
 }  // namespace game

@@ -30,7 +30,6 @@ ScriptRunner& runner_of(lua_State* L) {
   return *context(L).runner;
 }
 
-
 // game.spawn{model=, x=, z=, heading=, name=} -> vehicle or nil, message
 int g_spawn(lua_State* L) {
   luaL_checktype(L, 1, LUA_TTABLE);
@@ -250,8 +249,12 @@ int g_set_budget(lua_State* L) {
     luaL_argerror(L, 1,
                   "field 'scale_from': 0 (the maximum) or a threshold within [min, max] "
                   "expected");
-  if (get_number_field(L, 1, "triangles", &tris) && (tris < 100 || tris > 4'000'000))
-    luaL_argerror(L, 1, "field 'triangles': 100 .. 4000000 expected");
+  if (get_number_field(L, 1, "triangles", &tris) && (tris < g.root_triangles() || tris > 4'000'000))
+    luaL_argerror(L, 1,
+                  lua_pushfstring(L,
+                                  "field 'triangles': %d .. 4000000 expected (the views' "
+                                  "root triangles at least), got %f",
+                                  int(g.root_triangles()), tris));
   if (get_number_field(L, 1, "tess_ms", &b.tessellation_ms) &&
       (b.tessellation_ms < 0 || b.tessellation_ms > 1000))
     luaL_argerror(L, 1, "field 'tess_ms': 0 .. 1000 ms expected (0: none)");

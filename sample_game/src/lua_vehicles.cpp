@@ -26,7 +26,6 @@ GameApi& game_of(lua_State* L) {
   return *context(L).game;
 }
 
-
 VehicleHandle* check_handle(lua_State* L, int arg) {
   return static_cast<VehicleHandle*>(luaL_checkudata(L, arg, kVehicleMeta));
 }

@@ -54,6 +54,7 @@ struct Args {
   double detail_amplitude = -1;
   bool prefill_detail = false;
   bool full_fragments = false, unsorted = false;
+  std::uint32_t patch_exponent = 4;
 };
 
 void read_window_input(GLFWwindow* w, game::Game& g, bool keyboard_free, double dt) {
@@ -99,6 +100,7 @@ int run(const Args& a) {
   if (a.detail_levels >= 0) o.detail.levels = std::uint32_t(a.detail_levels);
   if (a.detail_amplitude >= 0) o.detail.amplitude = a.detail_amplitude;
   o.prefill_detail = a.prefill_detail;
+  o.patch_exponent = a.patch_exponent;
   std::vector<std::string> scripts = a.scripts;
   if (scripts.empty())
     for (const char* s : {"default.lua", "artillery.lua", "budget.lua", "earthworks.lua"})
@@ -392,6 +394,9 @@ int main(int argc, char** argv) {
   app.add_option("--detail-amplitude", a.detail_amplitude,
                  "first detail octave, metres (default 0.2)")
       ->check(CLI::Range(0.0, 10.0));
+  app.add_option("--patch-exponent", a.patch_exponent, "ROAM patches of 2^k stored cells per side")
+      ->check(CLI::Range(3, 8))
+      ->capture_default_str();
   app.add_flag("--prefill-detail", a.prefill_detail,
                "each view update waits for the detail tiles it asked for (pictures that do not "
                "depend on tile arrival)");

@@ -71,7 +71,7 @@ void Panel::draw(Game& game, RenderSettings& settings, const PanelInput& in, dou
   if (ImGui::SliderFloat("target ms", &target, 10.0f, 100.0f, "%.0f"))
     (void)game.controller().set_target_ms(target);
   int tris = int(game.max_triangles());
-  if (ImGui::SliderInt("triangle budget", &tris, 5000, 400000))
+  if (ImGui::SliderInt("triangle budget", &tris, int(game.root_triangles()), 400000))
     game.set_max_triangles(std::uint32_t(tris));
   float tess = float(game.tessellation_budget_ms());
   if (ImGui::SliderFloat("tessellation ms", &tess, 0.0f, 30.0f, "%.1f"))

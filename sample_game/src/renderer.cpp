@@ -437,9 +437,13 @@ void Renderer::upload_patch(PatchGpu& gpu, const ridgeline::PatchMesh& mesh, Ren
   gpu.ox = mesh.origin_x;
   gpu.oy = mesh.origin_y;
   gpu.oz = mesh.origin_z;
-  float r2 = 0;
-  for (const ridgeline::MeshVertex& v : mesh.vertices) r2 = std::max(r2, v.x * v.x + v.z * v.z);
-  gpu.radius = std::sqrt(r2);
+  gpu.lo = glm::vec3(1e30f);
+  gpu.hi = glm::vec3(-1e30f);
+  for (const ridgeline::MeshVertex& v : mesh.vertices) {
+    const glm::vec3 p(v.x, v.y, v.z);
+    gpu.lo = glm::min(gpu.lo, glm::min(p, p + glm::vec3(0, v.morph_dy, 0)));
+    gpu.hi = glm::max(gpu.hi, glm::max(p, p + glm::vec3(0, v.morph_dy, 0)));
+  }
 }
 
 RenderStats Renderer::draw(Game& game, const RenderSettings& settings) {
@@ -530,9 +534,17 @@ RenderStats Renderer::draw(Game& game, const RenderSettings& settings) {
   glUniform1f(loc(terrain_prog_, "u_fog_density"), settings.fog_density);
   const int u_offset = loc(terrain_prog_, "u_offset"), u_uv = loc(terrain_prog_, "u_uv");
   order_.clear();
+  const ridgeline::Frustum frustum(cam);
   for (std::uint32_t p = 0; p < set.size(); ++p) {
-    if (set[p].count == 0) continue;
-    const double dx = set[p].ox - eye.x, dz = set[p].oz - eye.z;
+    const PatchGpu& g = set[p];
+    if (g.count == 0) continue;
+    const glm::dvec3 origin(g.ox, g.oy, g.oz);
+    if (frustum.classify_box(origin + glm::dvec3(g.lo), origin + glm::dvec3(g.hi)) ==
+        ridgeline::Frustum::Cull::kOut) {
+      ++st.patches_culled;
+      continue;
+    }
+    const double dx = g.ox - eye.x, dz = g.oz - eye.z;
     order_.push_back({settings.front_to_back ? float(dx * dx + dz * dz) : float(p), p});
   }
   std::sort(order_.begin(), order_.end());

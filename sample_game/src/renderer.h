@@ -36,6 +36,7 @@ struct RenderSettings {
 struct RenderStats {
   std::uint32_t patches_uploaded = 0;  ///< patch buffers re-uploaded this frame
   std::uint32_t patches_drawn = 0;
+  std::uint32_t patches_culled = 0;       ///< outside the view frustum: not drawn
   std::uint32_t triangles_drawn = 0;      ///< terrain triangles sent to GL (padding excluded)
   std::uint64_t bytes_uploaded = 0;       ///< vertex and index bytes sent this frame
   int scene_width = 0, scene_height = 0;  ///< pixels the scene rendered at (render scale)
@@ -65,7 +66,7 @@ class Renderer {
     unsigned vao = 0, vbo = 0, ibo = 0;
     int count = 0;
     double ox = 0, oy = 0, oz = 0;
-    float radius = 0;  ///< half the patch diagonal, metres (for the draw order)
+    glm::vec3 lo{0}, hi{0};  ///< patch-local bounding box of the vertices (geomorphs included)
     std::uint32_t triangles = 0;
   };
   struct MeshGpu {
