@@ -250,6 +250,7 @@ int run(const Args& a) {
     const double frame_ms = ms_since(t0);
     const double frame_cpu_ms = cpu_ms(CLOCK_PROCESS_CPUTIME_ID) - cpu0;
     const double frame_main_cpu_ms = cpu_ms(CLOCK_THREAD_CPUTIME_ID) - main0;
+    const auto tshot = Clock::now();
     if (renderer) {
       const bool last = a.frames > 0 && frame + 1 == a.frames;
       if (!a.screenshot.empty() && last) {
@@ -268,6 +269,7 @@ int run(const Args& a) {
           std::fprintf(stderr, "ridgeline_game: %s\n", s.message().c_str());
       }
     }
+    const double screenshot_ms = ms_since(tshot);
     if (ctx) ctx->present();
     last_frame_ms = frame_ms;
     g.set_last_frame_ms(frame_ms);
@@ -286,6 +288,7 @@ int run(const Args& a) {
     rec.render_ms = render_ms;
     rec.panel_ms = panel_ms;
     rec.burn_ms = burn;
+    rec.screenshot_ms = screenshot_ms;
     rec.threshold = vf.threshold;
     rec.wall_s =
         std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();

@@ -74,6 +74,7 @@ ridgeline::Status RunStats::write(const std::string& path, const std::string& mo
                       {"render_ms", f.render_ms},
                       {"panel_ms", f.panel_ms},
                       {"burn_ms", f.burn_ms},
+                      {"screenshot_ms", f.screenshot_ms},
                       {"threshold_px", f.threshold},
                       {"render_scale", f.render_scale},
                       {"triangles", f.triangles},

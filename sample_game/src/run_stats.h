@@ -19,6 +19,8 @@ struct FrameRecord {
   /// excluded), the panel's CPU side, artificial load.
   double frame_ms = 0, sim_ms = 0, scripts_ms = 0, physics_ms = 0, tess_ms = 0, upload_ms = 0,
          patch_mesh_ms = 0, render_ms = 0, panel_ms = 0, burn_ms = 0;
+  /// Milliseconds spent reading back and writing screenshots after the frame (not in frame_ms).
+  double screenshot_ms = 0;
   /// CPU milliseconds during the frame: every thread of the process, and the game's thread.
   double cpu_ms = 0, main_cpu_ms = 0;
   double threshold = 0, render_scale = 1;
