@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Game frame-time benchmark (docs/game.md, "Frame time"): the default scenario (the detail world,
-# four vehicles, artillery, earthworks, the budget controller with target 33 ms) at 1280 x 720
-# offscreen under Xvfb, one fixed step per frame:
+# Game frame-time benchmark (docs/game.md, "Frame time"): the default scenario as scripts/game.sh
+# runs it (the detail world, the debug panel, four vehicles, artillery, earthworks, the budget
+# controller with target 33 ms) at 1280 x 720 offscreen under Xvfb, one fixed step per frame:
 #   steady   1200 frames, statistics from frame 600;
 #   busy     1800 frames; two busy loops (one per core) started 20 s after the game and stopped
 #            15 s later by this script;
@@ -51,7 +51,7 @@ run() {
   wait_quiet
   echo "--- $name ($frames frames, load $(loadavg))"
   local before; before=$(loadavg)
-  with_display "$game" --offscreen --frames "$frames" --width 1280 --height 720 --no-panel \
+  with_display "$game" --offscreen --frames "$frames" --width 1280 --height 720 \
     --stats "$out/$name.json" "$@" > "$out/$name.log" 2>&1 ||
     { tail -20 "$out/$name.log"; exit 1; }
   printf '%s\n%s\n' "$before" "$(loadavg)" > "$out/$name.load"
@@ -63,7 +63,7 @@ if want busy; then
   wait_quiet
   echo "--- busy (1800 frames; two busy loops from 20 s to 35 s of wall time, load $(loadavg))"
   before=$(loadavg)
-  with_display "$game" --offscreen --frames 1800 --width 1280 --height 720 --no-panel \
+  with_display "$game" --offscreen --frames 1800 --width 1280 --height 720 \
     --stats "$out/busy.json" "${defaults[@]}" > "$out/busy.log" 2>&1 &
   game_pid=$!
   sleep 20
