@@ -94,14 +94,16 @@ def rolling_median(frames, i, n=15):
 
 
 def recovery(frames, t_end):
-    """Seconds after t_end until the rolling median frame time is within 10 % of the target and
-    stays there (to the end of the run); reversals of the controller after that point."""
+    """Seconds after t_end until the rolling median frame time (15 frames) is back at the target
+    (at most 10 % above it and at most 20 % below it) and stays there to the end of the run; the
+    controller's reversals after that point."""
     after = [i for i, x in enumerate(frames) if x["wall_s"] >= t_end]
     if not after:
         return None, None
     ok_from = None
     for i in after:
-        inside = abs(rolling_median(frames, i) / TARGET - 1) <= 0.10
+        rel = rolling_median(frames, i) / TARGET - 1
+        inside = -0.20 <= rel <= 0.10
         if inside and ok_from is None:
             ok_from = i
         elif not inside:
@@ -110,6 +112,17 @@ def recovery(frames, t_end):
         return None, None
     rev = frames[-1]["controller_reversals"] - frames[ok_from]["controller_reversals"]
     return frames[ok_from]["wall_s"] - t_end, rev
+
+
+def quality_recovery(frames, t0, t_end):
+    """Seconds after t_end until the threshold and the render scale are back within 10 % of their
+    medians over the 8 s before the load (None if they never are)."""
+    th0 = pct(window(frames, t0 - 8, t0, "threshold_px"), 50)
+    sc0 = pct(window(frames, t0 - 8, t0, "render_scale"), 50)
+    for x in frames:
+        if x["wall_s"] >= t_end and x["threshold_px"] <= th0 * 1.1 and x["render_scale"] >= sc0 / 1.1:
+            return x["wall_s"] - t_end
+    return None
 
 
 def load_summary(d, t0, t1, label):
@@ -134,6 +147,9 @@ def load_summary(d, t0, t1, label):
                   "threshold_px_p50": r(pct(window(f, t1 + 3, t1 + 10, "threshold_px"), 50), 3),
                   "render_scale_p50": r(pct(window(f, t1 + 3, t1 + 10, "render_scale"), 50), 3)},
         "recovery_s": r(rec_s),
+        "recovery_definition": "rolling median (15 frames) of the frame time back within "
+                               "[0.8, 1.1] x target and staying there",
+        "quality_recovery_s": r(quality_recovery(f, t0, t1)),
         "controller_reversals_after_recovery": rev,
         "load_average_before_after": d["load_average_before_after"],
     }
@@ -157,7 +173,7 @@ def plot(d, t0, t1, name, title):
     png = f"{images}/game_budget_{name}.png"
     a, b = t0 - start, t1 - start
     script = f"""
-set terminal png size 900,640 font ",10"
+set terminal png size 900,640 font ",10" noenhanced
 set output '{png}'
 set multiplot layout 3,1 title "{title}"
 set grid

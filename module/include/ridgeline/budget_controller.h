@@ -28,7 +28,7 @@ struct BudgetControllerDesc {
   /// by exp(gain * e), or the render scale divided by it), e being the relative error outside
   /// the band (clamped to [-1, 2]). Finite, > 0.
   double raise_gain = 3.0;  ///< used when frames are too slow
-  double lower_gain = 1.5;  ///< used when frames are fast (slower, to avoid overshoot)
+  double lower_gain = 2.5;  ///< used when frames are fast (slower, to avoid overshoot)
   /// After the controller moved in one direction it will not move the other way until this many
   /// seconds have passed outside the band on the other side (hysteresis in time: a single
   /// outlier frame never reverses it). >= 0.
