@@ -317,12 +317,18 @@ ViewFrame Game::update_view(double frame_ms) {
     render_scale_ = controller_.render_scale();
   }
   ViewFrame out;
-  out.threshold = threshold_;
+  // The views get the threshold on a 2 % geometric grid: RoamView re-keys its merge queue only
+  // when the threshold rises by more than 1 % between two updates, so a controller creeping up
+  // by less per frame would leave the mesh with the triangles of the lower threshold (measured:
+  // 18,500 instead of 12,800 after a ramp from 2 to 6 px at 0.5 % per frame; 40,000 at 6 px in
+  // the game).
+  const double view_threshold = controller_on_ ? quantise_threshold(threshold_) : threshold_;
+  out.threshold = view_threshold;
   out.render_scale = render_scale_;
   if (!options_.tessellate) return last_view_ = out;
   ridgeline::RoamView& v = active_view();
   ridgeline::RoamSettings s = v.settings();
-  s.threshold = threshold_;
+  s.threshold = view_threshold;
   s.max_triangles = max_triangles_;
   s.budget_ms = tess_budget_ms_;
   if (Status st = v.set_settings(s); !st) scripts_->log("view settings: " + st.message());
@@ -354,6 +360,13 @@ ViewFrame Game::update_view(double frame_ms) {
     scripts_->log("view update: " + r.error().message);
   }
   return last_view_ = out;
+}
+
+double quantise_threshold(double px) noexcept {
+  if (!(px > 0) || !std::isfinite(px)) return px;
+  constexpr double kStep = 1.02;
+  const double k = std::round(std::log(px) / std::log(kStep));
+  return std::pow(kStep, k);
 }
 
 BudgetSettings Game::budget() const noexcept {

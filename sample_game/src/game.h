@@ -30,6 +30,11 @@ namespace game {
 /// stored spacing (1 m finest spacing) with a 0.2 m octave (0.1 x the base spacing).
 ridgeline::DetailParams default_world_detail();
 
+/// The threshold a view gets from the controller's `px`: the nearest step of a 2 % geometric
+/// grid, so that a slowly rising threshold still re-keys the view's merges (RoamView does when
+/// the threshold rises by more than 1 % between updates). A fixed threshold is used as given.
+double quantise_threshold(double px) noexcept;
+
 /// Settings from the command line (main.cpp) or a test.
 struct GameOptions {
   std::string assets_dir;   ///< folder with vehicles/*.glb

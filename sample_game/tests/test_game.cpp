@@ -498,3 +498,34 @@ TEST(Game, TimesOfScriptsAndPhysicsAreMeasured) {
   EXPECT_GT(t.physics_ms, 0.0);
   EXPECT_EQ(g->take_step_times().scripts_ms, 0.0) << "taken";
 }
+
+TEST(Game, ASlowlyRisingThresholdStillCoarsensTheMesh) {
+  // The controller raises the threshold by well under 1 % per frame; the view re-keys its merges
+  // only for a larger rise, so the game hands it the threshold on a 2 % grid. Without the grid
+  // the mesh kept the triangles of the lower threshold.
+  auto g = make_game(true);
+  ASSERT_TRUE(g->load_script(kScripts + "/default.lua").ok());
+  ASSERT_TRUE(g->host().run("game.set_budget{controller=false, threshold=2, triangles=400000, "
+                            "tess_ms=0}", "b").ok());
+  for (int i = 0; i < 30; ++i) g->update_view(0);
+  const auto fixed6 = [&] {
+    auto h = make_game(true);
+    EXPECT_TRUE(h->load_script(kScripts + "/default.lua").ok());
+    EXPECT_TRUE(h->host().run("game.set_budget{controller=false, threshold=6, triangles=400000, "
+                              "tess_ms=0}", "b").ok());
+    game::ViewFrame f;
+    for (int i = 0; i < 30; ++i) f = h->update_view(0);
+    return f.stats.triangles;
+  }();
+  // The controller on, fed frames a little too slow: it creeps from 2 px towards its maximum.
+  ASSERT_TRUE(g->host().run("game.set_budget{controller=true, threshold=2, min=1, max=6, "
+                            "target_ms=33}", "b").ok());
+  game::ViewFrame f;
+  // 10 % too slow: 2 % outside the dead band, about 0.2 % per frame.
+  for (int i = 0; i < 3000 && g->threshold() < 6; ++i) f = g->update_view(33 * 1.1);
+  for (int i = 0; i < 30; ++i) f = g->update_view(33 * 1.1);
+  EXPECT_NEAR(f.threshold, 6.0, 0.13);
+  EXPECT_LT(f.stats.triangles, fixed6 * 1.1) << "the mesh coarsened as the threshold rose";
+  EXPECT_EQ(game::quantise_threshold(2.0), game::quantise_threshold(2.0 * 1.005));
+  EXPECT_NEAR(game::quantise_threshold(3.0) / 3.0, 1.0, 0.01);
+}
