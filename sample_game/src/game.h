@@ -45,7 +45,10 @@ struct GameOptions {
   double fixed_threshold = 0;
   /// > 0 (with fixed_threshold): the render scale stays at this value, else 1.
   double fixed_render_scale = 0;
-  ridgeline::BudgetControllerDesc budget{};  ///< target 33 ms by default
+  /// Target 33 ms; 30 warm-up frames: the game's first frames build every patch's mesh while
+  /// the view refines from its roots under the tessellation budget (about 20 frames of 50-140
+  /// ms in the default scenario), which must not steer the controller.
+  ridgeline::BudgetControllerDesc budget{.warmup_frames = 30};
   std::uint32_t max_triangles = 60000;       ///< triangle budget of every view
   double tessellation_budget_ms = 8;         ///< time budget of one view update
   bool tessellate = true;  ///< update the active view each frame (off: pure simulation)
