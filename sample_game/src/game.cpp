@@ -332,7 +332,17 @@ ViewFrame Game::update_view(double frame_ms) {
   s.max_triangles = max_triangles_;
   s.budget_ms = tess_budget_ms_;
   if (Status st = v.set_settings(s); !st) scripts_->log("view settings: " + st.message());
-  const ridgeline::Camera cam = camera();
+  ridgeline::Camera cam = camera();
+  // A falling threshold: RoamView keeps the split keys it computed for the higher threshold
+  // (their windows were sized for it), so leaves whose priority is now well below the threshold
+  // still split: ramping from 12 to 6 px left 59,000 triangles where a fresh view has 13,000.
+  // A change of the far plane makes the view recompute every key (within its time budget), so
+  // each step down moves the far plane by a part in 10^9 (alternating between two values, so
+  // that only the steps down re-key). The renderer's projection does not see it.
+  const int vi = int(rig_.mode);
+  if (view_threshold < last_view_threshold_[vi]) far_nudge_[vi] = !far_nudge_[vi];
+  last_view_threshold_[vi] = view_threshold;
+  if (far_nudge_[vi]) cam.far_m *= 1.0 + 1e-9;
   if (stream_) {  // tiles for where the camera is going, ahead of the view's own requests
     auto f = stream_->frame(cam);
     if (f) detail_frame_ = *f;

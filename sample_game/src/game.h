@@ -191,6 +191,8 @@ class Game final : public GameApi {
   std::uint32_t max_triangles_ = 60000;
   double tess_budget_ms_ = 8;
   ViewFrame last_view_;
+  double last_view_threshold_[3] = {0, 0, 0};  // per camera mode: the view's last threshold
+  bool far_nudge_[3] = {false, false, false};     // see update_view()
   std::optional<ridgeline::DetailStream> stream_;
   std::optional<ridgeline::DetailFrameStats> detail_frame_;
   std::uint64_t frame_ = 0;

@@ -529,3 +529,28 @@ TEST(Game, ASlowlyRisingThresholdStillCoarsensTheMesh) {
   EXPECT_EQ(game::quantise_threshold(2.0), game::quantise_threshold(2.0 * 1.005));
   EXPECT_NEAR(game::quantise_threshold(3.0) / 3.0, 1.0, 0.01);
 }
+
+TEST(Game, AFallingThresholdDoesNotOverRefineTheMesh) {
+  // The controller lowers the threshold step by step after a load; the view kept split keys
+  // sized for the higher threshold and over-refined (59,000 triangles at 6 px instead of
+  // 13,000) until the game made it re-key on every step down.
+  auto fixed6 = [&] {
+    auto h = make_game(true);
+    EXPECT_TRUE(h->load_script(kScripts + "/default.lua").ok());
+    EXPECT_TRUE(h->host().run("game.set_budget{controller=false, threshold=6, triangles=400000, "
+                              "tess_ms=0}", "b").ok());
+    game::ViewFrame f;
+    for (int i = 0; i < 30; ++i) f = h->update_view(0);
+    return f.stats.triangles;
+  }();
+  auto g = make_game(true);
+  ASSERT_TRUE(g->load_script(kScripts + "/default.lua").ok());
+  ASSERT_TRUE(g->host().run("game.set_budget{controller=true, threshold=12, min=6, max=12, "
+                            "triangles=400000, tess_ms=0, target_ms=33}", "b").ok());
+  game::ViewFrame f;
+  // Frames 15 % faster than the target: the threshold falls by about 0.4 % per frame.
+  for (int i = 0; i < 3000 && g->threshold() > 6; ++i) f = g->update_view(33 * 0.85);
+  for (int i = 0; i < 30; ++i) f = g->update_view(33 * 0.85);
+  EXPECT_NEAR(f.threshold, 6.0, 0.13);
+  EXPECT_LT(f.stats.triangles, fixed6 * 1.15) << "fixed 6 px: " << fixed6;
+}
