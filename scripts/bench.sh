@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Regenerates the benchmark figures quoted in docs/benchmarks.md: query speed and ROAM cost and
 # error along camera paths, on the 1025 x 1025 value-noise field the peer figures were measured on
-# (written by ../shared/tools/make-noise-field when present) and on the built-in default terrain.
+# (written by `ridge report --write-noise-field`) and on the built-in default terrain, with the
+# stateless SOAR comparator (`bench lod --mode soar`) on the noise field in the same run.
 # Usage: scripts/bench.sh [OUT_DIR]   (default docs/benchmarks; per-frame JSON goes to build/bench)
 # BENCH_ONLY=lod runs only the ROAM part (lod_summary.json, tables.md).
 set -euo pipefail
@@ -14,11 +15,10 @@ ensure_packages "${RIDGELINE_PACKAGES[@]}" python3
 configure_and_build build/release -DCMAKE_BUILD_TYPE=Release > /dev/null
 ridge=build/release/module/ridge
 
-noise=()
-gen=$RIDGELINE_ROOT/../shared/tools/make-noise-field
-if [ -f "$work/noise1025.png" ] || { [ -x "$gen" ] && "$gen" "$work" > /dev/null; }; then
-  noise=(--heightmap "$work/noise1025.png" --spacing 1 --height-scale 0.005)
-fi
+# The peers' noise field and circle path, from the project's own definition (ridgeline/scenes.h).
+[ -f "$work/noise1025.png" ] && [ -f "$work/noise1025_circle.json" ] ||
+  "$ridge" report --write-noise-field "$work"
+noise=(--heightmap "$work/noise1025.png" --spacing 1 --height-scale 0.005)
 
 echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)" | tee "$out/machine.txt"
 
@@ -26,15 +26,17 @@ only=${BENCH_ONLY:-all}
 if [ "$only" = all ]; then
   # Queries.
   "$ridge" bench queries --default-terrain --json "$out/queries_default.json"
-  [ ${#noise[@]} -gt 0 ] && "$ridge" bench queries "${noise[@]}" --json "$out/queries_noise1025.json"
+  "$ridge" bench queries "${noise[@]}" --json "$out/queries_noise1025.json"
   # Lua calls (when the binding is built).
   [ -x build/release/bindings/lua/bench_lua ] && build/release/bindings/lua/bench_lua > "$out/lua.json"
 fi
 
-# ROAM along paths. Error measured every 10th frame on every vertex in view.
+# ROAM along paths. Error measured every 10th frame on every vertex in view. A row that fails
+# stops the script (set -e): no row is dropped silently.
 lod() {  # NAME ARGS...
   local name=$1; shift
-  "$ridge" bench lod "$@" --error-every 10 --json "$work/$name.json"
+  "$ridge" bench lod "$@" --error-every 10 --json "$work/$name.json" ||
+    { echo "bench.sh: row $name failed" >&2; exit 1; }
   python3 - "$work/$name.json" "$name" >> "$work/summaries.jsonl" <<'PY'
 import json, sys
 s = json.load(open(sys.argv[1]))["summary"]
@@ -43,22 +45,27 @@ print(json.dumps(s))
 PY
 }
 rm -f "$work/summaries.jsonl"
-if [ ${#noise[@]} -gt 0 ]; then
-  path=$work/noise1025_circle.json
-  for t in 0.5 1 2 4 8; do
-    for mode in coherent rebuild; do
-      lod "noise_${mode}_t$t" "${noise[@]}" --path "$path" --threshold "$t" --mode "$mode" --warmup 60
-    done
+path=$work/noise1025_circle.json
+for t in 0.5 1 2 4 8; do
+  for mode in coherent rebuild soar; do
+    lod "noise_${mode}_t$t" "${noise[@]}" --path "$path" --threshold "$t" --mode "$mode" --warmup 60
   done
-  for n in 5250 53000; do
-    lod "noise_coherent_n$n" "${noise[@]}" --path "$path" --triangles "$n" --warmup 60
+done
+for n in 5250 20800 53000; do
+  for mode in coherent soar; do
+    lod "noise_${mode}_n$n" "${noise[@]}" --path "$path" --triangles "$n" --mode "$mode" --warmup 60
   done
-  # Time budgets on the flyover at 1 px (wall and thread-CPU percentiles).
-  for b in 2 0.5; do
-    lod "noise_coherent_t1_budget${b}ms" "${noise[@]}" --path "$path" --threshold 1 --budget-ms "$b" \
-      --warmup 60
-  done
-fi
+done
+# The peers' SOAR settings: nu = 100, 250, 500 is a threshold of 512 / nu px on this path.
+for nu in 100 250 500; do
+  lod "noise_soar_nu$nu" "${noise[@]}" --path "$path" --mode soar \
+    --threshold "$(python3 -c "print(512 / $nu)")" --warmup 60
+done
+# Time budgets on the flyover at 1 px (wall and thread-CPU percentiles).
+for b in 2 0.5; do
+  lod "noise_coherent_t1_budget${b}ms" "${noise[@]}" --path "$path" --threshold 1 --budget-ms "$b" \
+    --warmup 60
+done
 for p in flyover drive fast_yaw zoom down fast_pass; do
   lod "default_${p}_t2" --default-terrain --path "tests/data/paths/$p.json" --threshold 2
 done

@@ -2,14 +2,13 @@
 # The main job: builds Ridgeline and runs the `ridge` tool on the built-in default terrain,
 # printing what a person can judge: the terrain's size and heights, a height profile, query
 # speed, a converged ROAM mesh written to out/demo_mesh.glb, and the ROAM cost along a flyover.
-# (The sample game will replace this as the main job once it exists.)
 set -euo pipefail
 source "$(dirname "$0")/lib/common.sh"
 cd "$RIDGELINE_ROOT"
 ensure_packages "${RIDGELINE_PACKAGES[@]}"
-echo "building (build/demo)..."
-configure_and_build build/demo -DCMAKE_BUILD_TYPE=Release -DRIDGELINE_BUILD_TESTS=OFF > /dev/null
-ridge=build/demo/module/ridge
+echo "building ridge (build/release)..."
+build_release ridge ridgeline_lua_module > /dev/null
+ridge=build/release/module/ridge
 mkdir -p out
 echo "--- ridge info --default-terrain"
 "$ridge" info --default-terrain

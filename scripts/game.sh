@@ -12,12 +12,10 @@ set -euo pipefail
 source "$(dirname "$0")/lib/common.sh"
 cd "$RIDGELINE_ROOT"
 ensure_packages "${RIDGELINE_PACKAGES[@]}"
-echo "building (build/game-release)..."
+echo "building the game (build/release)..."
 mkdir -p build
-configure_and_build build/game-release -DCMAKE_BUILD_TYPE=Release -DRIDGELINE_BUILD_TESTS=OFF \
-  -DRIDGELINE_BUILD_BENCHMARKS=OFF -DRIDGELINE_BUILD_TOOLS=OFF > build/game-release.build.log 2>&1 ||
-  { tail -40 build/game-release.build.log; exit 1; }
-game=build/game-release/sample_game/ridgeline_game
+build_release ridgeline_game ridgeline_lua_module > build/release.build.log 2>&1 || { tail -40 build/release.build.log; exit 1; }
+game=build/release/sample_game/ridgeline_game
 if [ -n "${DISPLAY:-}" ] && [ -z "${RIDGELINE_OFFSCREEN:-}" ]; then
   echo "running the game in a window (Tab: camera, F1: wireframe, F5: reload scripts)"
   exec "$game" "$@"

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Regenerates the speed-versus-error report (docs/report.md): builds `ridge` (Release), writes the
-# 1025 x 1025 noise field with ../shared/tools/make-noise-field, fetches the real DEM (elev.tif of
+# 1025 x 1025 noise field with `ridge report --write-noise-field`, fetches the real DEM (elev.tif of
 # Debian's r-cran-terra, without installing R), runs `ridge report` once over every scene, path,
 # setting and mode, then plots with gnuplot.
 # Usage: bash scripts/report.sh [OUT_DIR]   (default docs/benchmarks/report; inputs in build/report-data)
@@ -22,8 +22,7 @@ if [ -z "$ridge" ]; then  # the report needs only `ridge`: build that target, no
 fi
 build_s=$SECONDS
 
-gen=$RIDGELINE_ROOT/../shared/tools/make-noise-field
-[ -f "$data/noise1025.png" ] || python3 "$gen" "$data" > /dev/null
+[ -f "$data/noise1025.png" ] || "$ridge" report --write-noise-field "$data"
 
 dem=$data/terra/usr/lib/R/site-library/terra/ex/elev.tif
 if [ ! -f "$dem" ]; then

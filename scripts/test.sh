@@ -15,6 +15,8 @@ JOBS=$(nproc)
 total0=$SECONDS
 
 stage "packages" ensure_packages "${RIDGELINE_PACKAGES[@]}" clang-14 libclang-rt-14-dev || exit 1
+# Real DEMs for the loader tests (build/test-data; they skip when it cannot be fetched).
+fetch_test_data
 
 # Khronos' glTF-Validator for the .glb export test, when npm is there (the test skips otherwise).
 install_gltf_validator() {
@@ -26,7 +28,7 @@ install_gltf_validator() {
 }
 
 release() {
-  configure_and_build build/release -DCMAKE_BUILD_TYPE=Release || return 1
+  build_release || return 1
   install_gltf_validator build/release
   # Under Xvfb when there is no display: the game's OpenGL tests need an X server for GLFW
   # (they skip with exit 77 where no context can be made; EGL needs none).

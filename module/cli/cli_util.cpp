@@ -96,6 +96,7 @@ Status write_output(const std::string& text, const std::string& path) {
     if (!std::cout) return Error{"cannot write to standard output"};
     return {};
   }
+  if (auto s = check_output_folder(path, "output file '" + path + "'"); !s) return s;
   // Written beside the target and renamed, so a crash never leaves a half-written file.
   const std::string tmp = path + ".tmp." + std::to_string(::getpid());
   {
@@ -121,6 +122,23 @@ Status write_output(const std::string& text, const std::string& path) {
 int report_error(const std::string& message) {
   std::fprintf(stderr, "ridge: error: %s\n", message.c_str());
   return kExitError;
+}
+
+int report_usage(const std::string& message) {
+  std::fprintf(stderr, "ridge: error: %s\n", message.c_str());
+  return kExitUsage;
+}
+
+Status check_output_folder(const std::string& path, const std::string& what) {
+  const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+  if (folder.empty()) return {};
+  std::error_code ec;
+  const auto st = std::filesystem::status(folder, ec);
+  if (st.type() == std::filesystem::file_type::not_found)
+    return Error{what + ": the folder '" + folder.string() + "' does not exist"};
+  if (!ec && st.type() != std::filesystem::file_type::directory)
+    return Error{what + ": '" + folder.string() + "' is not a folder"};
+  return {};
 }
 
 void install_log_sink() {

@@ -31,7 +31,8 @@ Result<std::uint64_t> parse_count(std::string_view text, const std::string& what
 std::string csv_number(double v);
 
 /// Writes `text` to stdout when `path` is empty or "-", else to `path` through a temporary file
-/// renamed into place (a crash never leaves a half-written file). Fails naming the file.
+/// renamed into place (a crash never leaves a half-written file). Fails naming the file (and
+/// the folder when it does not exist).
 Status write_output(const std::string& text, const std::string& path);
 
 /// write_output() of the JSON, indented by 2, with a final newline.
@@ -42,6 +43,15 @@ Status write_json(const Json& json, const std::string& path) {
 
 /// Prints "ridge: error: MESSAGE" to stderr and returns kExitError.
 int report_error(const std::string& message);
+
+/// Prints "ridge: error: MESSAGE" to stderr and returns kExitUsage: for a flag the command
+/// cannot run without (docs/cli.md, exit codes).
+int report_usage(const std::string& message);
+
+/// Fails, naming `what` and the folder, unless the folder `path` would be written into exists
+/// ("output file 'a/b.glb': the folder 'a' does not exist"). An empty folder part is the
+/// current directory.
+Status check_output_folder(const std::string& path, const std::string& what);
 
 /// CPU time of the calling thread, nanoseconds (CLOCK_THREAD_CPUTIME_ID): unlike wall time it
 /// does not count the time the thread waits for a core, which on a shared machine can dominate.

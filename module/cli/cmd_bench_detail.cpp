@@ -415,7 +415,7 @@ Command add_bench_detail_command(CLI::App& bench) {
       ->type_name("N");
   auto* fl = app->add_option_group("Flight");
   fl->add_option("--path", a->path,
-                 "Camera path (SPEC.md PATH.json) instead of the straight flight")
+                 "Camera path (PATH.json, docs/cli.md) instead of the straight flight")
       ->type_name("PATH.json");
   fl->add_option("--from", a->from,
                  "Start of the straight flight (default: 5 % in from the west edge, middle z)")

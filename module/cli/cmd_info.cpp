@@ -16,8 +16,13 @@ struct InfoOptions {
   std::string json_path;
 };
 
+const char* source_of(bool flag, bool from_file) {
+  return flag ? "flag" : from_file ? "geotiff" : "default";
+}
+
 int run_info(const InfoOptions& o) {
-  auto terrain = o.terrain.load_terrain();
+  io::LoadReport report;
+  auto terrain = o.terrain.load_terrain(&report);
   if (!terrain) return report_error(terrain.error().message);
   const Heightfield& hf = (*terrain)->heightfield();
   const std::uint64_t samples = std::uint64_t{hf.width()} * hf.height();
@@ -29,8 +34,14 @@ int run_info(const InfoOptions& o) {
       {"width", hf.width()},
       {"height", hf.height()},
       {"samples", samples},
+      {"pixel_type", report.pixel_type},
       {"spacing", {hf.spacing_x(), hf.spacing_z()}},
+      {"spacing_source", source_of(o.terrain.given("--spacing"), report.spacing_from_file)},
       {"origin", {hf.origin_x(), hf.origin_z()}},
+      {"origin_source", source_of(o.terrain.given("--origin"), report.origin_from_file)},
+      {"file_placement", report.file_placement
+                             ? nlohmann::ordered_json(report.file_placement->description)
+                             : nlohmann::ordered_json()},
       {"extent", {hf.extent_x(), hf.extent_z()}},
       {"height_offset", hf.height_offset()},
       {"height_scale", hf.height_scale()},
@@ -38,6 +49,7 @@ int run_info(const InfoOptions& o) {
       {"height_max", hf.height_offset() + double(hf.max_local())},
       {"has_materials", hf.has_materials()},
       {"filled_samples", hf.filled_samples()},
+      {"filled_fraction", double(hf.filled_samples()) / double(samples)},
       {"heightfield_bytes", hf.memory_bytes()},
       {"memory_bytes", bytes},
       {"bytes_per_sample", double(bytes) / double(samples)},
@@ -46,6 +58,7 @@ int run_info(const InfoOptions& o) {
       {"finest_spacing",
        {std::ldexp(hf.spacing_x(), -int((*terrain)->detail_levels())),
         std::ldexp(hf.spacing_z(), -int((*terrain)->detail_levels()))}},
+      {"warnings", report.warnings},
   };
   if (auto s = write_json(j, o.json_path); !s) return report_error(s.message());
   return 0;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <memory>
 
+#include "bench_soar.h"
 #include "cli_util.h"
 #include "commands.h"
 #include "ridgeline/camera_path.h"
@@ -20,10 +21,10 @@ namespace {
 struct LodArgs {
   TerrainArgs terrain;
   std::string patch_exponent = "6", threshold, triangles, tolerance, budget_ms, mode = "coherent",
-              slack;
+              morph_window;
   std::string json_path;
 
-  void add_to(CLI::App& app, bool with_tolerance) {
+  void add_to(CLI::App& app) {
     terrain.add_to(app);
     auto* g = app.add_option_group("Level of detail");
     g->add_option("--patch-exponent", patch_exponent,
@@ -33,19 +34,27 @@ struct LodArgs {
     g->add_option("--triangles", triangles,
                   "Hard cap on leaf triangles (alone: the best mesh of at most N triangles)")
         ->type_name("N");
-    if (with_tolerance)
-      g->add_option("--tolerance", tolerance,
-                    "View-independent mode: every triangle within METRES of the samples under it; "
-                    "whole terrain, no culling")
-          ->type_name("METRES");
+    g->add_option("--tolerance", tolerance,
+                  "View-independent mode: every triangle within METRES of the samples under it; "
+                  "whole terrain, no culling")
+        ->type_name("METRES");
     g->add_option("--budget-ms", budget_ms, "Time budget per update, milliseconds")
         ->type_name("MS");
-    g->add_option("--mode", mode, "coherent (split/merge queues) or rebuild (split only, Turner)")
+    g->add_option("--mode", mode,
+                  "coherent (split/merge queues) or rebuild (split only, Turner); bench lod "
+                  "also soar (the stateless SOAR comparator)")
         ->type_name("MODE");
-    g->add_option("--slack", slack, "Priority window as a fraction of distance (default 0.05)")
-        ->type_name("F");
+    g->add_option("--morph-window", morph_window,
+                  "Geomorph window w, 0..4 (default 0.5; 0: no morph nesting)")
+        ->type_name("W");
     app.add_option("--json", json_path, "Write the JSON to FILE instead of standard output")
         ->type_name("FILE");
+    // Without any of the three there is nothing to tessellate for: a usage error (exit 2).
+    app.callback([this] {
+      if (threshold.empty() && triangles.empty() && tolerance.empty())
+        throw CLI::RequiredError("give --threshold PX, --triangles N or --tolerance METRES",
+                                 CLI::ExitCodes::RequiredError);
+    });
   }
 
   Result<RoamSettings> settings() const {
@@ -81,11 +90,6 @@ struct LodArgs {
       if (*b < 0) return Error{"--budget-ms must be >= 0"};
       s.budget_ms = *b;
     }
-    if (!slack.empty()) {
-      auto f = parse_finite(slack, "--slack");
-      if (!f) return f.error();
-      s.slack = *f;
-    }
     if (mode == "coherent")
       s.mode = RoamMode::kCoherent;
     else if (mode == "rebuild")
@@ -102,7 +106,13 @@ struct LodArgs {
     if (!k) return k.error();
     auto t = terrain.load_terrain();
     if (!t) return t.error();
-    auto l = Landscape::create(*t, {.patch_exponent = static_cast<std::uint32_t>(*k)});
+    LandscapeDesc desc{.patch_exponent = static_cast<std::uint32_t>(*k)};
+    if (!morph_window.empty()) {
+      auto w = parse_finite(morph_window, "--morph-window");
+      if (!w) return w.error();
+      desc.morph_window = *w;
+    }
+    auto l = Landscape::create(*t, desc);
     if (!l) return l.error();
     *bounds_ms = (*l)->build_ms();
     *bound_bytes = (*l)->bound_bytes();
@@ -111,19 +121,17 @@ struct LodArgs {
 };
 
 nlohmann::ordered_json stats_json(const RoamStats& s) {
-  const char* stop = s.stop == StopReason::kConverged        ? "converged"
-                     : s.stop == StopReason::kTriangleBudget ? "triangles"
-                                                             : "time";
   return {{"triangles", s.triangles},
           {"splits", s.splits},
           {"forced_splits", s.forced_splits},
           {"merges", s.merges},
           {"priority_updates", s.priority_updates},
           {"update_ms", s.update_ms},
-          {"stopped_by", stop},
+          {"stopped_by", stop_reason_name(s.stop)},
           {"rebuilt", s.rebuilt},
           {"max_remaining_error", s.max_remaining_error},
-          {"memory_bytes", s.memory_bytes}};
+          {"memory_bytes", s.memory_bytes},
+          {"output_bytes", s.output_bytes}};
 }
 
 // ---- ridge mesh ---------------------------------------------------------------------------
@@ -131,7 +139,6 @@ nlohmann::ordered_json stats_json(const RoamStats& s) {
 struct MeshArgs {
   LodArgs lod;
   std::string eye, target, up = "0,1,0", fov = "60", viewport = "1280,720", far = "50000", out;
-  bool include_padding = false;
 };
 
 int run_mesh(const MeshArgs& a) {
@@ -139,7 +146,7 @@ int run_mesh(const MeshArgs& a) {
   const bool tolerance = !a.lod.tolerance.empty();
   if (!tolerance || !a.eye.empty()) {
     if (a.eye.empty() || a.target.empty())
-      return report_error("give --eye X,Y,Z and --target X,Y,Z (or --tolerance alone)");
+      return report_usage("give --eye X,Y,Z and --target X,Y,Z (or --tolerance alone)");
     auto e = parse_finite_list(a.eye, "--eye", 3, 3);
     if (!e) return report_error(e.error().message);
     auto t = parse_finite_list(a.target, "--target", 3, 3);
@@ -176,7 +183,6 @@ int run_mesh(const MeshArgs& a) {
   const auto stride = static_cast<std::uint32_t>(std::max(1.0, std::ceil(std::sqrt(verts / 4e6))));
   const auto err = (*view)->measure_error(c, stride);
   io::GltfExportOptions go;
-  go.include_padding = a.include_padding;
   if (auto s = io::write_glb(**view, a.out, go); !s) return report_error(s.message());
   const Landscape& l = (*view)->landscape();
   nlohmann::ordered_json j = stats_json(*st);
@@ -202,6 +208,25 @@ struct BenchLodArgs {
   std::string path, error_every = "1", error_stride = "1", warmup = "0", repeat = "1";
 };
 
+// Leaves whose box (lattice extent, heights of the corners) meets the camera's frustum and that
+// are drawn (not padding): the triangles a renderer that culls per triangle would draw.
+std::uint64_t triangles_in_view(const RoamView& v, const Camera& c) {
+  const Frustum f(c);
+  const Landscape& l = v.landscape();
+  const double off = l.terrain().heightfield().height_offset();
+  std::uint64_t n = 0;
+  v.for_each_leaf([&](std::uint32_t, std::uint64_t, const LatticeTriangle& t) {
+    const Landscape::LatticeBox b = Landscape::box_of(t);
+    if (b.i0 >= l.last_i() || b.j0 >= l.last_j()) return;  // padding, not drawn
+    const double ha = l.lattice_height(t.ax, t.az), hl = l.lattice_height(t.lx, t.lz),
+                 hr = l.lattice_height(t.rx, t.rz);
+    const glm::dvec3 lo(l.world_x(b.i0), off + std::min({ha, hl, hr}), l.world_z(b.j0));
+    const glm::dvec3 hi(l.world_x(b.i1), off + std::max({ha, hl, hr}), l.world_z(b.j1));
+    n += f.classify_box(lo, hi) != Frustum::Cull::kOut;
+  });
+  return n;
+}
+
 double percentile(std::vector<double> v, double q) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
@@ -221,6 +246,10 @@ int run_bench_lod(const BenchLodArgs& a) {
   if (!warmup) return report_error(warmup.error().message);
   auto repeat = parse_count(a.repeat, "--repeat", 1, 1000);
   if (!repeat) return report_error(repeat.error().message);
+  if (a.lod.mode == "soar")  // the stateless comparator (bench_soar.h)
+    return run_bench_lod_soar({&a.lod.terrain, &*frames, a.lod.threshold, a.lod.triangles,
+                               a.lod.budget_ms, *every, *stride, *warmup, *repeat,
+                               a.lod.json_path});
   double bounds_ms = 0;
   std::size_t bound_bytes = 0;
   auto view = a.lod.view(&bounds_ms, &bound_bytes);
@@ -228,11 +257,14 @@ int run_bench_lod(const BenchLodArgs& a) {
   RoamView& v = **view;
 
   // Warm-up frames (the first frames of the path, not reported), then the path `repeat` times.
-  for (std::uint64_t k = 0; k < *warmup; ++k)
+  for (std::uint64_t k = 0; k < *warmup; ++k) {
     if (auto st = v.update((*frames)[k % frames->size()].camera); !st)
       return report_error(st.error().message);
+    (void)v.take_dirty_patches();
+  }
   nlohmann::ordered_json out_frames = nlohmann::ordered_json::array();
-  std::vector<double> ms, cpu, tris, changes, max_err, rms_err, px_err, mem;
+  std::vector<double> ms, cpu, out_ms, out_cpu, total_ms, total_cpu, tris, in_view, changes,
+      max_err, rms_err, px_err, mem, out_mem, upload;
   std::uint32_t time_stops = 0, rebuilds = 0;
   for (std::uint64_t rep = 0; rep < *repeat; ++rep) {
     for (std::size_t k = 0; k < frames->size(); ++k) {
@@ -241,21 +273,33 @@ int run_bench_lod(const BenchLodArgs& a) {
       // the difference is time the update was preempted, which no budget can keep.
       const double cpu0 = thread_cpu_ns();
       auto st = v.update(c);
-      const double cpu_ms = (thread_cpu_ns() - cpu0) * 1e-6;
+      const double cpu1 = thread_cpu_ns();
       if (!st) return report_error(st.error().message);
-      (void)v.take_dirty_patches();
-      nlohmann::ordered_json f = {
-          {"update_ms", st->update_ms},
-          {"update_cpu_ms", cpu_ms},
-          {"triangles", st->triangles},
-          {"splits", st->splits + st->forced_splits},
-          {"merges", st->merges},
-          {"priority_updates", st->priority_updates},
-          {"expired", st->expired},
-          {"rebuilt", st->rebuilt},
-          {"stopped_by", st->stop == StopReason::kConverged        ? "converged"
-                         : st->stop == StopReason::kTriangleBudget ? "triangles"
-                                                                   : "time"}};
+      // The output an engine uploads: the update keeps the patch buffers in step; what is left
+      // is taking the dirty patches and their ranges.
+      const auto w0 = std::chrono::steady_clock::now();
+      const std::vector<std::uint32_t> dirty = v.take_dirty_patches();
+      const double o_ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - w0).count();
+      const double o_cpu = (thread_cpu_ns() - cpu1) * 1e-6;
+      const double cpu_ms = (cpu1 - cpu0) * 1e-6;
+      const std::uint64_t visible = triangles_in_view(v, c);
+      nlohmann::ordered_json f = {{"update_ms", st->update_ms},
+                                  {"update_cpu_ms", cpu_ms},
+                                  {"output_ms", o_ms},
+                                  {"output_cpu_ms", o_cpu},
+                                  {"triangles", st->triangles},
+                                  {"triangles_in_view", visible},
+                                  {"splits", st->splits + st->forced_splits},
+                                  {"forced_splits", st->forced_splits},
+                                  {"merges", st->merges},
+                                  {"priority_updates", st->priority_updates},
+                                  {"front_size", st->front_size},
+                                  {"upload_bytes", st->upload_bytes},
+                                  {"dirty_patches", dirty.size()},
+                                  {"rebuilt", st->rebuilt},
+                                  {"stopped_by", stop_reason_name(st->stop)},
+                                  {"morph_threshold", st->morph_threshold}};
       if (*every > 0 && k % *every == 0) {
         const auto e = v.measure_error(c, static_cast<std::uint32_t>(*stride));
         f["max_error"] = e.max_m;
@@ -270,14 +314,22 @@ int run_bench_lod(const BenchLodArgs& a) {
       out_frames.push_back(f);
       ms.push_back(st->update_ms);
       cpu.push_back(cpu_ms);
+      out_ms.push_back(o_ms);
+      out_cpu.push_back(o_cpu);
+      total_ms.push_back(st->update_ms + o_ms);
+      total_cpu.push_back(cpu_ms + o_cpu);
       tris.push_back(st->triangles);
+      in_view.push_back(double(visible));
       changes.push_back(st->splits + st->forced_splits + st->merges);
       mem.push_back(double(st->memory_bytes));
+      out_mem.push_back(double(st->output_bytes));
+      upload.push_back(double(st->upload_bytes));
       time_stops += st->stop == StopReason::kTimeBudget;
       rebuilds += st->rebuilt;
     }
   }
   const RoamSettings s = v.settings();
+  const double tri_median = std::max(1.0, percentile(tris, 0.5));
   nlohmann::ordered_json summary = {
       {"frames", ms.size()},
       {"mode", s.mode == RoamMode::kCoherent ? "coherent" : "rebuild"},
@@ -289,15 +341,25 @@ int run_bench_lod(const BenchLodArgs& a) {
       {"update_cpu_ms_median", percentile(cpu, 0.5)},
       {"update_cpu_ms_p99", percentile(cpu, 0.99)},
       {"update_ms_max", percentile(ms, 1.0)},
+      {"output_ms_median", percentile(out_ms, 0.5)},
+      {"output_cpu_ms_median", percentile(out_cpu, 0.5)},
+      {"update_plus_output_ms_median", percentile(total_ms, 0.5)},
+      {"update_plus_output_cpu_ms_median", percentile(total_cpu, 0.5)},
+      {"update_plus_output_cpu_ms_p99", percentile(total_cpu, 0.99)},
       {"triangles_median", percentile(tris, 0.5)},
       {"triangles_p99", percentile(tris, 0.99)},
+      {"triangles_in_view_median", percentile(in_view, 0.5)},
       {"changes_per_frame_median", percentile(changes, 0.5)},
+      {"upload_bytes_median", percentile(upload, 0.5)},
+      {"upload_bytes_p99", percentile(upload, 0.99)},
       {"view_memory_bytes_median", percentile(mem, 0.5)},
-      {"view_bytes_per_triangle", percentile(mem, 0.5) / std::max(1.0, percentile(tris, 0.5))},
+      {"view_bytes_per_triangle", percentile(mem, 0.5) / tri_median},
+      {"output_bytes_per_triangle", percentile(out_mem, 0.5) / tri_median},
       {"max_error_median", percentile(max_err, 0.5)},
       {"max_error_max", percentile(max_err, 1.0)},
       {"rms_error_median", percentile(rms_err, 0.5)},
       {"max_screen_error_px_median", percentile(px_err, 0.5)},
+      {"max_screen_error_px_max", percentile(px_err, 1.0)},
       {"time_budget_stops", time_stops},
       {"rebuilds", rebuilds},
       {"bounds_build_ms", bounds_ms},
@@ -320,7 +382,7 @@ Command add_mesh_command(CLI::App& parent) {
   auto* app = parent.add_subcommand(
       "mesh", "Converge the ROAM mesh for one view and write it as glTF 2.0 binary (.glb)");
   auto a = std::make_shared<MeshArgs>();
-  a->lod.add_to(*app, true);
+  a->lod.add_to(*app);
   auto* g = app->add_option_group("Camera");
   g->add_option("--eye", a->eye, "Eye position")->type_name("X,Y,Z");
   g->add_option("--target", a->target, "Point looked at")->type_name("X,Y,Z");
@@ -330,9 +392,7 @@ Command add_mesh_command(CLI::App& parent) {
   g->add_option("--viewport", a->viewport, "Viewport in pixels (default 1280,720)")
       ->type_name("W,H");
   g->add_option("--far", a->far, "Far plane, metres (default 50000)")->type_name("M");
-  app->add_option("--out", a->out, "Output .glb file")->type_name("FILE.glb");
-  app->add_flag("--include-padding", a->include_padding,
-                "Also write triangles over the edge padding of the last patches");
+  app->add_option("--out", a->out, "Output .glb file")->type_name("FILE.glb")->required();
   return {app, [a] { return run_mesh(*a); }};
 }
 
@@ -340,8 +400,10 @@ Command add_bench_lod_command(CLI::App& bench) {
   auto* app = bench.add_subcommand(
       "lod", "Run a camera path: per-frame update ms, triangles, splits, merges and error (JSON)");
   auto a = std::make_shared<BenchLodArgs>();
-  a->lod.add_to(*app, false);
-  app->add_option("--path", a->path, "Camera path (SPEC.md PATH.json)")->type_name("PATH.json");
+  a->lod.add_to(*app);
+  app->add_option("--path", a->path, "Camera path (PATH.json, docs/cli.md)")
+      ->type_name("PATH.json")
+      ->required();
   app->add_option("--error-every", a->error_every,
                   "Measure the mesh error every K-th frame (default 1; 0 = never)")
       ->type_name("K");

@@ -1,6 +1,7 @@
 #include "terrain_args.h"
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <limits>
 
@@ -8,6 +9,7 @@
 #include "ridgeline/detail.h"
 #include "ridgeline/edit.h"
 #include "ridgeline/io.h"
+#include "ridgeline/log.h"
 
 namespace ridgeline::cli {
 
@@ -30,6 +32,12 @@ void TerrainArgs::add_to(CLI::App& app) {
       ->group(g);
   hm->excludes(dt);
   dt->excludes(hm);
+  // A terrain source is required: a usage error (exit 2) found after parsing, after --help.
+  app.parse_complete_callback([this] {
+    if (!given("--heightmap") && !default_terrain_)
+      throw CLI::RequiredError("no terrain given: pass --heightmap FILE or --default-terrain",
+                               CLI::ExitCodes::RequiredError);
+  });
   app.add_option("--raw-size", raw_size_, "Size of a raw heightmap in samples")
       ->type_name("W,H")
       ->group(g);
@@ -39,7 +47,8 @@ void TerrainArgs::add_to(CLI::App& app) {
       ->type_name("u16|f32")
       ->group(g);
   app.add_option("--spacing", spacing_,
-                 "Metres between samples: one value for both axes or SX,SZ (default 1)")
+                 "Metres between samples: one value for both axes or SX,SZ (default: a GeoTIFF's "
+                 "own placement, else 1)")
       ->type_name("S|SX,SZ")
       ->group(g);
   app.add_option(
@@ -50,7 +59,9 @@ void TerrainArgs::add_to(CLI::App& app) {
   app.add_option("--height-offset", height_offset_, "Height offset in metres (default 0)")
       ->type_name("O")
       ->group(g);
-  app.add_option("--origin", origin_, "World position of sample (0, 0) in metres (default 0,0)")
+  app.add_option("--origin", origin_,
+                 "World position of sample (0, 0) in metres (default: a projected GeoTIFF's own "
+                 "placement, else 0,0)")
       ->type_name("X,Z")
       ->group(g);
   app.add_option("--nodata", nodata_,
@@ -130,6 +141,25 @@ std::string TerrainArgs::source() const {
   return default_terrain_ ? std::string("default terrain") : heightmap_;
 }
 
+namespace {
+
+// The loaders' warning for a map mostly filled from no-data, for the generated terrain placed
+// with --nodata and --fill (loaded files get it from the loader).
+void warn_if_filled(const Heightfield& hf, io::LoadReport* report) {
+  const double samples = double(hf.width()) * double(hf.height());
+  const double fraction = double(hf.filled_samples()) / samples;
+  if (fraction <= io::kFilledWarningFraction) return;
+  char text[160];
+  std::snprintf(text, sizeof text,
+                "%llu of %.0f samples (%.1f %%) are filled from no-data: that part of the terrain "
+                "is invented",
+                static_cast<unsigned long long>(hf.filled_samples()), samples, 100.0 * fraction);
+  log_message(LogLevel::kWarning, std::string("default terrain: ") + text);
+  if (report != nullptr) report->warnings.push_back(text);
+}
+
+}  // namespace
+
 Result<HeightfieldDesc> TerrainArgs::placement() const {
   HeightfieldDesc d;
   if (given("--spacing")) {
@@ -183,7 +213,7 @@ Result<HeightfieldDesc> TerrainArgs::placement() const {
   return d;
 }
 
-Result<Heightfield> TerrainArgs::load_heightfield() const {
+Result<Heightfield> TerrainArgs::load_heightfield(io::LoadReport* report) const {
   if (!given("--heightmap") && !default_terrain_)
     return Error{"no terrain given: pass --heightmap FILE or --default-terrain"};
   auto desc = placement();
@@ -208,6 +238,7 @@ Result<Heightfield> TerrainArgs::load_heightfield() const {
     if (auto s = validate_heightfield_desc(d); !s) return Error{s.message()};
     auto base = make_default_heightfield(params);
     if (!base) return base.error();
+    if (report != nullptr) report->pixel_type = "float (generated)";
     const bool placed = given("--spacing") || given("--height-scale") || given("--height-offset") ||
                         given("--origin") || given("--nodata") || given("--fill");
     if (!placed) return base;
@@ -216,12 +247,17 @@ Result<Heightfield> TerrainArgs::load_heightfield() const {
     mats.reserve(std::size_t{base->width() - 1} * (base->height() - 1));
     for (std::uint32_t j = 0; j + 1 < base->height(); ++j)
       for (std::uint32_t i = 0; i + 1 < base->width(); ++i) mats.push_back(base->material(i, j));
-    return Heightfield::create(d, base->local_heights(), mats);
+    auto placed_hf = Heightfield::create(d, base->local_heights(), mats);
+    if (placed_hf) warn_if_filled(*placed_hf, report);
+    return placed_hf;
   }
 
   io::LoadOptions options;
   options.placement = *desc;
   options.materials_path = materials_;
+  // A GeoTIFF's own placement unless the flags give one.
+  options.spacing_from_file = !given("--spacing");
+  options.origin_from_file = !given("--origin");
   if (given("--channel")) {
     auto c = parse_count(channel_, "--channel", 0, 1023);
     if (!c) return c.error();
@@ -247,9 +283,9 @@ Result<Heightfield> TerrainArgs::load_heightfield() const {
     auto t = io::parse_raw_type(type);
     if (!t) return Error{"--raw-type: " + t.error().message};
     raw.type = *t;
-    return io::load_raw(heightmap_, raw, options);
+    return io::load_raw(heightmap_, raw, options, report);
   }
-  return io::load_heightmap(heightmap_, options);
+  return io::load_heightmap(heightmap_, options, nullptr, report);
 }
 
 Result<DetailParams> TerrainArgs::detail_params() const {
@@ -297,8 +333,8 @@ Result<DetailParams> TerrainArgs::detail_params() const {
   return detail;
 }
 
-Result<std::shared_ptr<Terrain>> TerrainArgs::load_terrain() const {
-  auto hf = load_heightfield();
+Result<std::shared_ptr<Terrain>> TerrainArgs::load_terrain(io::LoadReport* report) const {
+  auto hf = load_heightfield(report);
   if (!hf) return hf.error();
   auto detail = detail_params();
   if (!detail) return detail.error();

@@ -1,6 +1,6 @@
-// The common terrain flags of every `ridge` subcommand (SPEC.md, "The `ridge` tool's common
-// flags"), defined once so that every subcommand (info, query, profile, bench, mesh, ...) reads
-// its terrain the same way.
+// The common terrain flags of every `ridge` subcommand (docs/cli.md, "Terrain flags"), defined
+// once so that every subcommand (info, query, profile, bench, mesh, ...) reads its terrain the
+// same way.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -9,6 +9,7 @@
 
 #include "ridgeline/detail.h"
 #include "ridgeline/heightfield.h"
+#include "ridgeline/io.h"
 #include "ridgeline/result.h"
 #include "ridgeline/terrain.h"
 
@@ -24,15 +25,19 @@ class TerrainArgs {
   /// --default-size and the detail flags (--detail-levels, --detail-seed, --detail-amplitude,
   /// --detail-gain, --detail-flat-shape, --detail-steep-shape, --detail-flat-slope,
   /// --detail-steep-slope, --detail-blur-radius, --detail-budget-mb) to
-  /// `app`, in an option group "Terrain". The object must outlive the parse.
+  /// `app`, in an option group "Terrain". The object must outlive the parse. Sets the app's
+  /// parse_complete_callback: a missing terrain source (neither --heightmap nor
+  /// --default-terrain) is a usage error (CLI::RequiredError, exit 2).
   void add_to(CLI::App& app);
 
   /// The heightfield the flags describe: loaded from --heightmap or generated (--default-terrain),
-  /// placed by the placement flags.
-  Result<Heightfield> load_heightfield() const;
+  /// placed by the placement flags; without --spacing (--origin) a GeoTIFF's own placement is
+  /// used. `report`, when given, receives what the loader found (pixel type, file placement,
+  /// warnings).
+  Result<Heightfield> load_heightfield(io::LoadReport* report = nullptr) const;
   /// load_heightfield() wrapped into a Terrain (builds the query structures), with the edit
   /// state of --load STATE.bin applied when given.
-  Result<std::shared_ptr<Terrain>> load_terrain() const;
+  Result<std::shared_ptr<Terrain>> load_terrain(io::LoadReport* report = nullptr) const;
 
   /// The DetailParams of the detail flags (levels 0 without --detail-levels), validated; the
   /// other detail flags without --detail-levels N >= 1 are refused.

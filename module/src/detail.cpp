@@ -529,9 +529,8 @@ std::shared_ptr<const DetailTile> DetailField::make_tile_chain(const DetailTileK
   return make_tile(key, parent.get());
 }
 
-double DetailField::contribution_bound(std::uint32_t from_level, std::uint32_t level,
-                                       std::int64_t i0, std::int64_t j0, std::int64_t i1,
-                                       std::int64_t j1) const noexcept {
+std::uint32_t DetailField::shape_max_q15(std::uint32_t level, std::int64_t i0, std::int64_t j0,
+                                         std::int64_t i1, std::int64_t j1) const noexcept {
   if (i0 > i1 || j0 > j1 || level > kMaxDetailLevels) return 0;
   // Base samples whose shape can reach a finest sample in the rectangle, or a corner of the
   // level-m triangle around one (one base sample of margin covers both).
@@ -546,21 +545,35 @@ double DetailField::contribution_bound(std::uint32_t from_level, std::uint32_t l
   for (std::int64_t bj = b0 >> p; bj <= (b1 >> p); ++bj)
     for (std::int64_t bi = a0 >> p; bi <= (a1 >> p); ++bi)
       smax = std::max(smax, blocks[std::size_t(bi + bj * pw)]);
-  std::int64_t amps = 0, rounding = 0;
-  for (std::uint32_t m = std::max(from_level, 1u); m <= params_.levels; ++m) {
+  return smax;
+}
+
+std::int64_t DetailField::amplitude_sum(std::uint32_t from_level) const noexcept {
+  std::int64_t amps = 0;
+  for (std::uint32_t m = std::max(from_level, 1u); m <= params_.levels; ++m)
     amps += amp_[m] + amp_[m - 1];
-    rounding += 1;
-  }
-  return (double(amps) * double(smax) / 32768.0 + double(rounding)) * kDetailUnit;
+  return amps;
+}
+
+std::int64_t DetailField::rounding_terms(std::uint32_t from_level) const noexcept {
+  const std::uint32_t from = std::max(from_level, 1u);
+  return from > params_.levels ? 0 : std::int64_t(params_.levels - from + 1);
+}
+
+double DetailField::contribution_bound(std::uint32_t from_level, std::uint32_t level,
+                                       std::int64_t i0, std::int64_t j0, std::int64_t i1,
+                                       std::int64_t j1) const noexcept {
+  if (i0 > i1 || j0 > j1 || level > kMaxDetailLevels) return 0;
+  const double smax = shape_max_q15(level, i0, j0, i1, j1);
+  return (double(amplitude_sum(from_level)) * smax / 32768.0 +
+          double(rounding_terms(from_level))) *
+         kDetailUnit;
 }
 
 double DetailField::contribution_bound(std::uint32_t from_level) const noexcept {
-  std::int64_t amps = 0, rounding = 0;
-  for (std::uint32_t m = std::max(from_level, 1u); m <= params_.levels; ++m) {
-    amps += amp_[m] + amp_[m - 1];
-    rounding += 1;
-  }
-  return (double(amps) * double(shape_max_all_) / 32768.0 + double(rounding)) * kDetailUnit;
+  return (double(amplitude_sum(from_level)) * double(shape_max_all_) / 32768.0 +
+          double(rounding_terms(from_level))) *
+         kDetailUnit;
 }
 
 // ---- DetailSnapshot, DetailCache ----------------------------------------------------------------

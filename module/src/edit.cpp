@@ -2,19 +2,19 @@
 // (docs/deformation.md).
 #include "ridgeline/edit.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <bit>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fcntl.h>
-#include <mutex>
 #include <numbers>
-#include <unistd.h>
 
 #include "edit_layer.h"
-#include "edit_listener.h"
+#include "edit_log.h"
 #include "format.h"
 #include "ray_hierarchy.h"
 #include "ridgeline/detail.h"
@@ -131,19 +131,6 @@ void EditLayer::restore_all(Heightfield& hf) {
   originals_.clear();
 }
 
-// ---- listeners -------------------------------------------------------------------------------
-
-void Terrain::add_listener(detail::EditListener* l) const {
-  std::lock_guard lock(listeners_->mutex);
-  listeners_->list.push_back(l);
-}
-
-void Terrain::remove_listener(detail::EditListener* l) const {
-  std::lock_guard lock(listeners_->mutex);
-  auto& v = listeners_->list;
-  v.erase(std::remove(v.begin(), v.end(), l), v.end());
-}
-
 // ---- the transaction -------------------------------------------------------------------------
 
 namespace {
@@ -163,10 +150,47 @@ struct Changes {
 
 }  // namespace
 
-// After the heights changed: ray pyramid, listeners, version, and the result's box.
-static void finish_transaction(Terrain& t, const Changes& c, EditResult& r,
-                               RayHierarchy& rays, std::uint64_t& version,
-                               const std::vector<detail::EditListener*>& listeners) {
+// What the changed stored samples of `c` changed on `t`'s surface: the cells touching them, the
+// surface's height range there before and after, the finest-lattice vertices that moved.
+static TerrainChange describe_change(const Terrain& t, const Changes& c) {
+  const Heightfield& hf = t.heightfield();
+  const int L = int(t.detail_levels());
+  // Corners of the cells touching a changed sample (unchanged corners keep their height).
+  const std::uint32_t vi0 = c.i0 > 0 ? c.i0 - 1 : 0, vj0 = c.j0 > 0 ? c.j0 - 1 : 0;
+  const std::uint32_t vi1 = std::min(c.i1 + 1, hf.width() - 1),
+                      vj1 = std::min(c.j1 + 1, hf.height() - 1);
+  float lo = c.lo, hi = c.hi;  // the changed samples, before and after
+  for (std::uint32_t j = vj0; j <= vj1; ++j)
+    for (std::uint32_t i = vi0; i <= vi1; ++i)
+      lo = std::min(lo, hf.local(i, j)), hi = std::max(hi, hf.local(i, j));
+  // The surface is piecewise linear over those corners, plus detail below the stored resolution.
+  const std::int64_t s = std::int64_t{1} << L;
+  const double pad = L == 0 ? 0.0
+                            : t.detail()->contribution_bound(1, std::uint32_t(L), vi0 * s, vj0 * s,
+                                                             vi1 * s, vj1 * s);
+  TerrainChange ch;
+  ch.box.min = {hf.origin_x() + vi0 * hf.spacing_x(), hf.height_offset() + double(lo) - pad,
+                hf.origin_z() + vj0 * hf.spacing_z()};
+  ch.box.max = {hf.origin_x() + vi1 * hf.spacing_x(), hf.height_offset() + double(hi) + pad,
+                hf.origin_z() + vj1 * hf.spacing_z()};
+  if (L == 0) {
+    ch.vertices = {c.i0, c.j0, c.i1, c.j1};
+  } else {
+    // Detail-lattice vertices strictly inside those cells are interpolated from the changed
+    // samples; the unchanged corners themselves stay.
+    const std::int64_t last_i = t.fine_width() - 1, last_j = t.fine_height() - 1;
+    ch.vertices = {std::max<std::int64_t>(0, (std::int64_t(c.i0) - 1) * s + 1),
+                   std::max<std::int64_t>(0, (std::int64_t(c.j0) - 1) * s + 1),
+                   std::min(last_i, (std::int64_t(c.i1) + 1) * s - 1),
+                   std::min(last_j, (std::int64_t(c.j1) + 1) * s - 1)};
+  }
+  return ch;
+}
+
+// After the heights changed: ray pyramid, version, change log and the result's box. Nothing is
+// called back: landscapes, views and engines pull the log (Terrain::changes_since).
+static void finish_transaction(Terrain& t, const Changes& c, EditResult& r, RayHierarchy& rays,
+                               std::uint64_t& version, ChangeLog& log) {
   r.samples_changed = c.samples;
   if (c.samples == 0) return;
   const Heightfield& hf = t.heightfield();
@@ -174,18 +198,41 @@ static void finish_transaction(Terrain& t, const Changes& c, EditResult& r,
   const std::uint32_t ci0 = c.i0 > 0 ? c.i0 - 1 : 0, cj0 = c.j0 > 0 ? c.j0 - 1 : 0;
   const std::uint32_t ci1 = std::min(c.i1, hf.width() - 2), cj1 = std::min(c.j1, hf.height() - 2);
   rays.update_cells(hf, ci0, cj0, ci1, cj1);
-  ++version;
-  const detail::EditRegion region{c.i0, c.j0, c.i1, c.j1};
-  for (detail::EditListener* l : listeners) l->on_edit(region, r);
-  r.changed.min = {hf.origin_x() + ci0 * hf.spacing_x(), hf.height_offset() + double(c.lo),
-                   hf.origin_z() + cj0 * hf.spacing_z()};
-  r.changed.max = {hf.origin_x() + (ci1 + 1) * hf.spacing_x(), hf.height_offset() + double(c.hi),
-                   hf.origin_z() + (cj1 + 1) * hf.spacing_z()};
+  TerrainChange ch = describe_change(t, c);
+  ch.version = ++version;
+  log.record(ch);
+  r.changed = ch.box;
+}
+
+TerrainChanges Terrain::changes_since(std::uint64_t version) const {
+  if (version <= edit_version_) return log_->since(version, edit_version_);
+  // Not a version of this terrain: everything may differ.
+  const Heightfield& hf = heightfield_;
+  const double pad = detail_ ? detail_->contribution_bound(1) : 0.0;
+  TerrainChange whole;
+  whole.version = edit_version_;
+  whole.box.min = {hf.origin_x(), hf.height_offset() + double(hf.min_local()) - pad, hf.origin_z()};
+  whole.box.max = {hf.origin_x() + hf.extent_x(), hf.height_offset() + double(hf.max_local()) + pad,
+                   hf.origin_z() + hf.extent_z()};
+  whole.vertices = {0, 0, fine_width() - 1, fine_height() - 1};
+  TerrainChanges out;
+  out.version = edit_version_;
+  out.changes.push_back(whole);
+  out.trimmed = true;
+  return out;
 }
 
 Result<EditResult> Terrain::apply_edit(const Edit& e) {
   if (auto s = validate_edit(e); !s) return Error{s.message()};
   Heightfield& hf = heightfield_;
+  if (!e.keep_detail && detail_levels_ != 0)
+    // Replacing the detail would need deltas on the detail lattice and error bounds (views,
+    // rays) that include them; docs/deformation.md, "keep_detail".
+    return Error{
+        fmt("edit: keep_detail = false is not supported on a terrain with procedural "
+            "detail (%u levels): edits are stored at the base spacing (%s m) and the "
+            "detail always rides on top of them; use keep_detail = true",
+            detail_levels_, num(std::min(hf.spacing_x(), hf.spacing_z())).c_str())};
   const double extent = std::max(hf.extent_x(), hf.extent_z());
   if (e.radius > extent)
     return Error{"edit: radius " + num(e.radius) + " m is larger than the terrain (" +
@@ -263,12 +310,7 @@ Result<EditResult> Terrain::apply_edit(const Edit& e) {
     }
   }
   r.clamped = r.samples_clamped > 0;
-  std::vector<detail::EditListener*> listeners;
-  {
-    std::lock_guard lock(listeners_->mutex);
-    listeners = listeners_->list;
-  }
-  finish_transaction(*this, c, r, *rays_, edit_version_, listeners);
+  finish_transaction(*this, c, r, *rays_, edit_version_, *log_);
   return r;
 }
 
@@ -307,6 +349,7 @@ std::shared_ptr<Terrain> Terrain::clone() const {
   *t->edits_ = *edits_;
   t->base_hash_ = base_hash_;
   t->edit_version_ = edit_version_;
+  *t->log_ = *log_;
   return t;
 }
 
@@ -460,6 +503,10 @@ Result<EditResult> load_edits_from_memory(Terrain& terrain, std::string_view in)
                      static_cast<unsigned long long>(count), expected)};
   if (fnv1a(in.data(), in.size() - 8) != get<std::uint64_t>(in, in.size() - 8))
     return Error{what + ": checksum mismatch (the file is corrupted)"};
+  if (get<std::uint64_t>(in, 48) != 0 || get<std::uint64_t>(in, 56) != 0)
+    return Error{what +
+                 ": reserved header bytes 48..63 are not zero (written by a newer version, "
+                 "or corrupted)"};
   const EditLimits& lim = terrain.edits_->limits;
   std::uint64_t prev_key = 0;
   for (std::uint64_t c = 0; c < count; ++c) {
@@ -513,12 +560,7 @@ Result<EditResult> load_edits_from_memory(Terrain& terrain, std::string_view in)
         changes.add(i, j, before, after);
     }
   EditResult r;
-  std::vector<detail::EditListener*> listeners;
-  {
-    std::lock_guard lock(terrain.listeners_->mutex);
-    listeners = terrain.listeners_->list;
-  }
-  finish_transaction(terrain, changes, r, *terrain.rays_, terrain.edit_version_, listeners);
+  finish_transaction(terrain, changes, r, *terrain.rays_, terrain.edit_version_, *terrain.log_);
   return r;
 }
 

@@ -50,11 +50,17 @@ struct RayHierarchy::Ray {
   glm::dvec3 origin, dir;  // world origin and unit direction
 };
 
+namespace {
+
+double touch_tolerance_of(const Heightfield& hf) {
+  return 1e-9 *
+         (1.0 + std::max(std::abs(double(hf.min_local())), std::abs(double(hf.max_local()))));
+}
+
+}  // namespace
+
 RayHierarchy::RayHierarchy(const Heightfield& hf)
-    : inv_sx_(1.0 / hf.spacing_x()),
-      inv_sz_(1.0 / hf.spacing_z()),
-      touch_(1e-9 *
-             (1.0 + std::max(std::abs(double(hf.min_local())), std::abs(double(hf.max_local()))))) {
+    : inv_sx_(1.0 / hf.spacing_x()), inv_sz_(1.0 / hf.spacing_z()), touch_(touch_tolerance_of(hf)) {
   const std::uint32_t cells_x = hf.width() - 1, cells_z = hf.height() - 1;
   Level leaf;
   leaf.nx = (cells_x + kLeafCells - 1) >> kLeafShift;
@@ -127,6 +133,29 @@ void RayHierarchy::update_cells(const Heightfield& hf, std::uint32_t i0, std::ui
     for (std::uint32_t z = z0; z <= z1; ++z)
       for (std::uint32_t x = x0; x <= x1; ++x) parent_node(lv, x, z);
   }
+  touch_ = touch_tolerance_of(hf);
+}
+
+std::string RayHierarchy::compare(const RayHierarchy& o) const {
+  if (levels_.size() != o.levels_.size())
+    return "ray pyramid: " + std::to_string(levels_.size()) + " levels, rebuilt " +
+           std::to_string(o.levels_.size());
+  if (touch_ != o.touch_) return "ray pyramid: touch tolerance differs from a rebuild";
+  for (std::size_t lv = 0; lv < levels_.size(); ++lv) {
+    const Level &a = levels_[lv], &b = o.levels_[lv];
+    if (a.nx != b.nx || a.nz != b.nz)
+      return "ray pyramid: level " + std::to_string(lv) + " size differs";
+    for (std::uint32_t z = 0; z < a.nz; ++z)
+      for (std::uint32_t x = 0; x < a.nx; ++x) {
+        const std::size_t k = a.index(x, z);
+        if (a.min[k] != b.min[k] || a.max[k] != b.max[k])
+          return "ray pyramid: level " + std::to_string(lv) + " node (" + std::to_string(x) + ", " +
+                 std::to_string(z) + ") holds [" + std::to_string(a.min[k]) + ", " +
+                 std::to_string(a.max[k]) + "], rebuilt [" + std::to_string(b.min[k]) + ", " +
+                 std::to_string(b.max[k]) + "]";
+      }
+  }
+  return {};
 }
 
 std::size_t RayHierarchy::memory_bytes() const noexcept {
@@ -552,6 +581,10 @@ std::size_t RayHierarchy::boxes_impl(const Grid& g, const Heightfield& hf, int L
     }
   }
   return added;
+}
+
+std::string Terrain::check_invariants() const {
+  return rays_->compare(RayHierarchy(heightfield_));
 }
 
 std::optional<RayHit> Terrain::raycast(const glm::dvec3& origin, const glm::dvec3& direction,

@@ -8,6 +8,7 @@
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "ridgeline/heightfield.h"
@@ -96,13 +97,18 @@ class RayHierarchy {
   RayHierarchy(const RayHierarchy&) = default;
 
   /// Recomputes the pyramid over the cells [i0, i1] x [j0, j1] (inclusive cell indices) after
-  /// their heights changed: the leaf blocks holding them, then their ancestors. Cost: the blocks'
-  /// samples plus the ancestors, about the edited area.
+  /// their heights changed: the leaf blocks holding them, then their ancestors, and the touch
+  /// tolerance from the field's (widened) height range. Cost: the blocks' samples plus the
+  /// ancestors, about the edited area.
   void update_cells(const Heightfield& hf, std::uint32_t i0, std::uint32_t j0, std::uint32_t i1,
                     std::uint32_t j1);
 
   /// Bytes held by the pyramid.
   std::size_t memory_bytes() const noexcept;
+
+  /// Compares two pyramids node by node (levels, sizes, every minimum and maximum, the touch
+  /// tolerance). Empty when equal, else the first difference.
+  std::string compare(const RayHierarchy& other) const;
 
   /// See Terrain::raycast.
   std::optional<RayHit> raycast(const Heightfield& hf, const glm::dvec3& origin,

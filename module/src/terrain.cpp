@@ -6,9 +6,9 @@
 #include <limits>
 
 #include "edit_layer.h"
-#include "ridgeline/detail.h"
-#include "edit_listener.h"
+#include "edit_log.h"
 #include "ray_hierarchy.h"
+#include "ridgeline/detail.h"
 #include "surface_eval.h"
 #include "terrain_fine.h"
 
@@ -32,10 +32,10 @@ Terrain::Terrain(Heightfield heightfield)
     : heightfield_(std::move(heightfield)),
       rays_(std::make_unique<RayHierarchy>(heightfield_)),
       edits_(std::make_unique<EditLayer>()),
+      log_(std::make_unique<ChangeLog>()),
       base_hash_(heightfield_.content_hash()),
       inv_spacing_x_(1.0 / heightfield_.spacing_x()),
-      inv_spacing_z_(1.0 / heightfield_.spacing_z()),
-      listeners_(std::make_unique<Listeners>()) {}
+      inv_spacing_z_(1.0 / heightfield_.spacing_z()) {}
 
 Terrain::~Terrain() = default;
 

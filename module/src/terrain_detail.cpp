@@ -5,7 +5,6 @@
 #include <cmath>
 
 #include "edit_layer.h"
-#include "edit_listener.h"
 #include "format.h"
 #include "ray_hierarchy.h"
 #include "ridgeline/detail.h"

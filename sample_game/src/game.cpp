@@ -220,6 +220,7 @@ void Game::step() {
       waypoint_scripts_ms += ms_since(t0);
     }
   }
+  follow_terrain_edits();
   for (auto& [id, e] : vehicles_) {
     const glm::dvec3 before = e.body.position();
     e.body.step(*terrain_, dt);
@@ -254,18 +255,26 @@ Result<std::size_t> Game::crater(double x, double z, double radius, double depth
   edit.strength = 1;
   auto r = terrain_->apply_edit(edit);
   if (!r) return Error{r.error().message};
-  CraterRecord rec{x, z, radius, depth, frame_, 0};
-  if (!r->empty()) {
-    for (auto& [id, e] : vehicles_) {
-      const glm::dvec3 p = e.body.position();
-      const double m = 6;  // a vehicle's half-length: bodies overlapping the box count
-      if (p.x >= r->changed.min.x - m && p.x <= r->changed.max.x + m &&
-          p.z >= r->changed.min.z - m && p.z <= r->changed.max.z + m)
-        rec.max_lift_m = std::max(rec.max_lift_m, e.body.resolve_penetration(*terrain_));
+  // The vehicles follow at the next step, through the change log like any other edit.
+  craters_.push_back({x, z, radius, depth, frame_});
+  return r->samples_changed;
+}
+
+void Game::follow_terrain_edits() {
+  const ridgeline::TerrainChanges c = terrain_->changes_since(seen_edit_version_);
+  seen_edit_version_ = c.version;
+  if (c.empty()) return;
+  for (auto& [id, e] : vehicles_) {
+    const glm::dvec3 p = e.body.position();
+    const double m = 6;  // a vehicle's half-length: bodies overlapping a box count
+    for (const ridgeline::TerrainChange& ch : c.changes) {
+      if (p.x >= ch.box.min.x - m && p.x <= ch.box.max.x + m && p.z >= ch.box.min.z - m &&
+          p.z <= ch.box.max.z + m && p.y >= ch.box.min.y - m && p.y <= ch.box.max.y + m) {
+        e.body.follow_ground(*terrain_);  // once: it compares with the ground it last saw
+        break;
+      }
     }
   }
-  craters_.push_back(rec);
-  return r->samples_changed;
 }
 
 ridgeline::Camera Game::camera() const {
@@ -285,8 +294,10 @@ ridgeline::Camera Game::camera() const {
     case CameraMode::kFollow: {
       const VehicleEntry* e = nullptr;
       auto it = vehicles_.find(rig_.follow_vehicle);
-      if (it != vehicles_.end()) e = &it->second;
-      else if (!vehicles_.empty()) e = &vehicles_.begin()->second;
+      if (it != vehicles_.end())
+        e = &it->second;
+      else if (!vehicles_.empty())
+        e = &vehicles_.begin()->second;
       if (e == nullptr) {
         c.eye = rig_.free_eye;
         c.target = c.eye + glm::dvec3(0.5, -0.3, 0.5);
@@ -366,10 +377,16 @@ ViewFrame Game::update_view(double frame_ms) {
   if (r) {
     out.stats = *r;
     out.updated = true;
+    morph_threshold_[vi] = r->morph_threshold;
   } else {
     scripts_->log("view update: " + r.error().message);
   }
   return last_view_ = out;
+}
+
+double Game::morph_threshold() const noexcept {
+  const int vi = int(rig_.mode);
+  return morph_threshold_[vi] > 0 ? morph_threshold_[vi] : views_[vi]->settings().threshold;
 }
 
 double quantise_threshold(double px) noexcept {

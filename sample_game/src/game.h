@@ -49,8 +49,8 @@ struct GameOptions {
   /// the view refines from its roots under the tessellation budget (about 20 frames of 50-140
   /// ms in the default scenario), which must not steer the controller.
   ridgeline::BudgetControllerDesc budget{.warmup_frames = 30};
-  std::uint32_t max_triangles = 60000;       ///< triangle budget of every view
-  double tessellation_budget_ms = 8;         ///< time budget of one view update
+  std::uint32_t max_triangles = 60000;  ///< triangle budget of every view
+  double tessellation_budget_ms = 8;    ///< time budget of one view update
   bool tessellate = true;  ///< update the active view each frame (off: pure simulation)
   std::uint64_t instruction_limit = 20'000'000;  ///< per script call (an infinite loop ends)
   /// ROAM patches of 2^k stored cells per side. 4 (32 m patches): a dirty patch's mesh is
@@ -95,7 +95,9 @@ class Game final : public GameApi {
   ridgeline::lua::Host& host() noexcept { return scripts_->host(); }
 
   // ---- simulation ----------------------------------------------------------------------------
-  /// One fixed step: scripts' tick handlers, autopilots, vehicle physics, vehicle contacts.
+  /// One fixed step: scripts' tick handlers, autopilots, the vehicles' reaction to every terrain
+  /// edit since the last step (from any brush, C++ or Lua, or a loaded edit state: the terrain's
+  /// change log is polled once here), vehicle physics, vehicle-vehicle contacts.
   void step();
   /// Times of the steps since the last call (a frame may take several steps), and resets them.
   StepTimes take_step_times() noexcept;
@@ -115,6 +117,9 @@ class Game final : public GameApi {
   ViewFrame update_view(double frame_ms);
   ridgeline::RoamView& view(CameraMode mode) noexcept { return *views_[int(mode)]; }
   ridgeline::RoamView& active_view() noexcept { return view(rig_.mode); }
+  /// The threshold the active view's mesh corresponds to (RoamStats::morph_threshold of its last
+  /// update; its settings' threshold before any): what the renderer's geomorph uses.
+  double morph_threshold() const noexcept;
   const ridgeline::BudgetController& controller() const noexcept { return controller_; }
   bool controller_on() const noexcept { return controller_on_; }
   void set_controller_on(bool on) noexcept { controller_on_ = on; }
@@ -171,6 +176,8 @@ class Game final : public GameApi {
   void emit(const char* event, int (*push)(lua_State*, void*), void* user) {
     scripts_->emit(event, push, user);
   }
+  // Pulls the terrain's change log: vehicles near a changed box follow the new ground.
+  void follow_terrain_edits();
 
   GameOptions options_;
   std::shared_ptr<ridgeline::Terrain> terrain_;
@@ -192,10 +199,12 @@ class Game final : public GameApi {
   double tess_budget_ms_ = 8;
   ViewFrame last_view_;
   double last_view_threshold_[3] = {0, 0, 0};  // per camera mode: the view's last threshold
-  bool far_nudge_[3] = {false, false, false};     // see update_view()
+  double morph_threshold_[3] = {0, 0, 0};      // per camera mode: its last morph_threshold
+  bool far_nudge_[3] = {false, false, false};  // see update_view()
   std::optional<ridgeline::DetailStream> stream_;
   std::optional<ridgeline::DetailFrameStats> detail_frame_;
   std::uint64_t frame_ = 0;
+  std::uint64_t seen_edit_version_ = 0;  // the terrain edit version the vehicles have followed
   double burned_ms_ = 0;
   double last_frame_ms_ = 0;
   Input input_;

@@ -44,7 +44,6 @@ struct VehicleEntry {
 struct CraterRecord {
   double x = 0, z = 0, radius = 0, depth = 0;
   std::uint64_t frame = 0;
-  double max_lift_m = 0;  ///< largest lift applied to a vehicle inside the changed box
 };
 
 /// Per-frame statistics of the active view and the controller.
@@ -95,7 +94,8 @@ class GameApi {
 
   // ---- terrain ------------------------------------------------------------------------------
   virtual const std::shared_ptr<ridgeline::Terrain>& terrain_ptr() const noexcept = 0;
-  /// Opens a crater; bodies inside the changed box are lifted out. Samples changed.
+  /// Opens a crater (vehicles follow it at the next step, through the terrain's change log).
+  /// Samples changed.
   virtual ridgeline::Result<std::size_t> crater(double x, double z, double radius,
                                                 double depth) = 0;
   virtual std::size_t crater_count() const noexcept = 0;

@@ -15,6 +15,7 @@
 #include <glm/mat4x4.hpp>
 #include <string>
 
+#include "geomorph_glsl.h"
 #include "materials.h"
 
 namespace game {
@@ -22,16 +23,20 @@ namespace {
 
 using ridgeline::Error;
 
-const char* kTerrainVs = R"(#version 330 core
+// The terrain vertex shader: its version line and declarations, the shared geomorph
+// (geomorph_glsl.h), then main(); joined by terrain_vs().
+const char* kTerrainVsHead = R"(#version 330 core
 // The ROAM core's MeshVertex, as bind_mesh_vertex_layout() feeds it.
 layout(location = 0) in vec3 a_pos;     // patch-local position (x, height, z)
 layout(location = 1) in vec3 a_nrm;     // smooth vertex normal
-layout(location = 2) in vec2 a_morph;   // morph_dy, morph_bound
+layout(location = 2) in vec3 a_morph;   // morph_dy, morph_bound, morph_radius
 uniform mat4 u_view_proj;               // camera-relative
 uniform vec3 u_offset;                  // patch origin - eye
+uniform vec3 u_eye_local;               // eye - patch origin (the geomorph's patch-local eye)
 uniform vec4 u_uv;                      // material map: uv = u_uv.xy + a_pos.xz * u_uv.zw
 uniform float u_proj_scale;             // pixels per metre at unit distance (output pixels)
-uniform float u_threshold;              // pixels
+uniform float u_morph_threshold;        // pixels: the view's RoamStats::morph_threshold
+uniform float u_morph_window;           // the landscape's morph_window()
 uniform int u_geomorph;
 uniform int u_cheap;
 uniform vec3 u_sun;
@@ -42,22 +47,16 @@ out float v_dist;
 out vec3 v_light;   // cheap path: the light terms per vertex
 out float v_fog;    // cheap path: the fog factor per vertex
 out float v_rock;   // cheap path: the slope's rock weight per vertex
+)";
 
-// The geomorph, in one place: the height offset that moves a vertex from its true height
-// towards the edge it splits, from the MeshVertex morph data and the vertex's distance.
-// morph_factor() of roam_view.h: t = clamp(p / threshold - 1, 0, 1), p the diamond bound
-// projected at the vertex's distance; the vertex sits at y + (1 - t) * morph_dy.
-float geomorph_dy(vec2 morph, float dist) {
-  if (u_geomorph == 0 || morph.y <= 0.0) return 0.0;
-  float p = morph.y * u_proj_scale / dist;
-  float t = clamp(p / max(u_threshold, 1e-3) - 1.0, 0.0, 1.0);
-  return (1.0 - t) * morph.x;
-}
-
+const char* kTerrainVsMain = R"(
 void main() {
-  vec3 rel = u_offset + a_pos;
+  float y = a_pos.y;
+  if (u_geomorph != 0)
+    y = geomorph_height(a_pos, a_morph, u_eye_local, u_proj_scale, u_morph_threshold,
+                        u_morph_window);
+  vec3 rel = u_offset + vec3(a_pos.x, y, a_pos.z);
   float d = max(length(rel), 1e-3);
-  rel.y += geomorph_dy(a_morph, d);
   v_nrm = a_nrm;
   v_uv = u_uv.xy + a_pos.xz * u_uv.zw;
   v_dist = d;
@@ -72,6 +71,10 @@ void main() {
   gl_Position = u_view_proj * vec4(rel, 1.0);
 }
 )";
+
+std::string terrain_vs() {
+  return std::string(kTerrainVsHead) + kGeomorphGlsl + kTerrainVsMain;
+}
 
 // Albedo from the material map (baked per stored cell: material colour, grass tinted by
 // height); rock where the surface is steep (also where edits made it so); one sun, a sky
@@ -227,7 +230,8 @@ void bind_mesh_vertex_layout() {
   glEnableVertexAttribArray(1);
   glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, stride, (void*)offsetof(V, nx));
   glEnableVertexAttribArray(2);
-  glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, stride, (void*)offsetof(V, morph_dy));
+  glVertexAttribPointer(2, 3, GL_FLOAT, GL_FALSE, stride, (void*)offsetof(V, morph_dy));
+  static_assert(offsetof(V, morph_radius) == offsetof(V, morph_dy) + 8, "morph data contiguous");
 }
 
 // Deterministic per-cell variation of the albedo (+-6 %): grain near the camera.
@@ -310,7 +314,8 @@ ridgeline::Result<std::unique_ptr<Renderer>> Renderer::create(Game& game, int wi
   std::unique_ptr<Renderer> r(new Renderer());
   r->width_ = width;
   r->height_ = height;
-  auto tp = program(kTerrainVs, kTerrainFs, "terrain");
+  const std::string terrain_vs_src = terrain_vs();
+  auto tp = program(terrain_vs_src.c_str(), kTerrainFs, "terrain");
   if (!tp) return Error{tp.error().message};
   auto sp = program(kSkyVs, kSkyFs, "sky");
   if (!sp) return Error{sp.error().message};
@@ -383,28 +388,51 @@ Renderer::MeshGpu Renderer::upload_model(const ModelMesh& mesh) {
 void Renderer::sync_patches(ridgeline::RoamView& view, std::vector<PatchGpu>& set,
                             bool& initialised, RenderStats& st) {
   const std::uint32_t np = view.landscape().patch_count();
-  std::vector<std::uint32_t> dirty = view.take_dirty_patches();
-  if (!initialised) {
-    // First use of this view: every patch.
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::vector<std::uint32_t> dirty = view.take_dirty_patches();
+  st.patch_mesh_ms += ms_since(t0);
+  if (!initialised || set.size() != np) {
+    // First use of this view: every patch, whole.
     set.assign(np, PatchGpu{});
-    dirty.clear();
-    for (std::uint32_t p = 0; p < np; ++p) dirty.push_back(p);
+    for (std::uint32_t p = 0; p < np; ++p) upload_patch(set[p], view.patch_mesh(p), true, st);
     initialised = true;
+    return;
   }
-  for (std::uint32_t p : dirty) {
-    if (p >= np) continue;
-    const auto t0 = std::chrono::steady_clock::now();
-    const ridgeline::PatchMesh& mesh = view.patch_mesh(p);
-    st.patch_mesh_ms += ms_since(t0);
-    upload_patch(set[p], mesh, st);
-    ++st.patches_uploaded;
-  }
+  for (std::uint32_t p : dirty)
+    if (p < np) upload_patch(set[p], view.patch_mesh(p), false, st);
 }
 
-// Every patch upload goes through here: a whole patch's vertices and (non-padding) triangles.
-// Partial uploads of dirty ranges would replace the two glBufferData calls by glBufferSubData
-// over the ranges (buffers sized with headroom).
-void Renderer::upload_patch(PatchGpu& gpu, const ridgeline::PatchMesh& mesh, RenderStats& st) {
+namespace {
+
+// Uploads `ranges` of `data` (elements of `elem` bytes, `per` of them per slot) into the bound
+// buffer `target`. Returns the bytes sent.
+template <class T>
+std::uint64_t upload_ranges(GLenum target, const std::vector<T>& data,
+                            const std::vector<ridgeline::MeshRange>& ranges, std::size_t per) {
+  std::uint64_t bytes = 0;
+  for (const ridgeline::MeshRange& r : ranges) {
+    const std::size_t first = std::size_t(r.first) * per;
+    const std::size_t count =
+        std::min(std::size_t(r.count) * per, data.size() - std::min(first, data.size()));
+    if (count == 0) continue;
+    glBufferSubData(target, GLintptr(first * sizeof(T)), GLsizeiptr(count * sizeof(T)),
+                    data.data() + first);
+    bytes += count * sizeof(T);
+  }
+  return bytes;
+}
+
+}  // namespace
+
+// Every patch upload goes through here. The core reuses slots and lists what changed since the
+// last take_dirty_patches(): the dirty vertex and triangle ranges go up with glBufferSubData;
+// the buffers are allocated anew (glBufferData) only when the mesh outgrew them, and sent whole
+// when the core reallocated or compacted its arrays (PatchMesh::resized) or on a view's first
+// use. Unused slots and triangles over the padding are degenerate (0, 0, 0): the whole index
+// array is drawn.
+void Renderer::upload_patch(PatchGpu& gpu, const ridgeline::PatchMesh& mesh, bool whole,
+                            RenderStats& st) {
+  using V = ridgeline::MeshVertex;
   if (gpu.vao == 0) {
     glGenVertexArrays(1, &gpu.vao);
     glBindVertexArray(gpu.vao);
@@ -415,34 +443,62 @@ void Renderer::upload_patch(PatchGpu& gpu, const ridgeline::PatchMesh& mesh, Ren
     bind_mesh_vertex_layout();
   }
   glBindVertexArray(gpu.vao);
-  // Triangles whose centre lies in the padding are not terrain: leave them out.
-  std::vector<std::uint32_t>& idx = scratch_idx_;
-  idx.clear();
-  idx.reserve(mesh.indices.size());
-  std::uint32_t tris = 0;
-  for (std::size_t t = 0; t * 3 < mesh.indices.size(); ++t) {
-    if (t < mesh.padding.size() && mesh.padding[t]) continue;
-    idx.insert(idx.end(), mesh.indices.begin() + t * 3, mesh.indices.begin() + t * 3 + 3);
-    ++tris;
-  }
-  const std::size_t vbytes = mesh.vertices.size() * sizeof(ridgeline::MeshVertex);
   glBindBuffer(GL_ARRAY_BUFFER, gpu.vbo);
-  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(vbytes), mesh.vertices.data(), GL_DYNAMIC_DRAW);
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, gpu.ibo);
-  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(idx.size() * 4), idx.data(), GL_DYNAMIC_DRAW);
+  const std::size_t nv = mesh.vertices.size(), ni = mesh.indices.size();
+  whole = whole || mesh.resized || nv > gpu.vertex_capacity || ni > gpu.index_capacity;
+  std::uint64_t bytes = 0;
+  // Vertices.
+  if (nv > gpu.vertex_capacity) {
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(nv * sizeof(V)), mesh.vertices.data(),
+                 GL_DYNAMIC_DRAW);
+    gpu.vertex_capacity = nv;
+    bytes += nv * sizeof(V);
+    ++st.buffers_allocated;
+  } else if (whole) {
+    if (nv > 0)
+      glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(nv * sizeof(V)), mesh.vertices.data());
+    bytes += nv * sizeof(V);
+  } else {
+    bytes += upload_ranges(GL_ARRAY_BUFFER, mesh.vertices, mesh.dirty_vertices, 1);
+  }
+  // Indices (three per triangle slot).
+  if (ni > gpu.index_capacity) {
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(ni * 4), mesh.indices.data(), GL_DYNAMIC_DRAW);
+    gpu.index_capacity = ni;
+    bytes += ni * 4;
+    ++st.buffers_allocated;
+  } else if (whole) {
+    if (ni > 0)
+      glBufferSubData(GL_ELEMENT_ARRAY_BUFFER, 0, GLsizeiptr(ni * 4), mesh.indices.data());
+    bytes += ni * 4;
+  } else {
+    bytes += upload_ranges(GL_ELEMENT_ARRAY_BUFFER, mesh.indices, mesh.dirty_triangles, 3);
+  }
   glBindVertexArray(0);
-  st.bytes_uploaded += vbytes + idx.size() * 4;
-  gpu.count = static_cast<int>(idx.size());
-  gpu.triangles = tris;
+  st.bytes_uploaded += bytes;
+  ++st.patches_uploaded;
+  gpu.count = static_cast<int>(ni);
+  gpu.triangles = mesh.triangles;
   gpu.ox = mesh.origin_x;
   gpu.oy = mesh.origin_y;
   gpu.oz = mesh.origin_z;
-  gpu.lo = glm::vec3(1e30f);
-  gpu.hi = glm::vec3(-1e30f);
-  for (const ridgeline::MeshVertex& v : mesh.vertices) {
-    const glm::vec3 p(v.x, v.y, v.z);
-    gpu.lo = glm::min(gpu.lo, glm::min(p, p + glm::vec3(0, v.morph_dy, 0)));
-    gpu.hi = glm::max(gpu.hi, glm::max(p, p + glm::vec3(0, v.morph_dy, 0)));
+  // The culling box: patch-local, between each vertex's true and unmorphed height. Whole uploads
+  // recompute it; partial ones grow it by the changed vertices (stale slots only enlarge it).
+  const auto grow = [&](std::size_t first, std::size_t count) {
+    for (std::size_t i = first; i < first + count && i < nv; ++i) {
+      const V& v = mesh.vertices[i];
+      const glm::vec3 p(v.x, v.y, v.z), q(v.x, v.y + v.morph_dy, v.z);
+      gpu.lo = glm::min(gpu.lo, glm::min(p, q));
+      gpu.hi = glm::max(gpu.hi, glm::max(p, q));
+    }
+  };
+  if (whole) {
+    gpu.lo = glm::vec3(1e30f);
+    gpu.hi = glm::vec3(-1e30f);
+    grow(0, nv);
+  } else {
+    for (const ridgeline::MeshRange& r : mesh.dirty_vertices) grow(r.first, r.count);
   }
 }
 
@@ -525,7 +581,11 @@ RenderStats Renderer::draw(Game& game, const RenderSettings& settings) {
   glUniform1i(loc(terrain_prog_, "u_materials"), 0);
   glUniformMatrix4fv(loc(terrain_prog_, "u_view_proj"), 1, GL_FALSE, glm::value_ptr(vp));
   glUniform1f(loc(terrain_prog_, "u_proj_scale"), float(ridgeline::projection_scale(cam)));
-  glUniform1f(loc(terrain_prog_, "u_threshold"), float(game.active_view().settings().threshold));
+  // The geomorph's inputs (geomorph_glsl.h): the threshold the mesh corresponds to and the
+  // landscape's morph window.
+  glUniform1f(loc(terrain_prog_, "u_morph_threshold"), float(game.morph_threshold()));
+  glUniform1f(loc(terrain_prog_, "u_morph_window"),
+              float(game.active_view().landscape().morph_window()));
   glUniform1i(loc(terrain_prog_, "u_geomorph"), settings.geomorph ? 1 : 0);
   glUniform1i(loc(terrain_prog_, "u_wireframe"), settings.wireframe ? 1 : 0);
   glUniform1i(loc(terrain_prog_, "u_cheap"), settings.cheap_fragments ? 1 : 0);
@@ -533,6 +593,7 @@ RenderStats Renderer::draw(Game& game, const RenderSettings& settings) {
   glUniform3fv(loc(terrain_prog_, "u_fog_colour"), 1, glm::value_ptr(kFog));
   glUniform1f(loc(terrain_prog_, "u_fog_density"), settings.fog_density);
   const int u_offset = loc(terrain_prog_, "u_offset"), u_uv = loc(terrain_prog_, "u_uv");
+  const int u_eye_local = loc(terrain_prog_, "u_eye_local");
   order_.clear();
   const ridgeline::Frustum frustum(cam);
   for (std::uint32_t p = 0; p < set.size(); ++p) {
@@ -550,7 +611,9 @@ RenderStats Renderer::draw(Game& game, const RenderSettings& settings) {
   std::sort(order_.begin(), order_.end());
   for (const auto& [key, p] : order_) {
     const PatchGpu& g = set[p];
+    // Differences in double, then float: precise far from the world's origin.
     glUniform3f(u_offset, float(g.ox - eye.x), float(g.oy - eye.y), float(g.oz - eye.z));
+    glUniform3f(u_eye_local, float(eye.x - g.ox), float(eye.y - g.oy), float(eye.z - g.oz));
     glUniform4f(u_uv, float((g.ox - material_uv_[0]) * material_uv_[2]),
                 float((g.oz - material_uv_[1]) * material_uv_[3]), material_uv_[2],
                 material_uv_[3]);

@@ -6,10 +6,9 @@
 // current context (gl_context.h).
 //
 // For the ROAM core's output (docs/game.md, "Rendering"): every patch upload goes through
-// upload_patch(), the MeshVertex attribute layout is set in one place (bind_mesh_vertex_layout
-// in renderer.cpp) and the geomorph is one shader function (geomorph_dy in the terrain vertex
-// shader), so a new vertex layout, morph formula or partial (dirty-range) upload changes those
-// three places only.
+// upload_patch() (the dirty ranges of RoamView::take_dirty_patches() with glBufferSubData), the
+// MeshVertex attribute layout is set in one place (bind_mesh_vertex_layout in renderer.cpp) and
+// the geomorph is one GLSL function shared with its test (geomorph_glsl.h).
 #pragma once
 
 #include <cstdint>
@@ -34,14 +33,17 @@ struct RenderSettings {
 };
 
 struct RenderStats {
-  std::uint32_t patches_uploaded = 0;  ///< patch buffers re-uploaded this frame
+  std::uint32_t patches_uploaded = 0;  ///< patches whose buffers changed this frame
+  /// Patch buffers (re)allocated this frame with glBufferData (a mesh outgrew its buffer, or a
+  /// view's first use); every other change is a glBufferSubData of the dirty ranges.
+  std::uint32_t buffers_allocated = 0;
   std::uint32_t patches_drawn = 0;
   std::uint32_t patches_culled = 0;       ///< outside the view frustum: not drawn
-  std::uint32_t triangles_drawn = 0;      ///< terrain triangles sent to GL (padding excluded)
-  std::uint64_t bytes_uploaded = 0;       ///< vertex and index bytes sent this frame
+  std::uint32_t triangles_drawn = 0;      ///< terrain triangles drawn (degenerate slots excluded)
+  std::uint64_t bytes_uploaded = 0;       ///< vertex and index bytes sent to GL this frame
   int scene_width = 0, scene_height = 0;  ///< pixels the scene rendered at (render scale)
-  /// Wall milliseconds of the uploads (patch_mesh_ms of it: building the meshes in the ROAM
-  /// core, RoamView::patch_mesh) and of the draw calls.
+  /// Wall milliseconds of the uploads (patch_mesh_ms of it: RoamView::take_dirty_patches, the
+  /// core filling in the dirty ranges) and of the draw calls.
   double upload_ms = 0, patch_mesh_ms = 0, draw_ms = 0;
 };
 
@@ -68,6 +70,7 @@ class Renderer {
     double ox = 0, oy = 0, oz = 0;
     glm::vec3 lo{0}, hi{0};  ///< patch-local bounding box of the vertices (geomorphs included)
     std::uint32_t triangles = 0;
+    std::size_t vertex_capacity = 0, index_capacity = 0;  ///< elements the GL buffers hold
   };
   struct MeshGpu {
     unsigned vao = 0, vbo = 0, ibo = 0;
@@ -76,10 +79,11 @@ class Renderer {
   struct Target {
     unsigned fbo = 0, colour = 0, depth = 0;
   };
-  /// Re-uploads the patches the view marks dirty (every patch on a view's first use).
+  /// Uploads what changed in the patches the view marks dirty (every patch whole on a view's
+  /// first use).
   void sync_patches(ridgeline::RoamView& view, std::vector<PatchGpu>& set, bool& initialised,
                     RenderStats& st);
-  void upload_patch(PatchGpu& gpu, const ridgeline::PatchMesh& mesh, RenderStats& st);
+  void upload_patch(PatchGpu& gpu, const ridgeline::PatchMesh& mesh, bool whole, RenderStats& st);
   MeshGpu upload_model(const ModelMesh& mesh);
   ridgeline::Status make_target(Target& t, int w, int h);
   void make_material_texture(const ridgeline::Terrain& terrain);
@@ -91,7 +95,6 @@ class Renderer {
   float material_uv_[4] = {0, 0, 1, 1};  ///< u = (x - [0]) * [2], v = (z - [1]) * [3]
   std::vector<PatchGpu> patches_[3];     ///< per camera mode: each view has its own mesh
   bool patches_initialised_[3] = {false, false, false};
-  std::vector<std::uint32_t> scratch_idx_;
   std::vector<std::pair<float, std::uint32_t>> order_;
   std::map<std::string, std::pair<MeshGpu, MeshGpu>> models_;  ///< body, wheel
 };

@@ -92,7 +92,9 @@ double Vehicle::heading() const noexcept {
   return std::atan2(f.x, f.z);
 }
 
-double Vehicle::speed() const noexcept { return glm::dot(v_, forward()); }
+double Vehicle::speed() const noexcept {
+  return glm::dot(v_, forward());
+}
 
 std::array<glm::dvec3, 4> Vehicle::chassis_corners() const {
   const glm::dvec3 a = chassis_min, b = chassis_max;
@@ -220,7 +222,8 @@ double Vehicle::resolve_penetration(const ridgeline::Terrain& terrain) {
   for (int i = 0; i < 4; ++i) {
     const glm::dvec3 a = pos_ + R * params_.attach[i];
     if (auto hn = terrain.height_normal(a.x, a.z)) {
-      const double need = hn->height + params_.wheel_radius / std::max(0.2, double(hn->face_normal.y));
+      const double need =
+          hn->height + params_.wheel_radius / std::max(0.2, double(hn->face_normal.y));
       lift = std::max(lift, need - a.y);
     }
   }
@@ -254,6 +257,7 @@ void Vehicle::measure_contacts(const ridgeline::Terrain& terrain) {
     const auto h = terrain.height(bottom.x, bottom.z);
     w.surface_gap = h ? bottom.y - *h : 0.0;
     w.material = hit ? hit->material : 0;
+    ground_[i] = {a.x, a.z, terrain.height(a.x, a.z).value_or(std::nan(""))};
   }
   // The ground's material: the one under most wheels in contact (ties: the lowest id).
   int votes[256] = {};
@@ -284,6 +288,23 @@ void Vehicle::apply_impulse(const glm::dvec3& p, const glm::dvec3& impulse) noex
 void Vehicle::nudge(const glm::dvec3& d) noexcept {
   pos_ += d;
   for (WheelState& w : wheels_) w.centre += d;
+}
+
+double Vehicle::follow_ground(const ridgeline::Terrain& terrain) {
+  // The wheels carry the body: it rises with the ground under them (the chassis is kept out of
+  // the ground by resolve_penetration below).
+  double rise = 0;
+  for (const GroundPoint& g : ground_) {
+    const auto h = terrain.height(g.x, g.z);
+    if (h && std::isfinite(g.height)) rise = std::max(rise, *h - g.height);
+  }
+  if (rise > 0) {
+    pos_.y += rise;
+    for (WheelState& w : wheels_) w.centre.y += rise;
+  }
+  const double lift = rise + resolve_penetration(terrain);
+  measure_contacts(terrain);
+  return lift;
 }
 
 bool Autopilot::drive(Vehicle& v) {

@@ -3,12 +3,11 @@
 
 #include <array>
 #include <cstdint>
-#include <vector>
-
 #include <glm/gtc/quaternion.hpp>
 #include <glm/mat3x3.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
+#include <vector>
 
 #include "ridgeline/terrain.h"
 #include "vehicle_model.h"
@@ -18,17 +17,18 @@ namespace game {
 /// Physical constants of a vehicle kind. Units: kg, metres, newtons, seconds, radians.
 struct VehicleParams {
   double mass = 1500;
-  glm::dvec3 inertia_extent{2, 1.5, 4};  ///< box whose inertia the body takes (width, height, length)
+  glm::dvec3 inertia_extent{2, 1.5,
+                            4};        ///< box whose inertia the body takes (width, height, length)
   std::array<glm::dvec3, 4> attach{};  ///< suspension tops in the body frame (from the COM)
   double wheel_radius = 0.5;
-  double rest_length = 0.35;  ///< suspension length (attach -> wheel centre) with no load
-  double spring_k = 40000;    ///< N/m per wheel
-  double damper_c = 4000;     ///< N s/m per wheel
-  double friction = 1.0;      ///< tyre friction coefficient (friction circle radius / load)
-  double engine_force = 9000;  ///< N at full throttle, shared by the four wheels
-  double brake_force = 14000;  ///< N at full brake, shared by the four wheels
-  double max_steer = 0.55;     ///< radians at steer = +-1
-  double max_speed = 25;       ///< m/s; the engine gives no force above it
+  double rest_length = 0.35;         ///< suspension length (attach -> wheel centre) with no load
+  double spring_k = 40000;           ///< N/m per wheel
+  double damper_c = 4000;            ///< N s/m per wheel
+  double friction = 1.0;             ///< tyre friction coefficient (friction circle radius / load)
+  double engine_force = 9000;        ///< N at full throttle, shared by the four wheels
+  double brake_force = 14000;        ///< N at full brake, shared by the four wheels
+  double max_steer = 0.55;           ///< radians at steer = +-1
+  double max_speed = 25;             ///< m/s; the engine gives no force above it
   glm::dvec3 com_in_model{0, 1, 0};  ///< centre of mass in the model frame (the body origin)
 };
 
@@ -71,8 +71,15 @@ class Vehicle {
   /// velocity into the surface: what keeps a body out of the ground, also when an edit removes
   /// the ground under it. Returns the lift applied, metres.
   double resolve_penetration(const ridgeline::Terrain& terrain);
-  /// Updates every wheel's surface_gap (see WheelState).
+  /// Updates every wheel's surface_gap (see WheelState) and records the ground height under the
+  /// suspension tops, for follow_ground().
   void measure_contacts(const ridgeline::Terrain& terrain);
+  /// The terrain was edited under the body since the last measure_contacts(): where the ground
+  /// under its wheels rose, the body rises by the largest rise (suspension, velocity and tilt
+  /// kept, so it keeps resting instead of being launched by fully compressed springs); where it
+  /// fell, the body is left to fall. Then resolves any remaining penetration and measures again.
+  /// Returns the lift applied, metres.
+  double follow_ground(const ridgeline::Terrain& terrain);
 
   Controls controls;
   const VehicleParams& params() const noexcept { return params_; }
@@ -88,8 +95,7 @@ class Vehicle {
   void place(glm::dvec3 position, double heading_rad);
   /// Teleports to (x, z) with the given heading, tilted to the surface normal there and lifted
   /// so that the wheels just touch: how vehicles are spawned on slopes. False off-terrain.
-  bool place_on_surface(const ridgeline::Terrain& terrain, double x, double z,
-                        double heading_rad);
+  bool place_on_surface(const ridgeline::Terrain& terrain, double x, double z, double heading_rad);
   /// Bottom corners of the chassis box in world coordinates.
   std::array<glm::dvec3, 4> chassis_corners() const;
   glm::dvec3 chassis_min{-1, -0.5, -2}, chassis_max{1, 0.5, 2};  ///< body-frame box (from COM)
@@ -118,6 +124,12 @@ class Vehicle {
   glm::dvec3 inertia_{1};  // body-frame diagonal
   std::array<WheelState, 4> wheels_{};
   std::uint8_t ground_material_ = 0;
+  // Ground under the four suspension tops at the last measure_contacts() (height NaN
+  // off-terrain).
+  struct GroundPoint {
+    double x = 0, z = 0, height = 0;
+  };
+  std::array<GroundPoint, 4> ground_{};
 };
 
 /// Steers a vehicle along waypoints (pure pursuit on the xz plane).

@@ -31,6 +31,26 @@ ensure_packages() {
   "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" > /dev/null
 }
 
+# fetch_test_data [DIR]: data no one here made, for the tests that read real files (default
+# build/test-data, the tests' RIDGELINE_TEST_EXTERNAL_DATA): Debian's r-cran-terra example
+# rasters (elev.tif: a real DEM in degrees; meuse.tif: one in projected metres), taken from the
+# package without installing R (apt-get download, dpkg -x). Prints a note and returns 0 when the
+# package cannot be fetched: those tests then skip, naming the missing file.
+fetch_test_data() {
+  local dir=${1:-$RIDGELINE_ROOT/build/test-data}
+  local ex=$dir/terra/usr/lib/R/site-library/terra/ex
+  [ -f "$ex/elev.tif" ] && [ -f "$ex/meuse.tif" ] && return 0
+  mkdir -p "$dir"
+  local sudo=()
+  [ "$(id -u)" -eq 0 ] || sudo=(sudo)
+  (cd "$dir" && rm -f r-cran-terra_*.deb &&
+    { apt-get download r-cran-terra > /dev/null 2>&1 ||
+      { "${sudo[@]}" apt-get update -qq > /dev/null && apt-get download r-cran-terra > /dev/null; }; } &&
+    rm -rf terra && dpkg -x r-cran-terra_*.deb terra && rm -f r-cran-terra_*.deb) ||
+    echo "note: could not fetch r-cran-terra; the tests on elev.tif and meuse.tif will be skipped"
+  return 0
+}
+
 # configure_and_build BUILD_DIR [cmake args...]
 configure_and_build() {
   local dir=$1; shift
@@ -38,6 +58,24 @@ configure_and_build() {
   cmake -S "$RIDGELINE_ROOT" -B "$dir" -G Ninja "$@" > "$dir.configure.log" 2>&1 || {
     cat "$dir.configure.log"; return 1; }
   cmake --build "$dir" -j "$(nproc)"
+}
+
+# The one Release build every script and the README's commands share: build/release, configured
+# with the defaults (everything on), so that no script's options undo another's.
+RIDGELINE_RELEASE_DIR=build/release
+RIDGELINE_RELEASE_ARGS=(-DCMAKE_BUILD_TYPE=Release -DRIDGELINE_BUILD_TESTS=ON
+  -DRIDGELINE_BUILD_BENCHMARKS=ON -DRIDGELINE_BUILD_TOOLS=ON -DRIDGELINE_BUILD_LUA=ON
+  -DRIDGELINE_BUILD_GAME=ON)
+
+# build_release [TARGET...]: configures build/release and builds the given targets (all when
+# none is given).
+build_release() {
+  local dir=$RIDGELINE_ROOT/$RIDGELINE_RELEASE_DIR targets=()
+  [ $# -gt 0 ] && targets=(--target "$@")
+  mkdir -p "$dir"
+  cmake -S "$RIDGELINE_ROOT" -B "$dir" -G Ninja "${RIDGELINE_RELEASE_ARGS[@]}" \
+    > "$dir.configure.log" 2>&1 || { cat "$dir.configure.log"; return 1; }
+  cmake --build "$dir" -j "$(nproc)" "${targets[@]}"
 }
 
 # stage NAME COMMAND...: runs a stage and prints its wall time.

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "ridgeline/detail_stream.h"
+#include "ridgeline/scenes.h"
 #include "ridgeline/surface.h"
 
 using namespace ridgeline;
@@ -25,20 +26,7 @@ constexpr double kExaggeration = 4;  // vertical exaggeration of the shading
 // The world of the flight benchmark: the default terrain stretched to 3126 x 3126 samples at
 // 32 m, heights x 4 (`--default-size 3126 --spacing 32 --height-scale 4`).
 std::shared_ptr<const Terrain> make_world() {
-  DefaultTerrainParams p;
-  p.size = 3126;
-  auto base = make_default_heightfield(p);
-  if (!base) return nullptr;
-  HeightfieldDesc d;
-  d.width = d.height = p.size;
-  d.spacing_x = d.spacing_z = 32;
-  d.height_scale = 4;
-  d.name = "default terrain";
-  std::vector<std::uint8_t> mats;
-  mats.reserve(std::size_t{p.size - 1} * (p.size - 1));
-  for (std::uint32_t j = 0; j + 1 < p.size; ++j)
-    for (std::uint32_t i = 0; i + 1 < p.size; ++i) mats.push_back(base->material(i, j));
-  auto hf = Heightfield::create(d, base->local_heights(), mats);
+  auto hf = scenes::flight_world();
   if (!hf) return nullptr;
   return Terrain::create(std::move(hf).value());
 }

@@ -61,12 +61,45 @@ for s in info query profile bench "bench queries"; do
   run $s --help; expect "ridge $s --help" 0
 done
 run info --help; contains "info --help shows the terrain flags" "--raw-size"
-run; expect "no subcommand" 2
-run frobnicate; expect "unknown subcommand" 2
-run info --default-terrain --no-such-flag; expect "unknown flag" 2
+run; expect "no subcommand" 2 "A subcommand is required"
+run --version; expect "ridge --version" 0
+[[ "$out" =~ ^ridge\ [0-9]+\.[0-9]+\.[0-9]+$ ]] && ok || bad "--version prints 'ridge X.Y.Z'" "$out"
+run frobnicate; expect "unknown subcommand" 2 "unknown subcommand 'frobnicate' of ridge"
+[[ "$err" == *"info, query, profile"* ]] && ok || bad "unknown subcommand lists the subcommands" "$err"
+run bench frobnicate --default-terrain; expect "unknown benchmark" 2 "unknown subcommand 'frobnicate' of ridge bench"
+run info --default-terrain --no-such-flag; expect "unknown flag" 2 "--no-such-flag (see ridge info --help)"
 run bench --default-terrain; expect "bench without a benchmark" 2
 run info --default-terrain --heightmap "$PNG"; expect "--heightmap with --default-terrain" 2
-run info; expect "no terrain" 1 "no terrain given"
+# Missing required flags are usage errors (exit 2), as docs/cli.md says.
+run info; expect "no terrain" 2 "no terrain given: pass --heightmap FILE or --default-terrain"
+run info --help; expect "--help without a terrain" 0
+run mesh --default-terrain --threshold 2; expect "mesh without --out" 2 "--out is required"
+run mesh --default-terrain --out "$T/m.glb"; expect "mesh without a LOD setting" 2 "give --threshold PX, --triangles N or --tolerance METRES"
+run mesh --default-terrain --threshold 2 --out "$T/m.glb"; expect "mesh without a camera" 2 "give --eye X,Y,Z and --target X,Y,Z"
+run bench lod --default-terrain --threshold 2; expect "bench lod without --path" 2 "--path is required"
+run bench lod --default-terrain --path "$TEST_DATA/paths/flyover.json"; expect "bench lod without a LOD setting" 2 "--tolerance METRES"
+
+# ---- output files ----------------------------------------------------------------------------------
+run info --default-terrain --json "$T/no/such/dir/info.json"
+expect "--json into a missing folder" 1 "the folder '$T/no/such/dir' does not exist"
+run mesh --default-terrain --tolerance 20 --out "$T/no/such/dir/x.glb"
+expect "--out into a missing folder" 1 "the folder '$T/no/such/dir' does not exist"
+[ ! -e "$T/no" ] && ok || bad "nothing created for a missing folder"
+
+# ---- mesh and bench lod: --tolerance, the stop reason --------------------------------------------
+run bench lod --default-terrain --path "$TEST_DATA/paths/flyover.json" --tolerance 4 --error-every 0
+expect "bench lod --tolerance" 0
+contains "bench lod --tolerance converges" '"stopped_by": "converged"'
+tris_tol=$(json_num triangles_median)
+run mesh --default-terrain --tolerance 4 --out "$T/tol.glb"; expect "mesh --tolerance" 0
+near "bench lod --tolerance gives the view-independent mesh of ridge mesh" "$(json_num triangles)" "$tris_tol" 0
+run bench lod --default-terrain --path "$TEST_DATA/paths/flyover.json" --triangles 2000 --error-every 0
+expect "bench lod --triangles" 0
+contains "triangle cap stop reason" '"stopped_by": "triangle_budget"'
+[[ "$out" != *'"stopped_by": "triangles"'* ]] && ok || bad "old stop reason spelling" "$out"
+run mesh --default-terrain --eye 100,290,100 --target 600,170,500 --triangles 2000 --out "$T/capped.glb"
+expect "mesh --triangles" 0
+contains "mesh stop reason" '"stopped_by": "triangle_budget"'
 
 # ---- info ----------------------------------------------------------------------------------------
 run info --default-terrain; expect "info default" 0
@@ -151,6 +184,45 @@ run info --default-terrain --spacing ""; expect "empty --spacing" 1 "--spacing"
 run info --default-terrain --spacing 4 --origin 100,200 --height-offset 1000
 expect "default terrain placed" 0
 [[ "$(tr -d ' \n' <<< "$out")" == *'"extent":[4096.0,4096.0]'* ]] && ok || bad "placed extent"
+
+# ---- GeoTIFF placement (real DEMs from Debian's r-cran-terra, fetched by scripts/test.sh) ----------
+EX=${EXTERNAL_DATA:-}/terra/usr/lib/R/site-library/terra/ex
+if [ -f "$EX/elev.tif" ] && [ -f "$EX/meuse.tif" ]; then
+  # elev.tif: 1/120-degree cells at 49.8 N, about 598.8 x 926.7 m; 46 % no-data outside Luxembourg.
+  run info --heightmap "$EX/elev.tif"; expect "elev.tif without a fill policy" 1 "(the no-data value)"
+  run info --heightmap "$EX/elev.tif" --fill nearest; expect "info elev.tif" 0
+  sx=$(tr -d ' \n' <<< "$out" | sed -n 's/.*"spacing":\[\([-0-9.e+]*\),\([-0-9.e+]*\)\].*/\1/p')
+  sz=$(tr -d ' \n' <<< "$out" | sed -n 's/.*"spacing":\[\([-0-9.e+]*\),\([-0-9.e+]*\)\].*/\2/p')
+  near "elev.tif spacing x within 1 % of 598.8 m" "$sx" 598.8 5.988
+  near "elev.tif spacing z within 1 % of 926.7 m" "$sz" 926.7 9.267
+  contains "elev.tif spacing source" '"spacing_source": "geotiff"'
+  contains "elev.tif origin source" '"origin_source": "default"'
+  contains "elev.tif pixel type" '"pixel_type": "int16"'
+  contains "elev.tif placement described" 'GeoTIFF geographic (EPSG 4326)'
+  contains "elev.tif filled warning in the output" '3942 of 8550 samples (46.1 %) are filled'
+  [[ "$err" == *"warning:"*"46.1 %"* ]] && ok || bad "elev.tif filled warning logged" "$err"
+  [[ "$err" == *"degrees give no origin in metres"* ]] && ok || bad "loader says the conversion" "$err"
+  run info --heightmap "$EX/elev.tif" --fill nearest --spacing 30
+  expect "info elev.tif --spacing" 0
+  contains "--spacing overrides the file" '"spacing_source": "flag"'
+  [[ "$(tr -d ' \n' <<< "$out")" == *'"spacing":[30.0,30.0]'* ]] && ok || bad "--spacing 30 used"
+  # meuse.tif: projected (RD New), 40 m cells, tie point (178400, 334000) at the corner.
+  run info --heightmap "$EX/meuse.tif" --fill nearest; expect "info meuse.tif" 0
+  [[ "$(tr -d ' \n' <<< "$out")" == *'"spacing":[40.0,40.0]'* ]] && ok || bad "meuse spacing" "$out"
+  [[ "$(tr -d ' \n' <<< "$out")" == *'"origin":[178420.0,-333980.0]'* ]] && ok || bad "meuse origin" "$out"
+  contains "meuse origin source" '"origin_source": "geotiff"'
+  run info --heightmap "$EX/meuse.tif" --fill nearest --origin 0,0; expect "meuse --origin" 0
+  contains "--origin overrides the file" '"origin_source": "flag"'
+  contains "--origin keeps the file's spacing" '"spacing_source": "geotiff"'
+else
+  echo "note: $EX/elev.tif or meuse.tif missing (scripts/test.sh fetches r-cran-terra): GeoTIFF checks skipped"
+fi
+run info --default-terrain; contains "default terrain pixel type" '"pixel_type": "float (generated)"'
+contains "default terrain spacing source" '"spacing_source": "default"'
+run info --heightmap "$T/h.r16" --raw-size 3,2; contains "raw pixel type" '"pixel_type": "u16"'
+run info --heightmap "$T/h.r16" --raw-size 3,2 --nodata 0 --fill nearest
+contains "1 of 6 filled is warned about in the output" '1 of 6 samples (16.7 %) are filled'
+[[ "$err" == *"1 of 6 samples (16.7 %) are filled"* ]] && ok || bad "raw filled warning" "$err"
 
 # ---- query ---------------------------------------------------------------------------------------
 # On the ramp with spacing 10, scale 0.1, offset -50: height = -50 + 100 + x + z / 10 where the

@@ -72,3 +72,61 @@ T.case("save and load paths", function()
   T.raises("NUL", ridgeline.save_edits, t, "a\0b")
   T.raises("ridgeline.terrain expected", ridgeline.save_edits, {}, "x.bin")
 end)
+
+T.case("edit_version and changes_since: every edit is a changed box under its version", function()
+  local u = ridgeline.default_terrain()  -- shared with the cases above: versions are relative
+  local v0 = u:edit_version()
+  T.eq(math.type(v0), "integer")
+  local changes, v, trimmed = u:changes_since(v0)
+  T.eq(#changes, 0, "nothing new"); T.eq(v, v0); T.eq(trimmed, false)
+  local x1, x2 = 300, 700
+  local r1 = assert(u:deform{brush = "raise", x = x1, z = 500, radius = 10, depth = 3})
+  local r2 = assert(u:deform{brush = "crater", x = x2, z = 400, radius = 8, depth = 2})
+  assert(u:deform{brush = "crater", x = -5000, z = 0, radius = 3})  -- outside: no change
+  T.eq(u:edit_version(), v0 + 2, "two edits changed heights")
+  changes, v, trimmed = u:changes_since(v0)
+  T.eq(v, v0 + 2); T.eq(trimmed, false); T.eq(#changes, 2, "one entry per edit")
+  for k, r in ipairs{r1, r2} do
+    local c = changes[k]
+    T.eq(c.version, v0 + k, "version of entry " .. k)
+    for _, f in ipairs{"min_x", "min_y", "min_z", "max_x", "max_y", "max_z"} do
+      T.eq(c[f], r[f], f .. " of entry " .. k .. " is the deform result's")
+    end
+    -- lattice indices (2 m spacing, no detail): the changed samples
+    T.eq(math.type(c.i0), "integer")
+    T.truthy(c.i0 <= c.i1 and c.j0 <= c.j1, "vertex range")
+    T.truthy(c.min_x <= c.i0 * 2 and c.max_x >= c.i1 * 2, "box holds the vertex range")
+  end
+  T.truthy(changes[1].min_x < x1 and changes[1].max_x > x1, "the raise's box is around it")
+  T.truthy(changes[2].min_x < x2 and changes[2].max_x > x2, "the crater's box is around it")
+  changes, v = u:changes_since(v0 + 1)
+  T.eq(#changes, 1); T.eq(changes[1].version, v0 + 2); T.eq(v, v0 + 2)
+  changes, v = u:changes_since(v)
+  T.eq(#changes, 0, "nothing after the current version")
+  -- a version the terrain never had: the whole footprint, trimmed
+  local min_x, _, max_x = u:bounds()
+  changes, v, trimmed = u:changes_since(v0 + 99)
+  T.eq(#changes, 1); T.eq(trimmed, true); T.eq(v, v0 + 2)
+  T.eq(changes[1].min_x, min_x); T.eq(changes[1].max_x, max_x)
+  T.raises("version >= 0 expected", u.changes_since, u, -1)
+  T.raises("number has no integer representation", u.changes_since, u, 1.5)
+  T.raises("number expected", u.changes_since, u)
+  u:release()
+  T.raises("released", u.edit_version, u)
+  T.raises("released", u.changes_since, u, 0)
+end)
+
+T.case("keep_detail = false: refused over procedural detail, the same edit without", function()
+  local d = assert(ridgeline.load{heightmap = DATA .. "ramp16.png", spacing = 8, detail_levels = 3})
+  local h = d:height(12, 12)
+  local r, err = d:deform{brush = "flatten", x = 12, z = 12, radius = 10, height = 5,
+                          keep_detail = false}
+  T.eq(r, nil); T.truthy(err:find("keep_detail = false is not supported", 1, true), err)
+  T.eq(d:height(12, 12), h, "nothing changed"); T.eq(d:edit_version(), 0)
+  assert(d:deform{brush = "flatten", x = 12, z = 12, radius = 10, height = 5})  -- detail kept
+  T.eq(d:edit_version(), 1)
+  local plain = ridgeline.default_terrain()
+  assert(plain:deform{brush = "flatten", x = 800, z = 800, radius = 10, height = 5,
+                      keep_detail = false})
+  T.near(plain:height(800, 800), 5, 1e-4, "without detail there is nothing to keep")
+end)

@@ -3,9 +3,10 @@
 collectgarbage("collect")
 local base = collectgarbage("count")
 local d = ridgeline.default_terrain()
-for i = 1, 100000 do
+-- Each call is a fresh 6 MB copy: fewer of them, dropped without release().
+for i = 1, 300 do
   local t = ridgeline.default_terrain()
-  if i % 1000 == 0 then T.truthy(t:height(1024, 1024)) end
+  if i % 10 == 0 then T.truthy(t:height(1024, 1024)) end
 end
 local ramp = assert(ridgeline.load{heightmap = DATA .. "ramp16.png"})
 for i = 1, 100000 do

@@ -115,7 +115,55 @@ T.case("default terrain", function()
   T.truthy(hh > 16 and hh < 219, "height in the documented range")
   local x0, z0, x1, z1 = t:bounds()
   T.eq(x1 - x0, 2048); T.eq(z1 - z0, 2048)
-  T.near(ridgeline.default_terrain():height(1024, 1024), hh, 0, "shared and deterministic")
+  T.near(ridgeline.default_terrain():height(1024, 1024), hh, 0, "deterministic")
+end)
+
+T.case("default terrain: a fresh terrain per call", function()
+  local a = ridgeline.default_terrain()
+  local pristine = a:height(1024, 1024)
+  assert(a:deform{brush = "crater", x = 1024, z = 1024, radius = 10, depth = 5})
+  T.near(a:height(1024, 1024), pristine - 5, 1e-3, "the crater is in the terrain that made it")
+  local b = ridgeline.default_terrain()
+  T.eq(b:height(1024, 1024), pristine, "another call does not see it")
+  assert(b:deform{brush = "raise", x = 500, z = 500, radius = 10, depth = 3, strength = 1})
+  T.near(a:height(1024, 1024), pristine - 5, 1e-3, "nor does the first see the second's edit")
+  a:release()
+  T.eq(ridgeline.default_terrain():height(1024, 1024), pristine, "pristine after release")
+  T.truthy(a ~= b and rawequal(a, a), "distinct objects")
+end)
+
+T.case("arguments are never coerced", function()
+  -- One rule for every function: a number argument must be a Lua number (a numeric string is
+  -- refused like any other type), a string argument a string, a boolean field a boolean.
+  local t = ramp()
+  T.raises("bad argument #1 to 'height' (number expected, got string)", function() return t:height("10", 1) end)
+  T.raises("bad argument #2 to 'height' (number expected, got string)", function() return t:height(102, "202") end)
+  T.raises("bad argument #1 to 'normal' (number expected, got string)", function() return t:normal("102", 202) end)
+  T.raises("bad argument #2 to 'smooth_normal' (number expected, got string)", function() return t:smooth_normal(102, "202") end)
+  T.raises("bad argument #1 to 'sample' (number expected, got string)", function() return t:sample("102", 202) end)
+  T.raises("bad argument #2 to 'raycast' (number expected, got string)", function() return t:raycast(102, "1000", 202, 0, -1, 0) end)
+  T.raises("bad argument #7 to 'raycast' (number expected, got string)", function() return t:raycast(102, 1000, 202, 0, -1, 0, "10") end)
+  T.raises("bad argument #1 to 'place' (number expected, got string)", function() return t:place("102", 202, {length = 1, width = 1}) end)
+  T.raises("field 'length': number expected, got string", function() return t:place(102, 202, {length = "1", width = 1}) end)
+  T.raises("bad argument #3 to 'contacts' (number expected, got string)", function() return t:contacts(102, 202, "0", {}) end)
+  T.raises("offset 1: {x, z} of finite numbers expected", function() return t:contacts(102, 202, 0, {{"1", 0}}) end)
+  T.raises("entry 1: number expected, got string", function() return t:heights{"102", 202} end)
+  T.raises("bad argument #1 to 'save_edits' (string expected, got number)", function() return t:save_edits(123) end)
+  T.raises("bad argument #1 to 'load_edits' (string expected, got number)", function() return t:load_edits(123) end)
+  T.raises("bad argument #2 to 'save_edits' (string expected, got number)", function() return ridgeline.save_edits(t, 123) end)
+  T.raises("field 'x': number expected, got string", function() return t:deform{brush = "raise", x = "1", z = 1, radius = 1} end)
+  T.raises("field 'detail_levels': number expected, got string",
+           ridgeline.load, {heightmap = DATA .. "ramp16.png", detail_levels = "2"})
+  local v = t:new_view{eye = {104, 50, 190}, target = {104, 0, 203}}
+  T.raises("bad argument #1 to 'set_threshold' (number expected, got string)", function() return v:set_threshold("2") end)
+  T.raises("field 'ms': number expected, got string", function() return v:set_budget{ms = "2"} end)
+  local c = ridgeline.budget_controller()
+  T.raises("bad argument #1 to 'update' (number expected, got string)", function() return c:update("33", 0.03) end)
+  T.raises("bad argument #1 to 'set_target' (number expected, got string)", function() return c:set_target("16") end)
+  T.raises("bad argument #2 to 'set_range' (number expected, got string)", function() return c:set_range(1, "8") end)
+  T.raises("bad argument #1 to 'reset' (number expected, got string)", function() return c:reset("2") end)
+  -- Numbers of either subtype are numbers.
+  T.near(t:height(102, 202), t:height(102.0, 202.0), 0, "integers and floats")
 end)
 
 T.case("release", function()
@@ -154,4 +202,48 @@ T.case("procedural detail through load", function()
   T.eq(bad, nil); T.truthy(err:find("gain is 3", 1, true), err)
   bad, err = ridgeline.load{heightmap = DATA .. "ramp16.png", detail_levels = 2, detail_amplitude = -1}
   T.eq(bad, nil); T.truthy(err:find("amplitude", 1, true), err)
+end)
+
+T.case("GeoTIFF placement through load", function()
+  if not (STOCK and io and os and os.tmpname) then return end  -- needs a file written here
+  -- A 3 x 2 int16 GeoTIFF: UTM 33N, 30 m pixels, tie point (500000, 4100000) at the corner.
+  local entries = {
+    {256, 3, {3}}, {257, 3, {2}}, {258, 3, {16}}, {259, 3, {1}}, {262, 3, {1}},
+    {273, 4, {0}}, {277, 3, {1}}, {278, 3, {2}}, {279, 4, {12}}, {339, 3, {2}},
+    {33550, 12, {30, 30, 0}}, {33922, 12, {0, 0, 0, 500000, 4100000, 0}},
+    {34735, 3, {1, 1, 0, 2, 1024, 0, 1, 1, 3076, 0, 1, 9001}}}
+  local fmt = {[3] = "<I2", [4] = "<I4", [12] = "<d"}
+  local size = {[3] = 2, [4] = 4, [12] = 8}
+  local data_at = 8 + 2 + 12 * #entries + 4
+  local blobs, next_at = {}, data_at
+  for k, e in ipairs(entries) do
+    if #e[3] * size[e[2]] > 4 then blobs[k] = next_at; next_at = next_at + #e[3] * size[e[2]] end
+  end
+  entries[6][3][1] = next_at  -- the strip follows the data
+  local parts = {"II", string.pack("<I2I4I2", 42, 8, #entries)}
+  for k, e in ipairs(entries) do
+    local v = {}
+    for _, x in ipairs(e[3]) do v[#v + 1] = string.pack(fmt[e[2]], x) end
+    v = table.concat(v)
+    parts[#parts + 1] = string.pack("<I2I2I4", e[1], e[2], #e[3]) ..
+                        (blobs[k] and string.pack("<I4", blobs[k]) or (v .. ("\0"):rep(4 - #v)))
+  end
+  parts[#parts + 1] = string.pack("<I4", 0)
+  for k, e in ipairs(entries) do
+    if blobs[k] then for _, x in ipairs(e[3]) do parts[#parts + 1] = string.pack(fmt[e[2]], x) end end
+  end
+  for _, s in ipairs{10, 20, 30, 40, 50, 60} do parts[#parts + 1] = string.pack("<i2", s) end
+  local path = os.tmpname() .. ".tif"
+  local f = assert(io.open(path, "wb")); f:write(table.concat(parts)); f:close()
+  -- No spacing or origin given: the file's own (sample (0, 0) at the centre of pixel (0, 0),
+  -- z = -northing).
+  local t = assert(ridgeline.load{heightmap = path})
+  local x0, z0, x1, z1 = t:bounds()
+  T.eq(x0, 500015); T.eq(z0, -4099985); T.eq(x1 - x0, 60); T.eq(z1 - z0, 30)
+  T.eq(t:height(500015, -4099985), 10)
+  -- Given ones win.
+  t = assert(ridgeline.load{heightmap = path, spacing = 2, origin = {0, 0}})
+  x0, z0, x1, z1 = t:bounds()
+  T.eq(x0, 0); T.eq(z0, 0); T.eq(x1, 4); T.eq(z1, 2)
+  os.remove(path)
 end)

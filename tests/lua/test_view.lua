@@ -44,6 +44,12 @@ T.case("set_camera", function()
   local s = v:update()
   T.truthy(s.triangles > 100)
   T.raises("camera: ", v.set_camera, v, {eye = {1024, 0, 1024}})  -- eye == target
+  -- One "camera: " prefix, as validate_camera words it (it was doubled).
+  local ok, err = pcall(v.set_camera, v, {eye = {1024, 0, 1024}})
+  T.truthy(not ok and err:find("(camera: eye and target are the same point)", 1, true), err)
+  T.truthy(not err:find("camera: camera:", 1, true), "doubled prefix: " .. err)
+  ok, err = pcall(function() return t:new_view{fov_y = 200} end)
+  T.truthy(not ok and err:find("bad argument #1 to 'new_view' (camera: fov_y ", 1, true), err)
   T.raises("field 'fov_y': number expected, got string", v.set_camera, v, {fov_y = "wide"})
   T.raises("field 'eye': array of 3 numbers expected", v.set_camera, v, {eye = {1, 2}})
   T.raises("field 'eye': entry 2: finite number expected, got nan", v.set_camera, v, {eye = {1, 0 / 0, 3}})

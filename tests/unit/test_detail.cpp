@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "ridgeline/detail.h"
+#include "ridgeline/scenes.h"
 #include "ridgeline/surface.h"
 
 namespace ridgeline {
@@ -20,22 +21,12 @@ namespace {
 
 // 65 x 65 samples, 8 m apart: a flat plain (x < 200 m) next to steep sinusoidal hills.
 std::shared_ptr<const Terrain> make_terrain() {
-  HeightfieldDesc d;
-  d.width = 65;
-  d.height = 65;
-  d.spacing_x = 8;
-  d.spacing_z = 8;
-  d.origin_x = -100;
-  d.origin_z = 50;
-  std::vector<float> v(65 * 65);
-  for (int j = 0; j < 65; ++j)
-    for (int i = 0; i < 65; ++i) {
-      const double x = i * 8.0, z = j * 8.0;
-      v[i + j * 65] =
-          x < 200 ? 10.0f
-                  : float(10 + 60 * std::sin(x / 40.0) * std::cos(z / 55.0) + 0.3 * (x - 200));
-    }
-  auto hf = Heightfield::create(d, v);
+  auto hf = scenes::field(
+      {.width = 65, .height = 65, .spacing_x = 8, .spacing_z = 8, .origin_x = -100, .origin_z = 50},
+      [](int i, int j) {
+        const double x = i * 8.0, z = j * 8.0;
+        return x < 200 ? 10.0 : 10 + 60 * std::sin(x / 40.0) * std::cos(z / 55.0) + 0.3 * (x - 200);
+      });
   EXPECT_TRUE(hf.ok());
   return Terrain::create(std::move(hf).value());
 }

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "ridgeline/detail_stream.h"
+#include "ridgeline/scenes.h"
 
 namespace ridgeline {
 namespace {
@@ -22,19 +23,17 @@ constexpr std::uint32_t kSize = 257;  // 25.6 km square
 
 // 257 x 257 samples, 100 m apart: rolling hills with a plain in the south.
 std::shared_ptr<const Terrain> make_terrain() {
-  HeightfieldDesc d;
-  d.width = d.height = kSize;
-  d.spacing_x = d.spacing_z = kSpacing;
-  d.origin_x = -500;
-  d.origin_z = 300;
-  std::vector<float> v(std::size_t{kSize} * kSize);
-  for (std::uint32_t j = 0; j < kSize; ++j)
-    for (std::uint32_t i = 0; i < kSize; ++i) {
-      const double x = i * kSpacing, z = j * kSpacing;
-      v[i + j * kSize] =
-          z < 3000 ? 20.0f : float(200 + 150 * std::sin(x / 1700.0) * std::cos(z / 2300.0));
-    }
-  auto hf = Heightfield::create(d, v);
+  auto hf = scenes::field(
+      {.width = kSize,
+       .height = kSize,
+       .spacing_x = kSpacing,
+       .spacing_z = kSpacing,
+       .origin_x = -500,
+       .origin_z = 300},
+      [](int i, int j) {
+        const double x = i * kSpacing, z = j * kSpacing;
+        return z < 3000 ? 20.0 : 200 + 150 * std::sin(x / 1700.0) * std::cos(z / 2300.0);
+      });
   EXPECT_TRUE(hf.ok());
   return Terrain::create(std::move(hf).value());
 }

@@ -2,7 +2,9 @@
 // diagonals, seams, far edge, off-terrain, non-finite input), cliffs, flat fields, precision far
 // from the origin, smooth normals against a hand computation, batched == single, raycasts against
 // an independent brute-force reference (10^5 random rays plus every special case), triangles in a
-// box against brute force, and the full-detail triangulation's topology.
+// box against brute force, the full-detail triangulation's topology, and every query seeing every
+// edit (rays of every slant and boxes against brute force after edits, the ray pyramid against a
+// rebuild).
 //
 // The reference code in this file derives the triangulation from SPEC.md's wording ("cell (i, j)
 // is split along (i, j)-(i+1, j+1) when i + j is even, along (i+1, j)-(i, j+1) when it is odd") on
@@ -22,6 +24,9 @@
 #include <tuple>
 #include <vector>
 
+#include "ridgeline/scenes.h"
+#include "ridgeline/detail.h"
+#include "ridgeline/edit.h"
 #include "ridgeline/surface.h"
 #include "ridgeline/terrain.h"
 
@@ -37,24 +42,26 @@ struct FieldSpec {
   double sx = 1, sz = 1, ox = 0, oz = 0, offset = 0;
 };
 
+std::shared_ptr<Terrain> make_editable_terrain(const FieldSpec& s,
+                                               const std::function<double(int, int)>& f,
+                                               std::vector<std::uint8_t> materials = {}) {
+  auto hf = scenes::field({.width = s.w,
+                           .height = s.h,
+                           .spacing_x = s.sx,
+                           .spacing_z = s.sz,
+                           .origin_x = s.ox,
+                           .origin_z = s.oz,
+                           .height_offset = s.offset,
+                           .name = "test"},
+                          f, materials);
+  EXPECT_TRUE(hf) << (hf ? "" : hf.error().message);
+  return Terrain::create(std::move(hf).value());
+}
+
 std::shared_ptr<const Terrain> make_terrain(const FieldSpec& s,
                                             const std::function<double(int, int)>& f,
                                             std::vector<std::uint8_t> materials = {}) {
-  HeightfieldDesc d;
-  d.width = s.w;
-  d.height = s.h;
-  d.spacing_x = s.sx;
-  d.spacing_z = s.sz;
-  d.origin_x = s.ox;
-  d.origin_z = s.oz;
-  d.height_offset = s.offset;
-  d.name = "test";
-  std::vector<float> v(std::size_t{s.w} * s.h);
-  for (std::uint32_t j = 0; j < s.h; ++j)
-    for (std::uint32_t i = 0; i < s.w; ++i) v[i + j * s.w] = float(f(int(i), int(j)));
-  auto hf = Heightfield::create(d, v, materials);
-  EXPECT_TRUE(hf) << (hf ? "" : hf.error().message);
-  return Terrain::create(std::move(hf).value());
+  return make_editable_terrain(s, f, std::move(materials));
 }
 
 // ---- An independent reference surface ------------------------------------------------------
@@ -246,12 +253,7 @@ bool near_vec(glm::vec3 a, glm::dvec3 b, double tol) {
 // ---- Analytic cases ---------------------------------------------------------------------------
 
 TEST(Queries, PlaneHeight) {
-  HeightfieldDesc d;
-  d.width = d.height = 5;
-  std::vector<float> v(25);
-  for (int j = 0; j < 5; ++j)
-    for (int i = 0; i < 5; ++i) v[i + j * 5] = float(2 * i + 3 * j);
-  auto t = Terrain::create(std::move(Heightfield::create(d, v)).value());
+  auto t = make_terrain({}, [](int i, int j) { return 2 * i + 3 * j; });
   EXPECT_NEAR(*t->height(1.25, 2.5), 2 * 1.25 + 3 * 2.5, 1e-5);
   EXPECT_FALSE(t->height(-0.1, 1.0));
 }
@@ -988,13 +990,57 @@ bool tri_rect_overlap(const glm::dvec2 p[3], glm::dvec2 lo, glm::dvec2 hi) {
 
 }  // namespace
 
+namespace {
+
+// triangles_in_box(b) on `t` returns exactly the triangles that overlap b by brute force over every
+// triangle of the stored lattice (the independent reference), wound counter-clockwise from above,
+// with their cell's material.
+::testing::AssertionResult box_matches_brute_force(const Terrain& t, const Box& b) {
+  const Heightfield& hf = t.heightfield();
+  const Reference ref{&hf, 0.0};
+  std::vector<SurfaceTriangle> got;
+  const std::size_t n = t.triangles_in_box(b, got);
+  if (n != got.size()) return ::testing::AssertionFailure() << "count " << n << " != appended";
+  std::multiset<TriKey> got_keys, want_keys;
+  for (SurfaceTriangle tri : got) {
+    for (auto& v : tri.v) v = local_of(hf, v);
+    const glm::dvec3 c = glm::cross(tri.v[1] - tri.v[0], tri.v[2] - tri.v[0]);
+    if (!(c.y > 0)) return ::testing::AssertionFailure() << "clockwise triangle";
+    const double cx = (tri.v[0].x + tri.v[1].x + tri.v[2].x) / 3 / hf.spacing_x();
+    const double cz = (tri.v[0].z + tri.v[1].z + tri.v[2].z) / 3 / hf.spacing_z();
+    if (tri.material != hf.material(std::uint32_t(cx), std::uint32_t(cz)))
+      return ::testing::AssertionFailure() << "material of another cell";
+    got_keys.insert(canonical(key_of(tri)));
+  }
+  const Box lb{local_of(hf, b.min), local_of(hf, b.max)};
+  for (int j = 0; j + 1 < int(hf.height()); ++j)
+    for (int i = 0; i + 1 < int(hf.width()); ++i)
+      for (int w = 0; w < 2; ++w) {
+        RefTri r = ref.tri(i, j, w);
+        const glm::dvec2 p[3] = {{r.p[0].x, r.p[0].z}, {r.p[1].x, r.p[1].z}, {r.p[2].x, r.p[2].z}};
+        const double ylo = std::min({r.p[0].y, r.p[1].y, r.p[2].y});
+        const double yhi = std::max({r.p[0].y, r.p[1].y, r.p[2].y});
+        if (yhi < lb.min.y || ylo > lb.max.y) continue;
+        if (!tri_rect_overlap(p, {lb.min.x, lb.min.z}, {lb.max.x, lb.max.z})) continue;
+        // Wind it counter-clockwise about +y like the module does.
+        if (glm::cross(r.p[1] - r.p[0], r.p[2] - r.p[0]).y < 0) std::swap(r.p[1], r.p[2]);
+        SurfaceTriangle st;
+        for (int c = 0; c < 3; ++c) st.v[c] = r.p[c];
+        want_keys.insert(canonical(key_of(st)));
+      }
+  if (got_keys != want_keys)
+    return ::testing::AssertionFailure()
+           << got_keys.size() << " triangles, brute force finds " << want_keys.size();
+  return ::testing::AssertionSuccess();
+}
+
+}  // namespace
+
 TEST(TrianglesInBox, MatchesBruteForce) {
   FieldSpec s{23, 19, 1.0, 1.0, 0.0, 0.0, 0.0};
   std::vector<std::uint8_t> mats(22 * 18);
   for (std::size_t k = 0; k < mats.size(); ++k) mats[k] = std::uint8_t(k * 7 % 11);
   auto t = make_terrain(s, rough, mats);
-  const Heightfield& hf = t->heightfield();
-  const Reference ref{&hf, 0.0};
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> U(0.0, 1.0);
   for (int k = 0; k < 3000; ++k) {
@@ -1007,36 +1053,7 @@ TEST(TrianglesInBox, MatchesBruteForce) {
     const double y0 = -6 + 18 * U(rng), wy = 8 * U(rng) * U(rng);
     b.min = {x0, y0, z0};
     b.max = {x0 + wx, y0 + wy, z0 + wz};
-    std::vector<SurfaceTriangle> got;
-    const std::size_t n = t->triangles_in_box(b, got);
-    ASSERT_EQ(n, got.size());
-    std::multiset<TriKey> got_keys, want_keys;
-    for (const auto& tri : got) {
-      // Counter-clockwise seen from above (surface.h's convention) and the cell's material.
-      const glm::dvec3 c = glm::cross(tri.v[1] - tri.v[0], tri.v[2] - tri.v[0]);
-      ASSERT_GT(c.y, 0);
-      const double cx = (tri.v[0].x + tri.v[1].x + tri.v[2].x) / 3;
-      const double cz = (tri.v[0].z + tri.v[1].z + tri.v[2].z) / 3;
-      ASSERT_EQ(tri.material, hf.material(std::uint32_t(cx), std::uint32_t(cz)));
-      got_keys.insert(canonical(key_of(tri)));
-    }
-    for (int j = 0; j + 1 < 19; ++j)
-      for (int i = 0; i + 1 < 23; ++i)
-        for (int w = 0; w < 2; ++w) {
-          RefTri r = ref.tri(i, j, w);
-          const glm::dvec2 p[3] = {
-              {r.p[0].x, r.p[0].z}, {r.p[1].x, r.p[1].z}, {r.p[2].x, r.p[2].z}};
-          const double ylo = std::min({r.p[0].y, r.p[1].y, r.p[2].y});
-          const double yhi = std::max({r.p[0].y, r.p[1].y, r.p[2].y});
-          if (yhi < b.min.y || ylo > b.max.y) continue;
-          if (!tri_rect_overlap(p, {b.min.x, b.min.z}, {b.max.x, b.max.z})) continue;
-          // Wind it counter-clockwise about +y like the module does.
-          if (glm::cross(r.p[1] - r.p[0], r.p[2] - r.p[0]).y < 0) std::swap(r.p[1], r.p[2]);
-          SurfaceTriangle st;
-          for (int c = 0; c < 3; ++c) st.v[c] = r.p[c];
-          want_keys.insert(canonical(key_of(st)));
-        }
-    ASSERT_EQ(got_keys, want_keys) << "box " << k;
+    ASSERT_TRUE(box_matches_brute_force(*t, b)) << "box " << k;
   }
 }
 
@@ -1164,4 +1181,132 @@ TEST(Terrain, MemoryReport) {
   EXPECT_LE(bytes / samples, 6.0);
   EXPECT_GT(t->ray_hierarchy_bytes(), 0u);
   EXPECT_GE(t->memory_bytes(), std::size_t(bytes));
+}
+
+// ---- Every query sees every edit ---------------------------------------------------------------
+
+namespace {
+
+// The first distance along a ray (unit `d`) at which it is at or below the surface, found by
+// marching `step` metres and bisecting: an independent check for surfaces the brute-force
+// reference does not model (procedural detail). +inf when none within `max_distance`.
+double march(const Terrain& t, glm::dvec3 o, glm::dvec3 d, double max_distance, double step) {
+  auto below = [&](double s) {
+    const glm::dvec3 p = o + d * s;
+    const auto h = t.height(p.x, p.z);
+    return h && p.y <= *h;
+  };
+  for (double s = 0; s <= max_distance; s += step) {
+    if (!below(s)) continue;
+    double a = std::max(0.0, s - step), b = s;
+    for (int k = 0; k < 60; ++k) (below(0.5 * (a + b)) ? b : a) = 0.5 * (a + b);
+    return b;
+  }
+  return kInf;
+}
+
+}  // namespace
+
+TEST(QueriesAfterEdits, AHorizontalRayAtHalfTheHeightOfAFreshBumpHitsIt) {
+  auto t = make_editable_terrain({129, 129, 1.0, 1.0, 0.0, 0.0, 0.0}, [](int, int) { return 0.0; });
+  ASSERT_TRUE(t->apply_edit({.brush = Brush::kRaise, .x = 64, .z = 64, .radius = 10, .depth = 5}));
+  ASSERT_NEAR(*t->height(64, 64), 5.0, 1e-6);
+  // Where the bump is 2.5 m high: 5 (1 - r^2)^2 = 2.5 at r = 5.41 m (to within the lattice's
+  // linear interpolation).
+  const double r_half = 10 * std::sqrt(1 - std::sqrt(0.5));
+  RayCheck stats;
+  for (int k = 0; k < 16; ++k) {
+    const double a = k * M_PI / 8 + 0.01 * k;
+    const glm::dvec3 d(std::cos(a), 0, std::sin(a));
+    const glm::dvec3 o = glm::dvec3(64, 2.5, 64) - 60.0 * d;
+    auto hit = t->raycast(o, d, kInf);
+    ASSERT_TRUE(hit) << "horizontal ray at angle " << a << " misses the bump";
+    EXPECT_NEAR(hit->point.y, 2.5, 1e-9);
+    EXPECT_NEAR(glm::length(glm::dvec2(hit->point.x - 64, hit->point.z - 64)), r_half, 0.3);
+    EXPECT_TRUE(check_ray(*t, o, d, kInf, stats));
+    // Slanted through the bump's flank, down and up.
+    for (double dy : {-0.05, 0.04}) {
+      const glm::dvec3 ds = glm::normalize(glm::dvec3(d.x, dy, d.z));
+      EXPECT_TRUE(check_ray(*t, o, ds, kInf, stats));
+      EXPECT_TRUE(check_ray(*t, o, ds, 45.0, stats));
+    }
+  }
+  EXPECT_GE(stats.hits, 16 * 3);
+  // The same over procedural detail (2 levels): the bump still stops the ray, where the
+  // finest surface first reaches it.
+  HeightfieldDesc desc;
+  desc.width = desc.height = 65;
+  desc.spacing_x = desc.spacing_z = 2.0;
+  std::vector<float> zeros(65 * 65, 0.0f);
+  DetailParams dp;
+  dp.levels = 2;
+  dp.amplitude = 0.3;
+  DetailCacheDesc cache;
+  cache.worker_threads = 0;
+  cache.budget_bytes = std::size_t{16} << 20;
+  auto fine =
+      Terrain::create(std::move(Heightfield::create(desc, zeros)).value(), dp, cache).value();
+  ASSERT_TRUE(
+      fine->apply_edit({.brush = Brush::kRaise, .x = 64, .z = 64, .radius = 20, .depth = 5}));
+  for (int k = 0; k < 8; ++k) {
+    const double a = k * M_PI / 4 + 0.1;
+    const glm::dvec3 d(std::cos(a), 0, std::sin(a));
+    const glm::dvec3 o = glm::dvec3(64, 2.5, 64) - 60.0 * d;
+    auto hit = fine->raycast(o, d, kInf);
+    ASSERT_TRUE(hit) << "horizontal ray over detail at angle " << a << " misses the bump";
+    EXPECT_NEAR(hit->distance, march(*fine, o, d, 120, 0.05), 1e-6);
+  }
+}
+
+TEST(QueriesAfterEdits, RaysOfEverySlantAndBoxesMatchBruteForceAndThePyramidARebuild) {
+  const FieldSpec s{97, 81, 1.0, 1.25, 10.0, -20.0, 5.0};
+  auto t = make_editable_terrain(s, rough);
+  const Heightfield& hf = t->heightfield();
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  const Brush brushes[] = {Brush::kCrater, Brush::kRaise, Brush::kLower, Brush::kFlatten,
+                           Brush::kSmooth};
+  RayCheck stats;
+  int failures = 0;
+  for (int k = 0; k < 60; ++k) {
+    // Centres over the whole field and past its edges, craters and mounds.
+    Edit e{.brush = brushes[k % 5],
+           .x = s.ox - 5 + (hf.extent_x() + 10) * U(rng),
+           .z = s.oz - 5 + (hf.extent_z() + 10) * U(rng),
+           .radius = 2 + 10 * U(rng),
+           .depth = -4 + 10 * U(rng),
+           .height = s.offset + 12 * U(rng)};
+    auto r = t->apply_edit(e);
+    ASSERT_TRUE(r) << r.error().message;
+    if (r->empty()) continue;
+    ASSERT_EQ(t->check_invariants(), "") << "after edit " << k;
+    const Box& b = r->changed;
+    for (int q = 0; q < 60; ++q) {
+      // Aimed at a point of the edited region from around it: horizontal, shallow, steep.
+      const glm::dvec3 target(b.min.x + (b.max.x - b.min.x) * U(rng),
+                              b.min.y + (b.max.y - b.min.y) * U(rng),
+                              b.min.z + (b.max.z - b.min.z) * U(rng));
+      const double a = 2 * M_PI * U(rng), dist = 5 + 40 * U(rng);
+      const double slant = q % 3 == 0 ? 0.0 : (q % 3 == 1 ? 0.1 : 1.0) * (U(rng) - 0.3);
+      const glm::dvec3 o = target - dist * glm::dvec3(std::cos(a), slant, std::sin(a));
+      const glm::dvec3 d = target - o;
+      auto c = check_ray(*t, o, d, q % 2 ? kInf : 1.5 * dist, stats);
+      if (!c) {
+        ADD_FAILURE() << "after edit " << k << ": " << c.message();
+        if (++failures > 10) return;
+      }
+    }
+    for (int q = 0; q < 10; ++q) {
+      // Boxes over the edited region, thin in y (what a mid-phase asks for around a body).
+      Box box;
+      const double x = b.min.x + (b.max.x - b.min.x) * U(rng),
+                   z = b.min.z + (b.max.z - b.min.z) * U(rng);
+      const double y = b.min.y + (b.max.y - b.min.y) * U(rng);
+      box.min = {x - 3 * U(rng), y - U(rng), z - 3 * U(rng)};
+      box.max = {x + 3 * U(rng), y + U(rng), z + 3 * U(rng)};
+      ASSERT_TRUE(box_matches_brute_force(*t, box)) << "after edit " << k << ", box " << q;
+    }
+  }
+  EXPECT_GT(stats.hits, 1000);
+  EXPECT_LT(stats.ambiguous, 50);
 }

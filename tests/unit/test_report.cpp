@@ -1,32 +1,35 @@
-// The comparators and the measurement of `ridge report` (module/cli/report/meshes.h): the uniform
-// grid and the CDLOD quadtree are crack-free and cover the terrain, the error measurement agrees
-// with a brute-force reference and with RoamView::measure_error, triangle counts match.
+// The comparators and the measurement of `ridge report` (module/cli/report/, mesh_error.h): the
+// uniform grid, the CDLOD quadtree and the SOAR refinement are crack-free and cover the terrain,
+// the error measurement agrees with a brute-force reference and with RoamView::measure_error,
+// triangle counts match, the jump and the pop measure what docs/report.md says.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
 #include "report/meshes.h"
+#include "report/roam_drawn.h"
+#include "report/soar.h"
 #include "ridgeline/edit.h"
 #include "ridgeline/landscape.h"
+#include "ridgeline/mesh_error.h"
+#include "ridgeline/roam_view.h"
+#include "ridgeline/scenes.h"
 
 namespace ridgeline::report {
 namespace {
 
 std::shared_ptr<const Terrain> field(std::uint32_t w, std::uint32_t h, double sx = 1.0,
                                      double sz = 1.0, double origin = 0.0) {
-  HeightfieldDesc d;
+  scenes::FieldDesc d;
   d.width = w;
   d.height = h;
   d.spacing_x = sx;
   d.spacing_z = sz;
   d.origin_x = d.origin_z = origin;
-  std::vector<float> v(std::size_t(w) * h);
-  for (std::uint32_t j = 0; j < h; ++j)
-    for (std::uint32_t i = 0; i < w; ++i)
-      v[i + std::size_t(j) * w] = static_cast<float>(
-          20 * std::sin(0.21 * i) * std::cos(0.17 * j) + 7 * std::sin(0.9 * i + 1.3 * j) + 30);
-  auto hf = Heightfield::create(d, v);
+  auto hf = scenes::field(d, [](int i, int j) {
+    return 20 * std::sin(0.21 * i) * std::cos(0.17 * j) + 7 * std::sin(0.9 * i + 1.3 * j) + 30;
+  });
   EXPECT_TRUE(hf.ok()) << hf.error().message;
   return Terrain::create(std::move(*hf));
 }
@@ -78,8 +81,7 @@ std::vector<Camera> cameras() {
   std::vector<Camera> c;
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> xz(-20, 150), y(35, 300), t(0, 128);
-  for (int k = 0; k < 12; ++k)
-    c.push_back(look({xz(rng), y(rng), xz(rng)}, {t(rng), 20, t(rng)}));
+  for (int k = 0; k < 12; ++k) c.push_back(look({xz(rng), y(rng), xz(rng)}, {t(rng), 20, t(rng)}));
   c.push_back(look({64, 400, 64}, {64.1, 0, 64}));
   return c;
 }
@@ -146,11 +148,8 @@ TEST(ReportCdlod, MatchesAFeasibleTriangleTargetWithinTenPercent) {
 }
 
 TEST(ReportCdlod, RefreshAfterAnEditEqualsARebuiltQuadtree) {
-  HeightfieldDesc d;
-  d.width = d.height = 129;
-  std::vector<float> v(129 * 129);
-  for (std::size_t k = 0; k < v.size(); ++k) v[k] = float(30 + 10 * std::sin(0.1 * double(k % 129)));
-  auto hf = Heightfield::create(d, v);
+  auto hf = scenes::field({.width = 129, .height = 129},
+                          [](int i, int) { return 30 + 10 * std::sin(0.1 * i); });
   ASSERT_TRUE(hf.ok());
   auto t = Terrain::create(std::move(*hf));
   Cdlod cd(t->heightfield(), 8);
@@ -178,7 +177,7 @@ TEST(ReportCdlod, RefreshAfterAnEditEqualsARebuiltQuadtree) {
 
 // Brute force: for each lattice vertex in view, search every triangle of the mesh.
 MeshError brute_force(const Heightfield& hf, const DrawnMesh& m, const Camera& c) {
-  const ViewFrustum f(c);
+  const Frustum f(c);
   MeshError out;
   double sum2 = 0;
   for (std::uint32_t j = 0; j < hf.height(); ++j)
@@ -213,14 +212,13 @@ TEST(ReportMeasure, AgreesWithBruteForceOnASmallField) {
   auto t = field(33, 33, 2.0, 1.0);
   const Heightfield& hf = t->heightfield();
   const Cdlod cd(hf, 4);
+  const MeshErrorMeter meter(hf);
   for (const Camera& c : {look({-10, 60, -10}, {40, 0, 20}), look({33, 25, 16}, {0, 20, 16}),
                           look({32, 200, 16}, {32.1, 0, 16})}) {
     const DrawnMesh meshes[2] = {UniformGrid::for_triangles(hf, 150).mesh(hf),
                                  cd.mesh(cd.select(c, cd.min_r0(), false), c, true)};
     for (const DrawnMesh& m : meshes) {
-      DisplayedHeights shown(hf, 1);
-      shown.rasterize(m);
-      const MeshError a = measure(hf, shown, c), b = brute_force(hf, m, c);
+      const MeshError a = meter.measure(meter.rasterize(m), c), b = brute_force(hf, m, c);
       ASSERT_GT(a.vertices, 50u);
       EXPECT_EQ(a.vertices, b.vertices);
       EXPECT_EQ(a.uncovered, 0u);
@@ -235,7 +233,30 @@ TEST(ReportMeasure, AgreesWithBruteForceOnASmallField) {
   }
 }
 
-TEST(ReportMeasure, AgreesWithRoamViewOnItsOwnMesh) {
+TEST(ReportMeasure, HolesAreCountedAndAStrideSamplesEveryKthVertex) {
+  auto t = field(33, 33);
+  const Heightfield& hf = t->heightfield();
+  DrawnMesh m = UniformGrid{8, 8}.mesh(hf);
+  m.corners.resize(m.corners.size() - 6);  // drop the last quad (its corner (32, 32))
+  const Camera c = look({16, 80, -40}, {16, 0, 16});
+  const MeshErrorMeter all(hf, 1), every4(hf, 4);
+  const MeshError a = all.measure(all.rasterize(m), c), b = every4.measure(every4.rasterize(m), c);
+  EXPECT_EQ(all.columns(), 33u);
+  EXPECT_EQ(every4.columns(), 9u);
+  EXPECT_GT(a.uncovered, 0u);
+  EXPECT_LT(a.uncovered, 4u * 4u + 1u);  // at most the dropped quad's vertices
+  EXPECT_EQ(b.uncovered, 1u);            // of every 4th vertex, only (32, 32) lies in it
+  EXPECT_LT(b.vertices, a.vertices);
+  const MeshError w = all.measure_all(all.rasterize(m));
+  EXPECT_EQ(w.vertices, 33u * 33u);
+  EXPECT_EQ(w.max_px, 0.0);
+  // A bad camera sees nothing.
+  Camera bad = c;
+  bad.target = bad.eye;
+  EXPECT_EQ(all.measure(all.rasterize(m), bad).vertices, 0u);
+}
+
+TEST(ReportMeasure, RoamViewMeasuresItsPatchMeshesAsTheBruteForceDoes) {
   auto t = field(129, 129, 1.0, 1.0, 1e6);
   auto l = Landscape::create(t, {.patch_exponent = 5});
   ASSERT_TRUE(l.ok());
@@ -244,33 +265,165 @@ TEST(ReportMeasure, AgreesWithRoamViewOnItsOwnMesh) {
   const Camera c = look({1e6 - 20, 90, 1e6 - 20}, {1e6 + 64, 10, 1e6 + 64});
   ASSERT_TRUE((*v)->converge(c).ok());
   const auto ref = (*v)->measure_error(c);
-  DisplayedHeights shown(t->heightfield(), 1);
-  shown.rasterize(roam_mesh(**v, c, false));
-  const MeshError e = measure(t->heightfield(), shown, c);
-  EXPECT_EQ(e.vertices, ref.vertices);
-  EXPECT_EQ(e.uncovered, 0u);
+  const MeshErrorMeter meter(t->heightfield());
+  // The patch meshes as a renderer draws them (no geomorph) against a search over every triangle.
+  const DrawnMesh drawn = RoamSnapshot::capture(**v).draw(meter, c, false);
+  const MeshError b = brute_force(t->heightfield(), drawn, c);
+  EXPECT_EQ(b.vertices, ref.vertices);
+  EXPECT_EQ(b.uncovered, 0u);
   EXPECT_GT(ref.max_m, 0.1);
-  EXPECT_NEAR(e.max_m, ref.max_m, 1e-4);
-  EXPECT_NEAR(e.rms_m, ref.rms_m, 1e-4);
-  EXPECT_NEAR(e.max_px, ref.max_px, 1e-3);
-  EXPECT_EQ(check_watertight(t->heightfield(), roam_mesh(**v, c, false)), "");
+  EXPECT_NEAR(b.max_m, ref.max_m, 1e-4);
+  EXPECT_NEAR(b.rms_m, ref.rms_m, 1e-4);
+  EXPECT_NEAR(b.max_px, ref.max_px, 1e-3);
+  EXPECT_EQ(check_watertight(t->heightfield(), drawn), "");
+  EXPECT_EQ(check_watertight(t->heightfield(), leaves_mesh(**v)), "");
 }
 
-TEST(ReportMeasure, PoppingIsZeroForAnUnchangedMeshAndTheHeightJumpOtherwise) {
+TEST(ReportMeasure, JumpIsZeroForAnUnchangedMeshAndTheHeightJumpOtherwise) {
   auto t = field(33, 33);
   const Heightfield& hf = t->heightfield();
+  const MeshErrorMeter meter(hf);
   const Camera c = look({16, 40, -30}, {16, 20, 16});
-  DisplayedHeights a(hf, 1), b(hf, 1);
-  a.rasterize(UniformGrid{4, 4}.mesh(hf));
-  b.rasterize(UniformGrid{4, 4}.mesh(hf));
-  EXPECT_EQ(popping_px(hf, a, c, b, c), 0.0);
+  const DrawnHeights a = meter.rasterize(UniformGrid{4, 4}.mesh(hf));
+  DrawnHeights b = meter.rasterize(UniformGrid{4, 4}.mesh(hf));
+  EXPECT_EQ(meter.jump_px(a, b, c, &c), 0.0);
   DrawnMesh raised = UniformGrid{4, 4}.mesh(hf);
   for (auto& p : raised.corners) p.y += 0.5;
-  b.rasterize(raised);
-  const double pop = popping_px(hf, a, c, b, c);
+  b = meter.rasterize(raised);
+  const double pop = meter.jump_px(a, b, c);
   // 0.5 m at the nearest vertex in view: between 0.5 * scale / far-most and / near-most.
   EXPECT_GT(pop, 0.5 * projection_scale(c) / 100.0);
   EXPECT_LT(pop, 0.5 * projection_scale(c) / 20.0);
+  // Seen from behind the field (nothing of it in view) nothing pops.
+  EXPECT_EQ(meter.jump_px(a, b, look({16, 40, -30}, {16, 40, -60})), 0.0);
+}
+
+// The pop compares two meshes drawn for the same camera: a refinement pops by its height change,
+// a mesh that does not change topology does not pop even when it moves continuously.
+TEST(ReportPop, ARefinementPopsAndASameMeshMorphedDoesNot) {
+  auto t = field(129, 129);
+  auto l = Landscape::create(t, {.patch_exponent = 5});
+  ASSERT_TRUE(l.ok());
+  auto v = RoamView::create(*l, {.threshold = 8.0});
+  ASSERT_TRUE(v.ok());
+  const Camera c = look({-20, 70, -20}, {64, 10, 64});
+  ASSERT_TRUE((*v)->converge(c).ok());
+  const MeshErrorMeter meter(t->heightfield());
+  const RoamSnapshot coarse = RoamSnapshot::capture(**v);
+  ASSERT_TRUE((*v)->set_settings({.threshold = 2.0}).ok());
+  ASSERT_TRUE((*v)->converge(c).ok());
+  const RoamSnapshot fine = RoamSnapshot::capture(**v);
+  ASSERT_GT(fine.triangles(), coarse.triangles());
+  const DrawnHeights cf = meter.rasterize(coarse.draw(meter, c, false));
+  const DrawnHeights ff = meter.rasterize(fine.draw(meter, c, false));
+  EXPECT_GT(meter.jump_px(cf, ff, c), 2.0);  // splits past 8 px down to 2 px: visible
+  // One mesh drawn twice for one camera does not pop, morphed or not.
+  const DrawnHeights f1 = meter.rasterize(fine.draw(meter, c, true));
+  EXPECT_EQ(meter.jump_px(f1, meter.rasterize(fine.draw(meter, c, true)), c), 0.0);
+}
+
+TEST(ReportRoamDrawn, UnmorphedIsTheTrueHeightAndAFreshSplitStartsOnItsEdge) {
+  MeshVertex v{};
+  v.y = 10;
+  v.morph_dy = 2.0f;
+  v.morph_bound = 1.0f;
+  Camera c = look({0, 0, -1000}, {0, 0, 0});
+  const glm::dvec3 w(0, 10, 0);
+  EXPECT_EQ(roam_drawn_y(v, w, c, 2.0, 0.5, false), 10.0);
+  EXPECT_EQ(roam_drawn_y(v, w, c, 0.0, 0.5, true), 10.0);  // no pixel threshold: no morph
+  // Far away the bound projects below the threshold: the vertex sits on the coarser edge.
+  EXPECT_DOUBLE_EQ(roam_drawn_y(v, w, c, 2.0, 0.5, true), 12.0);
+  // Close, the projected bound is over twice the threshold: the true height.
+  c.eye = {0, 0, -1};
+  EXPECT_DOUBLE_EQ(roam_drawn_y(v, w, c, 2.0, 0.5, true), 10.0);
+}
+
+// ---- SOAR -------------------------------------------------------------------------------
+
+std::vector<Camera> soar_cameras() {
+  return {look({-10, 60, -10}, {64, 0, 64}), look({64, 25, 64}, {100, 20, 64}),
+          look({64, 300, 64}, {64.1, 0, 64}), look({200, 40, 64}, {0, 30, 64})};
+}
+
+TEST(ReportSoar, StripIsWatertightCoversTheTerrainAndHoldsTheLeafCount) {
+  auto t = field(129, 129);
+  const Heightfield& hf = t->heightfield();
+  const Soar soar(hf);
+  EXPECT_EQ(soar.size(), 129u);
+  std::vector<std::uint32_t> strip;
+  for (const Camera& c : soar_cameras())
+    for (double th : {0.5, 2.0, 8.0})
+      for (bool cull : {true, false}) {
+        const auto f = soar.refine(c, Soar::kappa_for(c, th), strip, cull);
+        const DrawnMesh m = soar.mesh(strip);
+        EXPECT_EQ(m.triangles(), f.triangles);
+        EXPECT_EQ(soar.count(c, Soar::kappa_for(c, th), cull), f.triangles);
+        EXPECT_EQ(check_watertight(hf, m), "") << th << " px, cull " << cull;
+      }
+}
+
+TEST(ReportSoar, InfiniteKappaGivesTheFullLatticeAndZeroError) {
+  auto t = field(65, 65);
+  const Heightfield& hf = t->heightfield();
+  const Soar soar(hf);
+  std::vector<std::uint32_t> strip;
+  const Camera c = soar_cameras()[0];
+  const auto f = soar.refine(c, Soar::kappa_for(c, 0.0), strip, false);
+  EXPECT_EQ(f.triangles, 2u * 64u * 64u);
+  const MeshErrorMeter meter(hf);
+  const MeshError e = meter.measure_all(meter.rasterize(soar.mesh(strip)));
+  EXPECT_EQ(e.uncovered, 0u);
+  EXPECT_LT(e.max_m, 1e-4);
+}
+
+TEST(ReportSoar, MoreKappaMoreTrianglesLessErrorAndCullingDropsTheOutOfView) {
+  auto t = field(129, 129);
+  const Heightfield& hf = t->heightfield();
+  const Soar soar(hf);
+  const MeshErrorMeter meter(hf);
+  std::vector<std::uint32_t> strip;
+  const Camera c = soar_cameras()[0];
+  std::uint64_t last = 0;
+  double last_rms = 1e9;
+  for (double th : {16.0, 4.0, 1.0, 0.25}) {
+    const auto f = soar.refine(c, Soar::kappa_for(c, th), strip);
+    const MeshError e = meter.measure(meter.rasterize(soar.mesh(strip)), c);
+    EXPECT_GT(f.triangles, last);
+    EXPECT_LE(e.rms_m, last_rms);
+    last = f.triangles;
+    last_rms = e.rms_m;
+  }
+  const Camera away = look({64, 40, -10}, {64, 40, -100});  // looking off the terrain
+  EXPECT_LT(soar.count(away, Soar::kappa_for(away, 1.0)),
+            soar.count(away, Soar::kappa_for(away, 1.0), false) / 4);
+}
+
+TEST(ReportSoar, NonPowerOfTwoFieldIsCoveredThroughThePadding) {
+  auto t = field(95, 90, 6.0, 9.0);
+  const Heightfield& hf = t->heightfield();
+  const Soar soar(hf);
+  EXPECT_EQ(soar.size(), 129u);
+  const MeshErrorMeter meter(hf);
+  std::vector<std::uint32_t> strip;
+  for (const Camera& c : {look({-50, 400, -50}, {280, 0, 400}), look({280, 300, 400}, {0, 0, 0})}) {
+    soar.refine(c, Soar::kappa_for(c, 2.0), strip);
+    const MeshError e = meter.measure_all(meter.rasterize(soar.mesh(strip)));
+    EXPECT_EQ(e.uncovered, 0u);
+    EXPECT_GT(e.max_m, 0.0);
+  }
+}
+
+TEST(ReportSoar, MatchFindsTheKappaOfATriangleTarget) {
+  auto t = field(257, 257);
+  const Soar soar(t->heightfield());
+  std::vector<Camera> path;
+  for (int k = 0; k < 12; ++k)
+    path.push_back(
+        look({128 + 90 * std::cos(k * 0.3), 70, 128 + 90 * std::sin(k * 0.3)}, {128, 20, 128}));
+  for (double target : {2000.0, 8000.0}) {
+    const Soar::Match m = soar.match(path, target);
+    EXPECT_NEAR(m.median / target, 1.0, 0.05) << target;
+  }
 }
 
 }  // namespace

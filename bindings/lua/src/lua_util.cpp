@@ -20,7 +20,9 @@ const char* non_finite_name(double v) {
 }  // namespace
 
 double check_finite(lua_State* L, int arg) {
-  const double v = luaL_checknumber(L, arg);
+  // No string coercion, as in option tables: t:height("10", 1) is refused like t:height({}, 1).
+  if (lua_type(L, arg) != LUA_TNUMBER) luaL_typeerror(L, arg, "number");
+  const double v = lua_tonumber(L, arg);
   if (!std::isfinite(v)) {
     lua_pushfstring(L, "finite number expected, got %s", non_finite_name(v));
     luaL_argerror(L, arg, lua_tostring(L, -1));

@@ -32,7 +32,9 @@ struct ConfigBox {
   bool confine_paths = false;
   std::uint64_t max_samples = 0;
   char root[4096] = {};
-  std::shared_ptr<Terrain> default_terrain;  // built once, shared by default_terrain()
+  // Built on the first default_terrain() call and never handed out: every call returns a clone,
+  // so one script's craters never reach another's terrain.
+  std::shared_ptr<const Terrain> default_terrain;
 };
 
 /// A terrain userdata. Released: `terrain` is empty.

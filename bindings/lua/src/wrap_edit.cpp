@@ -15,7 +15,8 @@ Terrain& editable_terrain(lua_State* L, int arg) {
   return *box->terrain;
 }
 
-// Reads the edit table at `arg` (SPEC.md's schema) into plain data; raises on a bad field.
+// Reads the edit table at `arg` (docs/deformation.md's fields) into plain data; raises on a bad
+// field.
 Edit check_edit(lua_State* L, int arg) {
   luaL_checktype(L, arg, LUA_TTABLE);
   static const char* const kFields[] = {"brush", "x",   "z",      "radius",      "strength",
@@ -129,7 +130,8 @@ bool do_file(bool confine, const char* root, Terrain& t, const char* name, FileO
 // functions (the module's rules, upvalue 1).
 int file_op(lua_State* L, FileOp op, bool method) {
   Terrain& t = editable_terrain(L, 1);
-  const char* name = luaL_checkstring(L, 2);
+  luaL_checktype(L, 2, LUA_TSTRING);  // a number is not a file name (no coercion)
+  const char* name = lua_tostring(L, 2);
   if (std::strlen(name) != lua_rawlen(L, 2)) luaL_argerror(L, 2, "file name holds a NUL byte");
   bool confine = true;
   const char* root = nullptr;  // kept alive by the terrain box or the module's config

@@ -20,6 +20,7 @@ struct LoadArgs {
   const char* heightmap = nullptr;  // kept alive by the option table on the stack
   double spacing[2] = {1, 1};
   double origin[2] = {0, 0};
+  bool has_spacing = false, has_origin = false;  // else a GeoTIFF's own placement is used
   double height_scale = 1, height_offset = 0;
   bool has_nodata = false;
   double nodata = 0;
@@ -38,6 +39,8 @@ bool do_load(const ConfigBox& config, const LoadArgs& a, TerrainBox* box, char* 
     p.spacing_z = a.spacing[1];
     p.origin_x = a.origin[0];
     p.origin_z = a.origin[1];
+    options.spacing_from_file = !a.has_spacing;
+    options.origin_from_file = !a.has_origin;
     p.height_scale = a.height_scale;
     p.height_offset = a.height_offset;
     if (a.has_nodata) p.nodata = a.nodata;
@@ -99,12 +102,13 @@ int r_load(lua_State* L) {
     luaL_argerror(L, 1, "field 'heightmap': embedded zero in file name");
   if (lua_getfield(L, 1, "spacing") == LUA_TTABLE) {
     lua_pop(L, 1);
-    get_vector_field(L, 1, "spacing", 2, a.spacing);
+    a.has_spacing = get_vector_field(L, 1, "spacing", 2, a.spacing);
   } else {
     lua_pop(L, 1);
-    if (get_number_field(L, 1, "spacing", &a.spacing[0])) a.spacing[1] = a.spacing[0];
+    a.has_spacing = get_number_field(L, 1, "spacing", &a.spacing[0]);
+    if (a.has_spacing) a.spacing[1] = a.spacing[0];
   }
-  get_vector_field(L, 1, "origin", 2, a.origin);
+  a.has_origin = get_vector_field(L, 1, "origin", 2, a.origin);
   get_number_field(L, 1, "height_scale", &a.height_scale);
   get_number_field(L, 1, "height_offset", &a.height_offset);
   a.has_nodata = get_number_field(L, 1, "nodata", &a.nodata);
@@ -147,7 +151,7 @@ bool make_default(ConfigBox* config, TerrainBox* box, char* err) noexcept {
       }
       config->default_terrain = Terrain::create(std::move(*hf));
     }
-    box->terrain = config->default_terrain;
+    box->terrain = config->default_terrain->clone();
     set_path_rules(box, *config);
     return true;
   } catch (const std::exception& e) {
@@ -156,13 +160,15 @@ bool make_default(ConfigBox* config, TerrainBox* box, char* err) noexcept {
   }
 }
 
-// ridgeline.default_terrain() -> terrain (the built-in 2048 m terrain; generated once per module
-// table, then shared by every call: cheap after the first).
+// ridgeline.default_terrain() -> terrain: a fresh copy of the built-in 2048 m terrain on every
+// call (generated once per module table, then cloned: a few milliseconds and ~6 MB each), so an
+// edit one script makes is never seen by another and a released terrain is simply gone.
 int r_default_terrain(lua_State* L) {
   ConfigBox* config = config_of(L);
   TerrainBox* box = push_terrain_box(L);
   char err[kErrSize];
   if (!make_default(config, box, err)) return luaL_error(L, "default_terrain: %s", err);
+  account_memory(L, box->terrain->memory_bytes());
   return 1;
 }
 

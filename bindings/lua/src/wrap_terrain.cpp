@@ -1,10 +1,13 @@
-// Lua userdata `ridgeline.terrain`: queries, batched heights, placement of game objects.
+// Lua userdata `ridgeline.terrain`: queries, batched heights, placement of game objects, the
+// change log (edit_version, changes_since).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <glm/geometric.hpp>
 #include <new>
 #include <optional>
+#include <type_traits>
 
 #include "lua_util.h"
 
@@ -132,7 +135,8 @@ int t_raycast(lua_State* L) {
   for (int i = 0; i < 6; ++i) v[i] = check_finite(L, i + 2);
   double max = INFINITY;
   if (!lua_isnoneornil(L, 8)) {
-    max = luaL_checknumber(L, 8);
+    if (lua_type(L, 8) != LUA_TNUMBER) luaL_typeerror(L, 8, "number");
+    max = lua_tonumber(L, 8);
     if (std::isnan(max)) luaL_argerror(L, 8, "number or math.huge expected, got nan");
   }
   const std::optional<RayHit> hit = t.raycast({v[0], v[1], v[2]}, {v[3], v[4], v[5]}, max);
@@ -253,8 +257,8 @@ int t_contacts(lua_State* L) {
     for (int c = 0; c < 2; ++c) {
       int isnum = 0;
       if (lua_type(L, -1) == LUA_TTABLE) {
-        lua_rawgeti(L, -1, c + 1);
-        o[c] = lua_tonumberx(L, -1, &isnum);
+        isnum = lua_rawgeti(L, -1, c + 1) == LUA_TNUMBER;  // no string coercion
+        o[c] = lua_tonumber(L, -1);
         lua_pop(L, 1);
       }
       if (!isnum || !std::isfinite(o[c]))
@@ -296,6 +300,71 @@ int t_bounds(lua_State* L) {
   return 6;
 }
 
+// terrain:edit_version() -> integer: 0 as created, one more per edit or load that changed heights
+int t_edit_version(lua_State* L) {
+  lua_pushinteger(L, static_cast<lua_Integer>(live_terrain(L).edit_version()));
+  return 1;
+}
+
+// Copies at most `room` entries of changes_since(since) into `out` (memory Lua owns) and returns
+// how many there are, or -1 with a message in `err`. No Lua calls: the answer's vector is gone
+// before the caller allocates or raises (correct under longjmp).
+static_assert(std::is_trivially_copyable_v<TerrainChange>);
+long long copy_changes(const Terrain& t, std::uint64_t since, TerrainChange* out, std::size_t room,
+                       std::uint64_t* version, bool* trimmed, char* err) noexcept {
+  try {
+    const TerrainChanges c = t.changes_since(since);
+    *version = c.version;
+    *trimmed = c.trimmed;
+    for (std::size_t k = 0; k < c.changes.size() && k < room; ++k) out[k] = c.changes[k];
+    return static_cast<long long>(c.changes.size());
+  } catch (const std::exception& ex) {
+    copy_error(err, ex.what());
+    return -1;
+  }
+}
+
+// terrain:changes_since(version) -> changes, version, trimmed; changes = {{version=, min_x=,
+// min_y=, min_z=, max_x=, max_y=, max_z=, i0=, j0=, i1=, j1=}, ...}
+int t_changes_since(lua_State* L) {
+  const Terrain& t = live_terrain(L);
+  const lua_Integer since = luaL_checkinteger(L, 2);
+  if (since < 0) luaL_argerror(L, 2, "version >= 0 expected (an earlier edit_version())");
+  char err[kErrSize];
+  std::uint64_t version = 0;
+  bool trimmed = false;
+  const long long n = copy_changes(t, std::uint64_t(since), nullptr, 0, &version, &trimmed, err);
+  if (n < 0) return luaL_error(L, "%s", err);
+  auto* buf = static_cast<TerrainChange*>(
+      lua_newuserdatauv(L, std::size_t(n) * sizeof(TerrainChange) + 1, 0));
+  const long long again =
+      copy_changes(t, std::uint64_t(since), buf, std::size_t(n), &version, &trimmed, err);
+  if (again != n) return luaL_error(L, "%s", again < 0 ? err : "changes_since: terrain changed");
+  lua_createtable(L, static_cast<int>(n), 0);
+  for (long long k = 0; k < n; ++k) {
+    const TerrainChange& c = buf[k];
+    lua_createtable(L, 0, 11);
+    lua_pushinteger(L, static_cast<lua_Integer>(c.version));
+    lua_setfield(L, -2, "version");
+    set_number(L, "min_x", c.box.min.x);
+    set_number(L, "min_y", c.box.min.y);
+    set_number(L, "min_z", c.box.min.z);
+    set_number(L, "max_x", c.box.max.x);
+    set_number(L, "max_y", c.box.max.y);
+    set_number(L, "max_z", c.box.max.z);
+    const std::int64_t ij[4] = {c.vertices.i0, c.vertices.j0, c.vertices.i1, c.vertices.j1};
+    const char* const names[4] = {"i0", "j0", "i1", "j1"};
+    for (int q = 0; q < 4; ++q) {
+      lua_pushinteger(L, static_cast<lua_Integer>(ij[q]));
+      lua_setfield(L, -2, names[q]);
+    }
+    lua_rawseti(L, -2, static_cast<lua_Integer>(k) + 1);
+  }
+  lua_pushinteger(L, static_cast<lua_Integer>(version));
+  lua_pushboolean(L, trimmed);
+  return 3;
+}
+
 int t_release(lua_State* L) {
   auto* box = static_cast<TerrainBox*>(check_self(L, kTerrainMeta));
   box->terrain.reset();
@@ -318,13 +387,23 @@ int t_tostring(lua_State* L) {
   return 1;
 }
 
-const luaL_Reg kMethods[] = {
-    {"height", t_height},   {"normal", t_normal},     {"smooth_normal", t_smooth_normal},
-    {"sample", t_sample},   {"heights", t_heights},   {"raycast", t_raycast},
-    {"place", t_place},     {"contacts", t_contacts}, {"bounds", t_bounds},
-    {"new_view", new_view}, {"deform", t_deform},     {"save_edits", t_save_edits},
-    {"load_edits", t_load_edits}, {"release", t_release},
-    {nullptr, nullptr}};
+const luaL_Reg kMethods[] = {{"height", t_height},
+                             {"normal", t_normal},
+                             {"smooth_normal", t_smooth_normal},
+                             {"sample", t_sample},
+                             {"heights", t_heights},
+                             {"raycast", t_raycast},
+                             {"place", t_place},
+                             {"contacts", t_contacts},
+                             {"bounds", t_bounds},
+                             {"new_view", new_view},
+                             {"deform", t_deform},
+                             {"save_edits", t_save_edits},
+                             {"load_edits", t_load_edits},
+                             {"edit_version", t_edit_version},
+                             {"changes_since", t_changes_since},
+                             {"release", t_release},
+                             {nullptr, nullptr}};
 const luaL_Reg kMeta[] = {
     {"__gc", t_release}, {"__close", t_release}, {"__tostring", t_tostring}, {nullptr, nullptr}};
 

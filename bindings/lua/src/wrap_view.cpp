@@ -48,13 +48,11 @@ bool camera_ok(const Camera& cam, char* err) noexcept {
   }
 }
 
-// Raises `bad argument #arg (camera: ...)` after the helper's objects are gone.
+// Raises `bad argument #arg (camera: ...)` after the helper's objects are gone (validate_camera's
+// messages already begin with "camera: ").
 void check_camera(lua_State* L, int arg, const Camera& cam) {
   char err[kErrSize];
-  if (!camera_ok(cam, err)) {
-    lua_pushfstring(L, "camera: %s", err);
-    luaL_argerror(L, arg, lua_tostring(L, -1));
-  }
+  if (!camera_ok(cam, err)) luaL_argerror(L, arg, err);
 }
 
 std::uint32_t clamp_triangles(double t) {

@@ -7,12 +7,13 @@ REPORT_DIR/plots/*.png and REPORT_DIR/summary.md; needs gnuplot)"""
 import collections, json, os, subprocess, sys, tempfile
 
 COLS = ["scene", "path", "kind", "value", "mode", "triangles", "ms", "ms_p99", "changes",
-        "err_max", "err_rms", "px_max", "px_p99", "pop", "pop_morph", "memory", "matched"]
-MODES = ["roam_coherent", "roam_rebuild", "uniform_grid", "cdlod"]
-COLORS = {"roam_coherent": "#9400d3", "roam_rebuild": "#009e73", "uniform_grid": "#56b4e9",
-          "cdlod": "#e69f00"}
+        "err_max", "err_rms", "px_max", "px_p99", "jump", "jump_morph", "memory", "matched",
+        "pop", "pop_morph", "px_max_morph", "cpu_ms", "cpu_ms_p99", "in_view"]
+MODES = ["roam_coherent", "roam_rebuild", "soar", "uniform_grid", "cdlod"]
+COLORS = {"roam_coherent": "#9400d3", "roam_rebuild": "#009e73", "soar": "#d55e00",
+          "uniform_grid": "#56b4e9", "cdlod": "#e69f00"}
 TITLES = {"roam_coherent": "ROAM coherent", "roam_rebuild": "ROAM rebuild (split only)",
-          "uniform_grid": "uniform grid", "cdlod": "CDLOD-like quadtree"}
+          "soar": "SOAR (stateless)", "uniform_grid": "uniform grid", "cdlod": "CDLOD-like quadtree"}
 
 
 def num(s):
@@ -45,7 +46,8 @@ def main():
         for p in paths:
             files = {}
             for m in MODES:
-                pts = sorted(by[(sc, p, m, "threshold")], key=lambda r: r["triangles"])
+                pts = sorted((r for r in by[(sc, p, m, "threshold")] if r["triangles"]),
+                             key=lambda r: r["triangles"])
                 fn = os.path.join(data, f"{sc}_{p}_{m}.dat")
                 with open(fn, "w") as f:
                     for r in pts:
@@ -55,20 +57,20 @@ def main():
             png = os.path.join(pdir, f"{sc}_{p}.png")
             ths = ", ".join("%g" % v for v in sorted({r["value"] for r in by[(sc, p, "roam_coherent", "threshold")]}))
             gp = [
-                "set terminal pngcairo size 1500,460 font 'sans,10'",
+                "set terminal pngcairo size 1500,460 font 'sans,10' noenhanced",
                 f"set output '{png}'",
                 "set multiplot layout 1,3 title "
-                f"'{sc}, {p}: thresholds {ths} px, comparators at the median triangles of ROAM coherent'",
+                f"'{sc}, {p}: thresholds {ths} px, grid and CDLOD at the median triangles of ROAM coherent, SOAR at the same threshold'",
                 "set logscale xy", "set grid", "set key top right",
                 "set xlabel 'triangles (median)'", "set ylabel 'RMS error in view (m)'",
                 "plot " + ", ".join(f"'{files[m]}' using 1:2 with linespoints lw 2 lc rgb '{COLORS[m]}' title '{TITLES[m]}'"
-                                    for m in MODES),
+                                    for m in MODES if os.path.getsize(files[m])),
                 "set xlabel 'update ms (median)'", "set ylabel 'RMS error in view (m)'",
                 "plot " + ", ".join(f"'{files[m]}' using 3:2 with linespoints lw 2 lc rgb '{COLORS[m]}' title '{TITLES[m]}'"
-                                    for m in MODES if m != "uniform_grid"),
+                                    for m in MODES if m != "uniform_grid" and os.path.getsize(files[m])),
                 "set xlabel 'triangles (median)'", "set ylabel 'update ms (median)'",
                 "plot " + ", ".join(f"'{files[m]}' using 1:3 with linespoints lw 2 lc rgb '{COLORS[m]}' title '{TITLES[m]}'"
-                                    for m in MODES if m != "uniform_grid"),
+                                    for m in MODES if m != "uniform_grid" and os.path.getsize(files[m])),
                 "unset multiplot",
             ]
             subprocess.run(["gnuplot"], input="\n".join(gp), text=True, check=True)
@@ -81,9 +83,10 @@ def main():
                f"(stride {report['error_stride']}; the detail scene's is below); wall time "
                f"{report['wall_s']:.0f} s.")
     out.append("")
-    hdr = ("| setting | mode | triangles | ms median | ms p99 | changes/frame | max err m | "
-           "RMS err m | max px | p99 px | pop px | pop px (morph) | memory MB | matched |")
-    sep = "|" + " --- |" * 14
+    hdr = ("| setting | mode | triangles | in view | ms median | ms p99 | CPU ms median | "
+           "changes/frame | max err m | RMS err m | max px | p99 px | max px (morph) | jump px | "
+           "jump px (morph) | pop px | pop px (morph) | memory MB | matched |")
+    sep = "|" + " --- |" * 19
     def fmt(v, digits=3):
         if v is None:
             return ""
@@ -95,9 +98,10 @@ def main():
                 setting = {"threshold": f"{fmt(r['value'])} px", "triangles": f"cap {r['value']:.0f}",
                            "time_ms": f"budget {fmt(r['value'])} ms"}[r["kind"]]
                 out.append("| " + " | ".join([
-                    setting, r["mode"], f"{r['triangles']:.0f}", fmt(r["ms"]), fmt(r["ms_p99"]),
-                    fmt(r["changes"]), fmt(r["err_max"]), fmt(r["err_rms"]), fmt(r["px_max"]),
-                    fmt(r["px_p99"]), fmt(r["pop"]), fmt(r["pop_morph"]),
+                    setting, r["mode"], f"{r['triangles']:.0f}", fmt(r["in_view"], 6), fmt(r["ms"]),
+                    fmt(r["ms_p99"]), fmt(r["cpu_ms"]), fmt(r["changes"]), fmt(r["err_max"]),
+                    fmt(r["err_rms"]), fmt(r["px_max"]), fmt(r["px_p99"]), fmt(r["px_max_morph"]),
+                    fmt(r["jump"]), fmt(r["jump_morph"]), fmt(r["pop"]), fmt(r["pop_morph"]),
                     fmt((r["memory"] or 0) / 1e6), fmt(r["matched"])]) + " |")
             out.append("")
     out.append("## Hard cases: what the loaders said")
@@ -119,8 +123,7 @@ def main():
                 f"measured on the finest lattice {s['measured_lattice'][0]} x "
                 f"{s['measured_lattice'][1]} (stride {s['error_stride']}); tile cache budget "
                 f"{dd['cache_budget_bytes'] / 2**20:.0f} MiB, {dd['cache_worker_threads']} worker "
-                f"thread(s), a cold cache for every run. Comparators: {dd['comparators']}. "
-                f"Geomorph popping: {dd['geomorph_popping']}.", "",
+                f"thread(s), a cold cache for every run. Comparators: {dd['comparators']}.", "",
                 "| path | setting | mode | triangles | pending splits median / max | tiles resident median / max | "
                 "detail MB (median) | tiles generated | cache update ms |",
                 "|" + " --- |" * 9]
@@ -138,7 +141,7 @@ def main():
                         f"{m.get('tiles_generated', 0)}",
                         fmt(m.get("cache_update_ms_median"))]) + " |")
     out += ["", "## Where the time went", "",
-            "| scene | wall s | of which error/popping measurement s | ROAM rebuild s | CDLOD calibration s |",
+            "| scene | wall s | of which error/popping measurement s | ROAM rebuild s | CDLOD and SOAR calibration s |",
             "|" + " --- |" * 5]
     for s in report["scenes"] + [h for h in report["hard_cases"] if "paths" in h]:
         meas = reb = cal = 0.0

@@ -28,7 +28,8 @@ void triangulate_grid(const std::vector<glm::dvec3>& v, std::uint32_t nx, std::u
       const std::size_t r0 = std::size_t(b) * (nx + 1), r1 = r0 + nx + 1;
       const glm::dvec3 &p00 = v[a + r0], &p10 = v[a + 1 + r0], &p01 = v[a + r1],
                        &p11 = v[a + 1 + r1];
-      out.corners.insert(out.corners.end(), {p00, p11, p10, p00, p01, p11});
+      out.add(p00, p11, p10);
+      out.add(p00, p01, p11);
     }
 }
 
@@ -57,181 +58,6 @@ double surface_height(const Heightfield& hf, double u, double v) {
                        : h11 + (1.0 - fu) * (h01 - h11) + (1.0 - fv) * (h10 - h11);
   }
   return hf.height_offset() + h;
-}
-
-// ---- frustum ----------------------------------------------------------------------------
-
-ViewFrustum::ViewFrustum(const Camera& c) : eye(c.eye) {
-  forward = glm::normalize(c.target - c.eye);
-  right = glm::normalize(glm::cross(forward, c.up));
-  up = glm::cross(right, forward);
-  tan_v = std::tan(c.fov_y_deg * kPi / 360.0);
-  tan_h = tan_v * double(c.viewport.x) / double(c.viewport.y);
-  far_m = c.far_m;
-  scale = projection_scale(c);
-}
-
-bool ViewFrustum::contains(const glm::dvec3& p, double* distance) const {
-  const glm::dvec3 q = p - eye;
-  const double z = glm::dot(q, forward);
-  *distance = glm::length(q);
-  return z > 0 && std::abs(glm::dot(q, right)) <= tan_h * z &&
-         std::abs(glm::dot(q, up)) <= tan_v * z && *distance <= far_m;
-}
-
-bool ViewFrustum::may_intersect(const glm::dvec3& lo, const glm::dvec3& hi) const {
-  // Planes through the eye with inward normals; the box is out when its most inward corner is
-  // outside any of them. Far: the box's nearest point beyond far_m.
-  const glm::dvec3 normals[5] = {forward, tan_h * forward + right, tan_h * forward - right,
-                                 tan_v * forward + up, tan_v * forward - up};
-  for (const glm::dvec3& n : normals) {
-    const glm::dvec3 p(n.x >= 0 ? hi.x : lo.x, n.y >= 0 ? hi.y : lo.y, n.z >= 0 ? hi.z : lo.z);
-    if (glm::dot(p - eye, n) < 0) return false;
-  }
-  const glm::dvec3 nearest = glm::clamp(eye, lo, hi);
-  return glm::length(nearest - eye) <= far_m;
-}
-
-// ---- displayed heights and error ------------------------------------------------------------
-
-DisplayedHeights::DisplayedHeights(const Heightfield& hf, std::uint32_t stride)
-    : hf_(&hf),
-      stride_(std::max<std::uint32_t>(stride, 1)),
-      nx_((hf.width() - 1) / stride_ + 1),
-      nz_((hf.height() - 1) / stride_ + 1),
-      h_(std::size_t(nx_) * nz_, std::numeric_limits<float>::quiet_NaN()) {}
-
-void DisplayedHeights::rasterize(const DrawnMesh& mesh) {
-  std::fill(h_.begin(), h_.end(), std::numeric_limits<float>::quiet_NaN());
-  const double s = stride_;
-  for (std::size_t t = 0; t + 2 < mesh.corners.size(); t += 3) {
-    const glm::dvec3 &a = mesh.corners[t], &b = mesh.corners[t + 1], &c = mesh.corners[t + 2];
-    const double area = (b.x - a.x) * (c.z - a.z) - (b.z - a.z) * (c.x - a.x);
-    if (std::abs(area) < 1e-12) continue;
-    const double umin = std::min({a.x, b.x, c.x}), umax = std::max({a.x, b.x, c.x});
-    const double vmin = std::min({a.z, b.z, c.z}), vmax = std::max({a.z, b.z, c.z});
-    const auto k0 = static_cast<std::int64_t>(std::max(0.0, std::ceil(umin / s - 1e-9)));
-    const auto k1 = std::min<std::int64_t>(nx_ - 1, std::int64_t(std::floor(umax / s + 1e-9)));
-    const auto l0 = static_cast<std::int64_t>(std::max(0.0, std::ceil(vmin / s - 1e-9)));
-    const auto l1 = std::min<std::int64_t>(nz_ - 1, std::int64_t(std::floor(vmax / s + 1e-9)));
-    const double tol = 1e-9 * std::abs(area);
-    for (std::int64_t l = l0; l <= l1; ++l) {
-      const double v = double(l) * s;
-      for (std::int64_t k = k0; k <= k1; ++k) {
-        float& out = h_[std::size_t(k) + std::size_t(l) * nx_];
-        if (!std::isnan(out)) continue;
-        const double u = double(k) * s;
-        // Barycentric weights (signed by the winding, normalised by `area`).
-        const double wa = ((b.x - u) * (c.z - v) - (b.z - v) * (c.x - u));
-        const double wb = ((c.x - u) * (a.z - v) - (c.z - v) * (a.x - u));
-        const double wc = ((a.x - u) * (b.z - v) - (a.z - v) * (b.x - u));
-        const double sgn = area > 0 ? 1.0 : -1.0;
-        if (wa * sgn < -tol || wb * sgn < -tol || wc * sgn < -tol) continue;
-        out = static_cast<float>((wa * a.y + wb * b.y + wc * c.y) / area);
-      }
-    }
-  }
-}
-
-MeshError measure(const Heightfield& hf, const DisplayedHeights& shown, const Camera& camera) {
-  const ViewFrustum f(camera);
-  MeshError out;
-  double sum2 = 0;
-  std::vector<float> px;
-  const std::uint32_t s = shown.stride();
-  for (std::uint32_t l = 0; l < shown.rows(); ++l) {
-    for (std::uint32_t k = 0; k < shown.columns(); ++k) {
-      const std::uint32_t i = k * s, j = l * s;
-      const double y = hf.world(i, j);
-      const glm::dvec3 p(hf.origin_x() + i * hf.spacing_x(), y, hf.origin_z() + j * hf.spacing_z());
-      double d = 0;
-      if (!f.contains(p, &d)) continue;
-      ++out.vertices;
-      const float h = shown.heights()[k + std::size_t(l) * shown.columns()];
-      if (std::isnan(h)) {
-        ++out.uncovered;
-        continue;
-      }
-      const double e = std::abs(double(h) - y);
-      out.max_m = std::max(out.max_m, e);
-      sum2 += e * e;
-      px.push_back(static_cast<float>(d > 0 ? e * f.scale / d : 0.0));
-    }
-  }
-  if (!px.empty()) {
-    out.rms_m = std::sqrt(sum2 / double(px.size()));
-    const std::size_t q = std::min(px.size() - 1, px.size() * 99 / 100);
-    std::nth_element(px.begin(), px.begin() + std::ptrdiff_t(q), px.end());
-    out.p99_px = px[q];
-    out.max_px = *std::max_element(px.begin(), px.end());
-  }
-  return out;
-}
-
-double popping_px(const Heightfield& hf, const DisplayedHeights& before,
-                  const Camera& before_camera, const DisplayedHeights& now, const Camera& camera) {
-  const ViewFrustum f(camera), fb(before_camera);
-  double worst = 0;
-  const std::uint32_t s = now.stride();
-  for (std::uint32_t l = 0; l < now.rows(); ++l) {
-    for (std::uint32_t k = 0; k < now.columns(); ++k) {
-      const std::size_t at = k + std::size_t(l) * now.columns();
-      const float a = before.heights()[at], b = now.heights()[at];
-      if (std::isnan(a) || std::isnan(b)) continue;
-      const std::uint32_t i = k * s, j = l * s;
-      const glm::dvec3 p(hf.origin_x() + i * hf.spacing_x(), hf.world(i, j),
-                         hf.origin_z() + j * hf.spacing_z());
-      double d = 0, db = 0;
-      if (!f.contains(p, &d) || d <= 0 || !fb.contains(p, &db)) continue;
-      worst = std::max(worst, std::abs(double(b) - double(a)) * f.scale / d);
-    }
-  }
-  return worst;
-}
-
-DrawnMesh roam_mesh(RoamView& view, const Camera& camera, bool morph) {
-  return roam_mesh(view, view.landscape().terrain().heightfield(), camera, morph);
-}
-
-DrawnMesh roam_mesh(RoamView& view, const Heightfield& hf, const Camera& camera, bool morph) {
-  const Landscape& l = view.landscape();
-  const double k = projection_scale(camera);
-  const double threshold = view.settings().threshold;
-  DrawnMesh out;
-  for (std::uint32_t p = 0; p < l.patch_count(); ++p) {
-    const PatchMesh& m = view.patch_mesh(p);
-    for (std::size_t t = 0; t + 2 < m.indices.size(); t += 3) {
-      for (int c = 0; c < 3; ++c) {
-        const MeshVertex& v = m.vertices[m.indices[t + std::size_t(c)]];
-        const glm::dvec3 w(m.origin_x + v.x, m.origin_y + v.y, m.origin_z + v.z);
-        double y = w.y;
-        if (morph && threshold > 0) {
-          const double d = glm::length(w - camera.eye);
-          y += (1.0 - morph_factor(v.morph_bound, d, k, threshold)) * v.morph_dy;
-        }
-        out.corners.emplace_back((w.x - hf.origin_x()) / hf.spacing_x(), y,
-                                 (w.z - hf.origin_z()) / hf.spacing_z());
-      }
-    }
-  }
-  return out;
-}
-
-DrawnMesh roam_leaves(const RoamView& view, const Heightfield& hf) {
-  DrawnMesh out;
-  out.corners.reserve(std::size_t(view.triangle_count()) * 3);
-  const std::int64_t W = hf.width() - 1, H = hf.height() - 1;
-  auto corner = [&](std::int64_t i, std::int64_t j) {
-    const auto ci = static_cast<std::uint32_t>(std::clamp<std::int64_t>(i, 0, W));
-    const auto cj = static_cast<std::uint32_t>(std::clamp<std::int64_t>(j, 0, H));
-    return glm::dvec3(double(i), hf.world(ci, cj), double(j));
-  };
-  view.for_each_leaf([&](std::uint32_t, std::uint64_t, const LatticeTriangle& t) {
-    out.corners.push_back(corner(t.ax, t.az));
-    out.corners.push_back(corner(t.lx, t.lz));
-    out.corners.push_back(corner(t.rx, t.rz));
-  });
-  return out;
 }
 
 // ---- uniform grid -----------------------------------------------------------------------
@@ -396,13 +222,13 @@ bool sphere_meets_box(const glm::dvec3& c, double r, const glm::dvec3& lo, const
 }
 }  // namespace
 
-bool Cdlod::select_node(std::uint32_t L, std::int64_t i0, std::int64_t j0, const ViewFrustum& f,
+bool Cdlod::select_node(std::uint32_t L, std::int64_t i0, std::int64_t j0, const Frustum& f,
                         const std::vector<double>& range, bool cull, Selection& out) const {
   if (i0 >= cells_x_ || j0 >= cells_z_) return true;  // nothing there
   glm::dvec3 lo, hi;
   box(L, i0, j0, &lo, &hi);
   if (L + 1 < levels_ && !sphere_meets_box(f.eye, range[L], lo, hi)) return false;
-  if (cull && !f.may_intersect(lo, hi)) return true;
+  if (cull && f.classify_box(lo, hi) == Frustum::Cull::kOut) return true;
   const std::int64_t half = (std::int64_t(grid_) << L) / 2;
   auto add = [&](std::uint8_t mask) {
     std::uint8_t m = 0;
@@ -434,7 +260,7 @@ std::vector<double> ranges(double r0, std::uint32_t levels) {
 }  // namespace
 
 Cdlod::Selection Cdlod::select(const Camera& camera, double r0, bool cull) const {
-  const ViewFrustum f(camera);
+  const Frustum f(camera);
   Selection s;
   s.r0 = std::max(r0, min_r0_);
   select_node(levels_ - 1, 0, 0, f, ranges(s.r0, levels_), cull, s);
@@ -469,7 +295,7 @@ Cdlod::Match Cdlod::match(const std::vector<Camera>& frames, double target,
   return best;
 }
 
-void Cdlod::emit_quadrant(const Chunk& c, int q, const ViewFrustum& f, bool morph,
+void Cdlod::emit_quadrant(const Chunk& c, int q, const Frustum& f, bool morph,
                           const std::vector<double>& range, DrawnMesh& out) const {
   const Heightfield& hf = *hf_;
   const std::uint32_t L = c.level, g = grid_ / 2;
@@ -496,7 +322,7 @@ void Cdlod::emit_quadrant(const Chunk& c, int q, const ViewFrustum& f, bool morp
 }
 
 DrawnMesh Cdlod::mesh(const Selection& s, const Camera& camera, bool morph) const {
-  const ViewFrustum f(camera);
+  const Frustum f(camera);
   const auto r = ranges(s.r0, levels_);
   DrawnMesh out;
   out.corners.reserve(std::size_t(s.triangles) * 3);

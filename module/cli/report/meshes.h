@@ -1,6 +1,6 @@
-// What `ridge report` compares ROAM with, and how it measures every mode alike: a drawn triangle
-// mesh, the two comparators (a uniform grid and a CDLOD-like chunked quadtree, Strugar 2009) and
-// the error and popping measurement over the lattice vertices in view (SPEC.md, "Error").
+// The comparators `ridge report` and `ridge bench lod` measure ROAM against: a uniform grid and a
+// CDLOD-like chunked quadtree (Strugar 2009), as drawn meshes (ridgeline/mesh_error.h), and a
+// watertightness check for any drawn mesh.
 //
 // These live with the tool, not in Ridgeline::terrain: they exist to be measured against, not to
 // be embedded. Everything here depends on the core library only (no image libraries), so the
@@ -16,81 +16,17 @@
 #include <vector>
 
 #include "ridgeline/camera.h"
-#include "ridgeline/roam_view.h"
+#include "ridgeline/mesh_error.h"
 #include "ridgeline/terrain.h"
 
 namespace ridgeline::report {
 
-/// A drawn mesh: triangles as vertex triples (u, y, v), u and v in lattice units of the stored
-/// heightfield (x = origin_x + u * spacing_x, z likewise), y the world height in metres. Any
-/// winding; degenerate triangles are allowed (and ignored by the measurement).
-struct DrawnMesh {
-  std::vector<glm::dvec3> corners;  ///< 3 per triangle
-  std::size_t triangles() const noexcept { return corners.size() / 3; }
-};
+using ridgeline::DrawnMesh;
 
-/// World height of the surface (SPEC.md: piecewise linear over the diagonal rule) at lattice
-/// coordinates (u, v), clamped into [0, W-1] x [0, H-1]. Exact sample heights at integer (u, v).
+/// World height of the surface (piecewise linear over the diagonal rule, docs/surface.md) at
+/// lattice coordinates (u, v), clamped into [0, W-1] x [0, H-1]. Exact sample heights at integer
+/// (u, v).
 double surface_height(const Heightfield& hf, double u, double v);
-
-/// The camera's frustum as SPEC.md measures with it (RoamView::measure_error uses the same):
-/// in front of the eye, inside the four side planes, within `far` of the eye (no near plane).
-struct ViewFrustum {
-  explicit ViewFrustum(const Camera& camera);
-  /// True when world point `p` is inside; `*distance` receives |p - eye|.
-  bool contains(const glm::dvec3& p, double* distance) const;
-  /// False only when the box [lo, hi] (world) is certainly outside (conservative).
-  bool may_intersect(const glm::dvec3& lo, const glm::dvec3& hi) const;
-  glm::dvec3 eye, forward, right, up;
-  double tan_v, tan_h, far_m, scale;  ///< scale: projection_scale(camera), pixels per metre at 1 m
-};
-
-/// Displayed height of every measured lattice vertex (every stride-th along each axis, starting
-/// at 0: a fixed stratified sample when stride > 1), NaN where no triangle covers it. A vertex on
-/// a shared edge takes the first triangle's value (identical on a crack-free mesh).
-class DisplayedHeights {
- public:
-  DisplayedHeights(const Heightfield& hf, std::uint32_t stride);
-  void rasterize(const DrawnMesh& mesh);
-  const std::vector<float>& heights() const noexcept { return h_; }
-  std::uint32_t columns() const noexcept { return nx_; }
-  std::uint32_t rows() const noexcept { return nz_; }
-  std::uint32_t stride() const noexcept { return stride_; }
-
- private:
-  const Heightfield* hf_;
-  std::uint32_t stride_, nx_, nz_;
-  std::vector<float> h_;
-};
-
-/// SPEC.md's measured error of a displayed mesh over the measured vertices in the frustum.
-struct MeshError {
-  double max_m = 0, rms_m = 0;    ///< metres
-  double max_px = 0, p99_px = 0;  ///< projected at each vertex's own distance
-  std::uint64_t vertices = 0;     ///< measured vertices in the frustum
-  std::uint64_t uncovered = 0;    ///< of those, vertices no triangle covers (holes; 0 expected)
-};
-MeshError measure(const Heightfield& hf, const DisplayedHeights& shown, const Camera& camera);
-
-/// Popping: the largest change of the displayed height at one measured vertex between two
-/// displayed meshes (the previous and the current frame), projected in pixels at the vertex's
-/// distance in `camera` (the current frame), over the vertices inside both frames' frustums
-/// (a vertex that was out of view cannot visibly pop when it comes into view).
-double popping_px(const Heightfield& hf, const DisplayedHeights& before,
-                  const Camera& before_camera, const DisplayedHeights& now, const Camera& camera);
-
-/// The ROAM view's mesh as drawn: its patch meshes, geomorphed for `camera` when `morph` (the
-/// vertex shader's job: y + (1 - t) * morph_dy, t = morph_factor(...)).
-DrawnMesh roam_mesh(RoamView& view, const Camera& camera, bool morph);
-/// The same in lattice units of `lattice` (same origin as the view's terrain): with procedural
-/// detail, the finest lattice as a heightfield (the stored one's spacing / 2^L).
-DrawnMesh roam_mesh(RoamView& view, const Heightfield& lattice, const Camera& camera, bool morph);
-/// The view's leaves as drawn without geomorphs, straight from the bintree (RoamView::
-/// for_each_leaf) with the vertex heights of `lattice` (its vertices are the view's lattice
-/// vertices; padding repeats the edge samples). The same triangles as roam_mesh(..., false)
-/// without building patch meshes (whose normals cost several full-detail height queries per
-/// vertex on a detail terrain).
-DrawnMesh roam_leaves(const RoamView& view, const Heightfield& lattice);
 
 // ---- uniform grid -----------------------------------------------------------------------
 
@@ -177,9 +113,9 @@ class Cdlod {
   void compute_min_r0();
   void box(std::uint32_t level, std::int64_t i0, std::int64_t j0, glm::dvec3* lo,
            glm::dvec3* hi) const;
-  bool select_node(std::uint32_t level, std::int64_t i0, std::int64_t j0, const ViewFrustum& f,
+  bool select_node(std::uint32_t level, std::int64_t i0, std::int64_t j0, const Frustum& f,
                    const std::vector<double>& range, bool cull, Selection& out) const;
-  void emit_quadrant(const Chunk& c, int q, const ViewFrustum& f, bool morph,
+  void emit_quadrant(const Chunk& c, int q, const Frustum& f, bool morph,
                      const std::vector<double>& range, DrawnMesh& out) const;
 
   const Heightfield* hf_;

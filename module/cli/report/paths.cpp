@@ -18,8 +18,7 @@ std::vector<NamedPath> make_paths(const Terrain& terrain, int frames) {
     z = std::clamp(z, hf.origin_z(), hf.origin_z() + ez);
     return terrain.height(x, z).value_or(top);
   };
-  auto cam = [&](glm::dvec3 eye, glm::dvec3 target, double fov = 60,
-                 glm::dvec3 up = {0, 1, 0}) {
+  auto cam = [&](glm::dvec3 eye, glm::dvec3 target, double fov = 60, glm::dvec3 up = {0, 1, 0}) {
     Camera c;
     c.eye = eye;
     c.target = target;

@@ -185,6 +185,16 @@ class DetailField {
                             std::int64_t j0, std::int64_t i1, std::int64_t j1) const noexcept;
   /// The same bound over the whole (infinite) lattice.
   double contribution_bound(std::uint32_t from_level) const noexcept;
+  /// The two factors of contribution_bound(): it equals (amplitude_sum(from_level) *
+  /// shape_max_q15(level, i0, j0, i1, j1) / 32768 + rounding_terms(from_level)) * kDetailUnit.
+  /// What a caller needs that combines the bound of several levels over one rectangle (the
+  /// tessellator's morph bounds) without recomputing the shape maximum for each.
+  std::int64_t amplitude_sum(std::uint32_t from_level) const noexcept;
+  std::int64_t rounding_terms(std::uint32_t from_level) const noexcept;
+  /// Largest shape value (Q15: 32768 = 1) that reaches the rectangle, as contribution_bound uses
+  /// it; 0 for an empty rectangle.
+  std::uint32_t shape_max_q15(std::uint32_t level, std::int64_t i0, std::int64_t j0,
+                              std::int64_t i1, std::int64_t j1) const noexcept;
 
   /// Shape field at level-`level` sample (i, j), in [0, 1] (fixed point 2^-15 internally).
   double shape(std::uint32_t level, std::int64_t i, std::int64_t j) const noexcept;
@@ -252,6 +262,8 @@ class DetailSnapshot {
   /// The tile, or null when it was not resident at that update(). Valid while the snapshot lives.
   const DetailTile* find(const DetailTileKey& key) const noexcept;
   std::size_t size() const noexcept { return tiles_.size(); }
+  /// Tile k of the snapshot, 0 <= k < size(), in no particular order (to list what arrived).
+  const DetailTile& tile(std::size_t k) const noexcept { return *tiles_[k]; }
 
  private:
   friend class DetailCache;

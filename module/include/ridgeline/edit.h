@@ -1,10 +1,10 @@
-// Runtime deformation (SPEC.md "Edits", docs/deformation.md): brushes, the edit transaction's
-// result and limits, and saving / loading the edit layer.
+// Runtime deformation (docs/deformation.md): brushes, the edit transaction's result and limits,
+// and saving / loading the edit layer.
 //
 // The transaction itself is Terrain::apply_edit() (terrain.h): it changes the heights, refreshes
-// the ray pyramid, the error bounds of every Landscape built on the terrain and the queues and
-// dirty patches of every RoamView on those landscapes, all inside the call, and returns the
-// changed region.
+// the ray pyramid, bumps the terrain's edit_version() and records the changed region in its
+// change log, all inside the call, and returns that region. Landscapes, views, physics and
+// engines learn of it by pulling Terrain::changes_since(); nothing is called back.
 #pragma once
 
 #include <cstdint>
@@ -17,7 +17,7 @@
 
 namespace ridgeline {
 
-/// The brushes of SPEC.md.
+/// The brushes (docs/deformation.md gives each one's formula).
 enum class Brush : std::uint8_t {
   kCrater,   ///< bowl of `depth` metres with a raised rim (`rim` x depth) out to 1.5 x radius
   kRaise,    ///< adds strength x depth metres at the centre, smooth falloff to 0 at the radius
@@ -31,7 +31,7 @@ const char* brush_name(Brush b) noexcept;
 /// The brush named `name`; empty for anything else.
 std::optional<Brush> parse_brush(std::string_view name) noexcept;
 
-/// One edit, the schema of SPEC.md (the same fields in JSON, Lua tables and the save file).
+/// One edit: the same fields in C++, JSON (edit_json.h), Lua tables and the save file.
 struct Edit {
   Brush brush = Brush::kCrater;
   double x = 0, z = 0;    ///< centre, world metres
@@ -40,9 +40,11 @@ struct Edit {
   double depth = 2;       ///< metres: crater depth (negative makes a mound), raise / lower amount
   double rim = 0.2;       ///< crater rim height as a fraction of depth, 0..1
   double height = 0;      ///< flatten: target world height, metres
-  /// Edits are deltas over base + detail, so detail shows through (SPEC.md). false is accepted
-  /// for the schema's sake and has no other effect in this version: the edit layer lives at the
-  /// stored resolution, below which procedural detail always rides on top (docs/deformation.md).
+  /// Edits are stored at the base spacing and procedural detail rides on top of them, so the
+  /// detail shows through an edited site (a flattened one included). false asks for the brush to
+  /// replace the detail under it: Terrain::apply_edit() refuses that on a terrain with detail
+  /// (an error saying so; nothing changes), and on a terrain without detail, where there is no
+  /// detail to replace, it is the same edit as true (docs/deformation.md, "keep_detail").
   bool keep_detail = true;
 };
 
@@ -75,9 +77,6 @@ struct EditResult {
   /// Some samples hit EditLimits' height range and were clamped (`samples_clamped` of them).
   bool clamped = false;
   std::size_t samples_clamped = 0;
-  /// Bound entries recomputed over all landscapes, view nodes refreshed over all views.
-  std::uint64_t bounds_updated = 0;
-  std::uint64_t view_nodes_updated = 0;
   bool empty() const noexcept { return samples_changed == 0; }
 };
 

@@ -1,5 +1,5 @@
-// Edits as JSON (SPEC.md "Edits"): {"edits": [{"brush": "crater", "x": .., "z": .., "radius": ..,
-// "depth": ..}, ...]}. Part of Ridgeline::io.
+// Edits as JSON (the schema of edit.h and docs/deformation.md): {"edits": [{"brush": "crater",
+// "x": .., "z": .., "radius": .., "depth": ..}, ...]}. Part of Ridgeline::io.
 #pragma once
 
 #include <string>

@@ -9,7 +9,6 @@
 namespace ridgeline::io {
 
 struct GltfExportOptions {
-  bool include_padding = false;  ///< also write triangles whose centre lies in the padding
   bool normals = true;           ///< write the smooth vertex normals
 };
 

@@ -4,8 +4,10 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "ridgeline/heightfield.h"
 #include "ridgeline/result.h"
@@ -29,6 +31,59 @@ struct LoadOptions {
   /// material id per sample; cell (i, j) takes the id of sample (i, j). Empty: no material layer.
   /// Used by every loader (image and raw).
   std::string materials_path;
+  /// Take the spacing from the file's own georeferencing (GeoTIFF tags, see FilePlacement) when
+  /// it has one, instead of `placement.spacing_x/z`. Off by default: the placement is used as
+  /// given. Tools set it when the user gave no spacing (`ridge`, `ridgeline.load`); a file
+  /// without usable tags keeps `placement`'s spacing (and a warning says why when it has tags
+  /// that cannot be used).
+  bool spacing_from_file = false;
+  /// The same for the origin; only projected files (metres) carry one.
+  bool origin_from_file = false;
+};
+
+/// Georeferencing read from a heightmap file (GeoTIFF: ModelPixelScale + ModelTiepoint or an
+/// axis-aligned ModelTransformation, and the GeoKeyDirectory's model type, raster type and
+/// units), converted to Ridgeline's placement. World x is easting and world z is -northing:
+/// image rows run south, and with x east and y up a right-handed frame has +z pointing south.
+///  - Projected files (GTModelTypeGeoKey 1) in metres, feet or US survey feet: spacing and
+///    origin in metres. The origin is the position of sample (0, 0): the centre of pixel (0, 0)
+///    for PixelIsArea files (the GeoTIFF default: the tie point is the pixel's corner), the tie
+///    point itself for PixelIsPoint files.
+///  - Geographic files (GTModelTypeGeoKey 2) in degrees: the pixel size in degrees converted to
+///    metres at the latitude of the raster's centre on the WGS 84 ellipsoid (other datums differ
+///    by less than 0.1 %); no origin (degrees give no metre position), so `has_origin` is false.
+///    The cells of such a grid are not square, and away from the centre latitude the true
+///    east-west size differs (by cos(latitude)); the conversion is for a local terrain.
+struct FilePlacement {
+  double spacing_x = 0;  ///< metres between samples along x (columns); finite, > 0
+  double spacing_z = 0;  ///< metres between samples along z (rows); finite, > 0
+  bool has_origin = false;
+  double origin_x = 0;      ///< world x of sample (0, 0), metres (easting); when has_origin
+  double origin_z = 0;      ///< world z of sample (0, 0), metres (-northing); when has_origin
+  bool geographic = false;  ///< spacing converted from degrees
+  /// One line for messages and reports: what the tags say and how they were converted, e.g.
+  /// "GeoTIFF geographic (EPSG 4326), 0.00833333 x 0.00833333 degree pixels = 599.9 x 926.9 m at
+  /// the centre latitude 49.817 N".
+  std::string description;
+};
+
+/// Fraction of filled (no-data or non-finite) samples above which the loaders log a warning
+/// (and LoadReport holds it): the filled area is invented terrain.
+inline constexpr double kFilledWarningFraction = 0.05;
+
+/// What a loader found and decided, for tools that report it (`ridge info`). Optional: pass a
+/// pointer to receive it.
+struct LoadReport {
+  /// The file's sample type as read: "uint8", "uint16", "int16", "uint32", "int32", "half",
+  /// "float", "double" (images), "u16" / "f32" (raw files).
+  std::string pixel_type;
+  /// The file's georeferencing when it has usable tags, whether or not it was used.
+  std::optional<FilePlacement> file_placement;
+  bool spacing_from_file = false;  ///< the heightfield's spacing came from file_placement
+  bool origin_from_file = false;   ///< the heightfield's origin came from file_placement
+  /// Every warning the loader logged (placement tags that cannot be used, a malformed no-data
+  /// tag, more than kFilledWarningFraction of the samples filled), without the file name prefix.
+  std::vector<std::string> warnings;
 };
 
 /// Loads a heightmap through OpenImageIO: 8- and 16-bit greyscale PNG, 16-bit and float TIFF,
@@ -39,7 +94,11 @@ struct LoadOptions {
 /// pixel is allocated, and only the chosen channel is read. Missing, truncated or corrupt files,
 /// unsupported formats and every bad value get a precise error naming the file; no-data and
 /// non-finite samples are handled by Heightfield::create (refused unless a fill policy is set).
-Result<Heightfield> load_image(const std::string& path, const LoadOptions& options);
+/// TIFF files are also read for GDAL's no-data tag (used when `placement.nodata` is not set)
+/// and for GeoTIFF placement (used as `spacing_from_file` and `origin_from_file` say).
+/// `report`, when not null, receives what was found and used.
+Result<Heightfield> load_image(const std::string& path, const LoadOptions& options,
+                               LoadReport* report = nullptr);
 
 /// Sample type of a headerless raw heightmap (little-endian).
 enum class RawType { kU16, kF32 };
@@ -53,11 +112,12 @@ struct RawFormat {
 /// Loads a headerless little-endian raw file of exactly width * height samples. The file size
 /// must match exactly (a truncated or oversized file is refused, naming both sizes).
 Result<Heightfield> load_raw(const std::string& path, const RawFormat& format,
-                             const LoadOptions& options);
+                             const LoadOptions& options, LoadReport* report = nullptr);
 
 /// Parses raw bytes already in memory (the part load_raw shares with the fuzzer).
 Result<Heightfield> parse_raw(std::span<const std::byte> bytes, const RawFormat& format,
-                              const LoadOptions& options, const std::string& name);
+                              const LoadOptions& options, const std::string& name,
+                              LoadReport* report = nullptr);
 
 /// Parses "u16" / "f32".
 Result<RawType> parse_raw_type(const std::string& text);
@@ -66,6 +126,6 @@ Result<RawType> parse_raw_type(const std::string& text);
 /// whatever its extension; otherwise ".raw"/".r16"/".r32" files are refused (they need a size)
 /// and anything else goes through load_image().
 Result<Heightfield> load_heightmap(const std::string& path, const LoadOptions& options,
-                                   const RawFormat* raw = nullptr);
+                                   const RawFormat* raw = nullptr, LoadReport* report = nullptr);
 
 }  // namespace ridgeline::io

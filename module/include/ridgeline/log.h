@@ -20,8 +20,14 @@ void set_log_sink(LogSinkFn sink, void* user = nullptr);
 /// Sends a message to the current sink.
 void log_message(LogLevel level, std::string_view message);
 
-/// Handler for failed RIDGELINE_ASSERTs (programmer errors). The default prints and aborts.
-/// An engine may install its own (break into the debugger, report, abort).
+/// Handler for programmer errors: failed RIDGELINE_ASSERTs (on in Debug and sanitizer builds)
+/// and, in every build, a misused Result (result.h: `value()` on an error, `error()` on a value).
+/// `expression` is the failed expression's text, or for a Result the misuse and the error's
+/// message ("Result::value() called on an error: heightmap 'a.png': no such file"); it is valid
+/// only during the call. The default prints "ridgeline: assertion failed: EXPRESSION (FILE:LINE)"
+/// to stderr and aborts. An engine may install its own (log, break into the debugger, throw in a
+/// test); if it returns, the process aborts. Set it at start-up, before other threads run;
+/// nullptr restores the default.
 using AssertHandlerFn = void (*)(const char* expression, const char* file, int line);
 void set_assert_handler(AssertHandlerFn handler);
 

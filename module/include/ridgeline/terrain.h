@@ -1,5 +1,6 @@
-// Terrain: shared, read-mostly terrain data (heightfield, ray hierarchy) and the physics queries on
-// the surface of surface.h.
+// Terrain: shared, read-mostly terrain data (heightfield, procedural detail, edits, ray hierarchy),
+// the physics queries on its surface (surface.h, docs/surface.md) and the change log through which
+// views, physics and engines learn what edits changed.
 #pragma once
 
 #include <cstdint>
@@ -27,9 +28,7 @@ struct DetailCacheDesc;
 struct Edit;
 struct EditLimits;
 struct EditResult;
-namespace detail {
-class EditListener;
-}
+class ChangeLog;
 
 /// Height, both normals and the material at a point of the surface.
 struct SurfaceSample {
@@ -68,14 +67,64 @@ struct Box {
   glm::dvec3 max{0};
 };
 
+/// An inclusive range of finest-lattice vertex indices, [i0, i1] x [j0, j1]: vertex (i, j) sits
+/// at world (origin_x + i * spacing_x / 2^L, origin_z + j * spacing_z / 2^L), L being
+/// Terrain::detail_levels() (the stored samples when L = 0). Empty when i1 < i0 or j1 < j0.
+struct LatticeRange {
+  std::int64_t i0 = 0, j0 = 0, i1 = -1, j1 = -1;
+  bool empty() const noexcept { return i1 < i0 || j1 < j0; }
+};
+
+/// What one edit (or one loaded edit state) changed: an entry of the terrain's change log.
+struct TerrainChange {
+  /// The Terrain::edit_version() this change produced (for a merged entry: the newest one).
+  std::uint64_t version = 0;
+  /// Where the surface changed, world metres: x and z span every finest-lattice cell touching a
+  /// changed vertex (the triangles whose shape or normals changed), clamped to the footprint;
+  /// y spans the surface over that region before and after the change. What an engine refreshes
+  /// its physics shape over and wakes the bodies in.
+  Box box;
+  /// The finest-lattice vertices whose height may have changed (every changed one is inside;
+  /// some inside may be unchanged), within the footprint: what a tessellator refreshes. An edit
+  /// of stored samples moves the interpolated detail-lattice vertices in the cells around them.
+  LatticeRange vertices;
+};
+
+/// The answer of Terrain::changes_since().
+struct TerrainChanges {
+  /// The terrain's edit_version() now: what to pass to the next changes_since() call.
+  std::uint64_t version = 0;
+  /// The changes after the version asked for, oldest first; or, when `trimmed`, a single entry
+  /// covering all of them. Empty when nothing changed.
+  std::vector<TerrainChange> changes;
+  /// The log no longer reaches back to the version asked for (more than kChangeLogCapacity
+  /// changes ago), or that version is not one this terrain had: `changes` holds one merged
+  /// entry covering everything that may differ (the whole footprint for an unknown version).
+  bool trimmed = false;
+  bool empty() const noexcept { return changes.empty(); }
+};
+
+/// Changes a Terrain's log holds one by one (about 90 bytes each). Older ones are merged into a
+/// single summary entry, so changes_since() always answers, with coarser boxes past this many.
+inline constexpr std::size_t kChangeLogCapacity = 1024;
+
 /// The terrain shared by every view and every physics query. Created once from a Heightfield;
 /// changed afterwards only by edits (apply_edit, load_edits in edit.h).
 ///
-/// Threading: every const method may run concurrently from any number of threads. An edit needs
-/// exclusive access, as in Jolt's HeightFieldShape: no query, Landscape or RoamView call on this
-/// terrain may run during apply_edit() or load_edits() (querying while modifying is a race). An
-/// engine whose physics thread must keep querying during edits queries a clone() (a snapshot)
-/// and swaps it after the edit.
+/// Edits are pulled, not pushed: every edit that changes the surface bumps edit_version() and
+/// records what it changed in a bounded change log; whoever caches something derived from the
+/// surface (a Landscape's bounds, a RoamView's mesh, a physics engine's shape, a game's sleeping
+/// bodies) keeps the version it has seen and asks changes_since(it) when it next runs, as Jolt's
+/// HeightFieldShape::SetHeights is followed by NotifyShapeChanged and waking the bodies in the
+/// box. Nothing is called back from inside an edit.
+///
+/// Threading: every const method may run concurrently from any number of threads. An edit
+/// (apply_edit(), load_edits(), set_edit_limits()) needs exclusive access, as in Jolt's
+/// HeightFieldShape: one thread edits, and no other call on this terrain, on a Landscape or
+/// RoamView built on it, or on its change log may run meanwhile (querying while modifying is a
+/// race). Between edits any number of threads may query, pull changes_since() and update views.
+/// An engine whose physics thread must keep querying during edits queries a clone() (a
+/// snapshot) and swaps it after the edit.
 ///
 /// Queries take world coordinates in double precision. Points outside the sampled area (including
 /// the padding that patches add), and NaN or infinite input, give an empty optional or no hit;
@@ -86,11 +135,11 @@ class Terrain {
   /// Builds the query acceleration structures (a max-height pyramid for rays). Never fails for a
   /// valid Heightfield.
   static std::shared_ptr<Terrain> create(Heightfield heightfield);
-  /// A terrain whose surface includes procedural detail (SPEC.md "The surface" with L =
-  /// detail.levels levels; docs/detail.md): every query, Landscape and RoamView then works on the
-  /// finest lattice (spacing / 2^L), whose vertex heights are base + detail. The terrain owns the
-  /// detail field and a tile cache made from `cache`; detail values come from the cache's tiles
-  /// when resident and from the direct evaluator otherwise (bit-identical). Fails, naming the
+  /// A terrain whose surface includes procedural detail with L = detail.levels levels
+  /// (docs/detail.md, docs/surface.md): every query, Landscape and RoamView then works on the
+  /// finest lattice (spacing / 2^L), whose vertex heights are base + detail (+ edits). The terrain
+  /// owns the detail field and a tile cache made from `cache`; detail values come from the cache's
+  /// tiles when resident and from the direct evaluator otherwise (bit-identical). Fails, naming the
   /// field, on invalid parameters. detail.levels == 0 gives a terrain without detail.
   static Result<std::shared_ptr<Terrain>> create(Heightfield heightfield, const DetailParams& detail,
                                                  const DetailCacheDesc& cache);
@@ -186,15 +235,15 @@ class Terrain {
   // ---- deformation (edit.h, docs/deformation.md) -------------------------------------------
 
   /// Applies one brush as one transaction: changes the heights (clamped to the edit limits),
-  /// refreshes the ray pyramid over the changed blocks, recomputes the error bounds of exactly
-  /// the bintree nodes of every attached Landscape whose triangles hold a changed sample
-  /// (bottom-up), and in every RoamView on those landscapes refreshes the nodes over the changed
-  /// region, requeues the queued ones with fresh priorities and marks the patches dirty. Queries
-  /// see the new surface when it returns. Cost follows the edited area (plus a rescan of the
-  /// top levels of the touched patches), never the terrain size.
+  /// refreshes the ray pyramid over the changed blocks, bumps edit_version() and records the
+  /// change in the log (changes_since()). Every query sees the new surface when it returns;
+  /// Landscapes and RoamViews catch up at their next sync() / update(). Cost follows the edited
+  /// area, never the terrain size.
   /// Errors (nothing changes): a field fails validate_edit(), the radius exceeds the terrain's
-  /// larger extent, or the area cap is exceeded with EditLimits::refuse_oversize. A brush wholly
-  /// outside the terrain is a no-op with an empty result. Exclusive access (see above).
+  /// larger extent, the area cap is exceeded with EditLimits::refuse_oversize, or keep_detail is
+  /// false on a terrain with detail (edit.h). A brush wholly outside the terrain, or one that
+  /// changes no height, is a no-op with an empty result (no version, no log entry). Exclusive
+  /// access (see above).
   Result<EditResult> apply_edit(const Edit& edit);
   /// Limits for later edits (validated: finite, area > 0, min < max; else an error and no change).
   Status set_edit_limits(const EditLimits& limits);
@@ -205,11 +254,29 @@ class Terrain {
   std::uint64_t base_hash() const noexcept { return base_hash_; }
   /// Hash of the current heights (base + edits): equal hashes, equal surfaces.
   std::uint64_t heights_hash() const noexcept { return heightfield_.content_hash(); }
-  /// Increases by one with every edit or load that changed something.
+  /// The surface's version: 0 as created, one more with every edit or load that changed a
+  /// height (one change-log entry each).
   std::uint64_t edit_version() const noexcept { return edit_version_; }
-  /// A deep copy (heights, ray pyramid, edit layer, limits), not attached to any Landscape: a
-  /// snapshot a physics thread can query while this terrain is being edited.
+  /// What changed after version `version` (an edit_version() value seen earlier), and the
+  /// current version. A consumer keeps `result.version` and asks again with it next time:
+  ///   auto c = terrain.changes_since(seen);  // nothing new: c.empty()
+  ///   for (const TerrainChange& ch : c.changes) refresh(ch.box);
+  ///   seen = c.version;
+  /// Within the last kChangeLogCapacity changes the answer lists them one by one; further back
+  /// it is one merged entry and `trimmed` (correct, coarser). A version above edit_version() is
+  /// not this terrain's: one entry covering the whole footprint, `trimmed`. Cost: O(entries
+  /// returned); allocates only when something changed. Any thread, concurrently with queries
+  /// and other pulls, never during an edit.
+  TerrainChanges changes_since(std::uint64_t version) const;
+  /// A deep copy (heights, ray pyramid, edit layer, limits, version and change log), not
+  /// attached to any Landscape: a snapshot a physics thread can query while this terrain is
+  /// being edited.
   std::shared_ptr<Terrain> clone() const;
+
+  /// Checks the query structures against the surface: the ray pyramid equals, node by node, one
+  /// rebuilt from the current heights. Returns an empty string when it holds, else the first
+  /// difference. O(samples): for tests and debugging after edits.
+  std::string check_invariants() const;
 
   /// Bytes held: heights, materials, ray hierarchy.
   std::size_t memory_bytes() const noexcept;
@@ -223,6 +290,7 @@ class Terrain {
   Heightfield heightfield_;
   std::unique_ptr<RayHierarchy> rays_;
   std::unique_ptr<EditLayer> edits_;
+  std::unique_ptr<ChangeLog> log_;
   std::uint64_t base_hash_ = 0;
   std::uint64_t edit_version_ = 0;
   std::uint32_t detail_levels_ = 0;
@@ -239,15 +307,9 @@ class Terrain {
   // Cached for the query fast path.
   double inv_spacing_x_ = 1, inv_spacing_z_ = 1;
 
-  // Landscapes register here to hear of edits (internal; Landscape and edit.cpp only).
-  friend class Landscape;
-  friend class EditLayer;
+  // The edit file's reader and writer (edit.cpp) reach the edit layer and the transaction.
   friend Result<EditResult> load_edits_from_memory(Terrain&, std::string_view);
   friend Status save_edits(const Terrain&, const std::string&);
-  void add_listener(detail::EditListener* l) const;
-  void remove_listener(detail::EditListener* l) const;
-  struct Listeners;
-  std::unique_ptr<Listeners> listeners_;
 };
 
 }  // namespace ridgeline

@@ -1,4 +1,4 @@
-// Camera path JSON (SPEC.md, PATH.json version 1), parsed with nlohmann-json.
+// Camera path JSON (PATH.json version 1, docs/cli.md "Camera paths"), parsed with nlohmann-json.
 #include "ridgeline/camera_path.h"
 
 #include <cmath>

@@ -33,6 +33,17 @@ int add_view(tinygltf::Model& model, const void* data, std::size_t bytes, int ta
 
 Status write_glb(RoamView& view, const std::string& path, const GltfExportOptions& options) {
   if (path.empty()) return Error{"glTF export: empty output path"};
+  {  // A missing folder is named as such (the writer would only fail at the rename).
+    const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+    std::error_code ec;
+    const auto type = std::filesystem::status(folder, ec).type();
+    if (!folder.empty() && type == std::filesystem::file_type::not_found)
+      return Error{fmt("glTF export '%s': the folder '%s' does not exist", path.c_str(),
+                       folder.string().c_str())};
+    if (!folder.empty() && !ec && type != std::filesystem::file_type::directory)
+      return Error{
+          fmt("glTF export '%s': '%s' is not a folder", path.c_str(), folder.string().c_str())};
+  }
   tinygltf::Model model;
   model.asset.version = "2.0";
   model.asset.generator = "Ridgeline";
@@ -48,8 +59,10 @@ Status write_glb(RoamView& view, const std::string& path, const GltfExportOption
     nrm.clear();
     idx.clear();
     remap.assign(pm.vertices.size(), std::numeric_limits<std::uint32_t>::max());
-    for (std::size_t t = 0; t < pm.padding.size(); ++t) {
-      if (pm.padding[t] && !options.include_padding) continue;
+    for (std::size_t t = 0; 3 * t + 2 < pm.indices.size(); ++t) {
+      // Unused slots and triangles over the padding are degenerate (0, 0, 0): the mesh ends on
+      // the border of the sampled data.
+      if (pm.indices[3 * t] == pm.indices[3 * t + 1]) continue;
       for (int k = 0; k < 3; ++k) {
         const std::uint32_t v = pm.indices[3 * t + k];
         if (remap[v] == std::numeric_limits<std::uint32_t>::max()) {
@@ -117,11 +130,13 @@ Status write_glb(RoamView& view, const std::string& path, const GltfExportOption
 
   const std::string tmp = path + ".tmp";
   tinygltf::TinyGLTF writer;
-  if (!writer.WriteGltfSceneToFile(&model, tmp, true, true, false, true)) {
-    std::remove(tmp.c_str());
-    return Error{fmt("glTF export '%s': cannot write", path.c_str())};
-  }
   std::error_code ec;
+  // tinygltf reports success for some failed writes: check that the file is there.
+  if (!writer.WriteGltfSceneToFile(&model, tmp, true, true, false, true) ||
+      std::filesystem::file_size(tmp, ec) == 0 || ec) {
+    std::remove(tmp.c_str());
+    return Error{fmt("glTF export '%s': cannot write '%s'", path.c_str(), tmp.c_str())};
+  }
   std::filesystem::rename(tmp, path, ec);
   if (ec) {
     std::remove(tmp.c_str());

@@ -11,6 +11,7 @@
 #include <memory>
 
 #include "format.h"
+#include "io/geotiff.h"
 #include "io/loader_common.h"
 #include "io/tiff_tags.h"
 #include "ridgeline/log.h"
@@ -31,6 +32,11 @@ Status check_regular_file(const std::string& path, const std::string& name) {
   if (st.type() == std::filesystem::file_type::directory) return Error{name + ": is a directory"};
   if (st.type() != std::filesystem::file_type::regular) return Error{name + ": not a regular file"};
   return {};
+}
+
+void warn(const std::string& name, const std::string& what, LoadReport* report) {
+  log_message(LogLevel::kWarning, name + ": " + what);
+  if (report != nullptr) report->warnings.push_back(what);
 }
 
 }  // namespace detail
@@ -145,23 +151,46 @@ Status read_values(ImageInput& in, int c, std::vector<float>& values, const std:
   }
 }
 
+/// The sample type's name as LoadReport gives it.
+std::string pixel_type_name(TypeDesc t) {
+  switch (t.basetype) {
+    case TypeDesc::UINT8:
+      return "uint8";
+    case TypeDesc::INT8:
+      return "int8";
+    case TypeDesc::UINT16:
+      return "uint16";
+    case TypeDesc::INT16:
+      return "int16";
+    case TypeDesc::UINT32:
+      return "uint32";
+    case TypeDesc::INT32:
+      return "int32";
+    case TypeDesc::HALF:
+      return "half";
+    case TypeDesc::FLOAT:
+      return "float";
+    case TypeDesc::DOUBLE:
+      return "double";
+    default:
+      return t.c_str();
+  }
+}
+
 /// TIFF files from GDAL carry their no-data value in tag 42113 (GDAL_NODATA), which
 /// OpenImageIO does not expose: read it (tiff_tags.h) and use it when the caller gave none.
-void apply_file_nodata(const std::string& path, const std::string& name, ImageInput& in,
-                       HeightfieldDesc& desc) {
-  if (std::string(in.format_name()) != "tiff") return;
-  auto tag = detail::read_gdal_nodata_file(path);
+void apply_file_nodata(const std::string& name, const std::vector<detail::TiffTag>& tags,
+                       HeightfieldDesc& desc, LoadReport* report) {
+  auto tag = detail::gdal_nodata_text(tags);
   if (!tag) {
-    log_message(LogLevel::kWarning,
-                fmt("%s: GDAL_NODATA tag ignored: %s", name.c_str(), tag.error().message.c_str()));
+    detail::warn(name, "GDAL_NODATA tag ignored: " + tag.error().message, report);
     return;
   }
   if (!*tag) return;
   const std::string& text = **tag;
   const auto v = detail::parse_nodata_text(text);
   if (!v) {
-    log_message(LogLevel::kWarning, fmt("%s: GDAL_NODATA tag '%s' is not a number; ignored",
-                                        name.c_str(), text.c_str()));
+    detail::warn(name, "GDAL_NODATA tag '" + text + "' is not a number; ignored", report);
     return;
   }
   if (desc.nodata) {
@@ -184,6 +213,64 @@ void apply_file_nodata(const std::string& path, const std::string& name, ImageIn
               fmt("%s: no-data value %s from the file's GDAL_NODATA tag (samples equal to it are "
                   "refused unless a fill policy is given)",
                   name.c_str(), num(*v).c_str()));
+}
+
+/// GeoTIFF placement (geotiff.h): spacing and origin from the file where the options allow it.
+void apply_file_placement(const std::string& name, const std::vector<detail::TiffTag>& tags,
+                          const LoadOptions& options, HeightfieldDesc& desc, LoadReport* report) {
+  const detail::GeoTiffPlacement geo = detail::geotiff_placement(tags, desc.height);
+  if (!geo.problem.empty()) {
+    detail::warn(name,
+                 "GeoTIFF placement ignored: " + geo.problem +
+                     fmt("; spacing stays %.10g x %.10g m", desc.spacing_x, desc.spacing_z),
+                 report);
+    return;
+  }
+  if (!geo.placement) return;
+  const FilePlacement& p = *geo.placement;
+  if (report != nullptr) report->file_placement = p;
+  const bool spacing = options.spacing_from_file;
+  const bool origin = options.origin_from_file && p.has_origin;
+  if (spacing) desc.spacing_x = p.spacing_x, desc.spacing_z = p.spacing_z;
+  if (origin) desc.origin_x = p.origin_x, desc.origin_z = p.origin_z;
+  if (report != nullptr) report->spacing_from_file = spacing, report->origin_from_file = origin;
+  const std::string given_spacing = fmt("%.10g x %.10g m", desc.spacing_x, desc.spacing_z);
+  const std::string given_origin = fmt("%.10g, %.10g", desc.origin_x, desc.origin_z);
+  std::string what;
+  if (spacing && origin)
+    what = "spacing and origin taken from the file";
+  else if (spacing && !p.has_origin)
+    what = "spacing taken from the file; origin stays " + given_origin +
+           " (degrees give no origin in metres)";
+  else if (spacing)
+    what = "spacing taken from the file; the given origin " + given_origin + " is used";
+  else if (origin)
+    what = "origin taken from the file; the given spacing " + given_spacing + " is used";
+  else
+    what = "not used: the given spacing " + given_spacing + " and origin " + given_origin +
+           " are used";
+  log_message(LogLevel::kInfo, name + ": " + p.description + "; " + what);
+}
+
+/// The tags the image loader reads from TIFF files: no-data and placement.
+constexpr std::uint16_t kLoaderTags[] = {
+    detail::kTagGdalNodata,          detail::kTagModelPixelScale, detail::kTagModelTiepoint,
+    detail::kTagModelTransformation, detail::kTagGeoKeyDirectory, detail::kTagGeoDoubleParams};
+
+/// Reads the TIFF tags OpenImageIO drops and applies them to `desc`.
+Status apply_tiff_tags(const std::string& path, const std::string& name, ImageInput& in,
+                       const LoadOptions& options, HeightfieldDesc& desc, LoadReport* report) {
+  if (std::string(in.format_name()) != "tiff") return {};
+  auto tags = detail::read_tiff_tags_file(path, kLoaderTags, detail::kMaxTagValues);
+  if (!tags) {
+    detail::warn(name, "TIFF tags (GDAL_NODATA, GeoTIFF) ignored: " + tags.error().message, report);
+    return {};
+  }
+  if (!*tags) return {};
+  apply_file_nodata(name, **tags, desc, report);
+  apply_file_placement(name, **tags, options, desc, report);
+  // The file's placement passes the same checks as the caller's (extent, finite origin).
+  return validate_heightfield_desc(desc);
 }
 
 }  // namespace
@@ -213,15 +300,27 @@ Result<std::vector<std::uint8_t>> load_material_ids(const LoadOptions& options, 
 }
 
 Result<Heightfield> finish_heightfield(const HeightfieldDesc& desc, std::span<const float> values,
-                                       const LoadOptions& options) {
+                                       const LoadOptions& options, LoadReport* report) {
   auto ids = load_material_ids(options, desc.width, desc.height);
   if (!ids) return ids.error();
-  return Heightfield::create(desc, values, *ids);
+  auto hf = Heightfield::create(desc, values, *ids);
+  if (!hf) return hf;
+  const double samples = double(hf->width()) * double(hf->height());
+  const double fraction = double(hf->filled_samples()) / samples;
+  if (fraction > kFilledWarningFraction)
+    warn(desc.name,
+         fmt("%llu of %.0f samples (%.1f %%) are filled from no-data by the %s fill policy: that "
+             "part of the terrain is invented, not measured",
+             static_cast<unsigned long long>(hf->filled_samples()), samples, 100.0 * fraction,
+             desc.fill == FillPolicy::kNearest ? "nearest" : "constant"),
+         report);
+  return hf;
 }
 
 }  // namespace detail
 
-Result<Heightfield> load_image(const std::string& path, const LoadOptions& options) {
+Result<Heightfield> load_image(const std::string& path, const LoadOptions& options,
+                               LoadReport* report) {
   const std::string name = detail::heightmap_name(path);
   auto img = open_image(path, name);
   if (!img) return img.error();
@@ -255,17 +354,19 @@ Result<Heightfield> load_image(const std::string& path, const LoadOptions& optio
             name.c_str(), img->nchannels, channel_list(spec).c_str())};
   }
 
-  apply_file_nodata(path, name, *img->input, desc);
+  if (report != nullptr) report->pixel_type = pixel_type_name(spec.channelformat(channel));
+  if (auto s = apply_tiff_tags(path, name, *img->input, options, desc, report); !s)
+    return Error{s.message()};
 
   std::vector<float> values;
   if (auto s = read_values(*img->input, channel, values, name); !s) return Error{s.message()};
   img->input->close();
-  return detail::finish_heightfield(desc, values, options);
+  return detail::finish_heightfield(desc, values, options, report);
 }
 
 Result<Heightfield> load_heightmap(const std::string& path, const LoadOptions& options,
-                                   const RawFormat* raw) {
-  if (raw && raw->width != 0 && raw->height != 0) return load_raw(path, *raw, options);
+                                   const RawFormat* raw, LoadReport* report) {
+  if (raw && raw->width != 0 && raw->height != 0) return load_raw(path, *raw, options, report);
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
@@ -273,7 +374,7 @@ Result<Heightfield> load_heightmap(const std::string& path, const LoadOptions& o
     return Error{detail::heightmap_name(path) +
                  ": a headerless raw file needs its size and sample type (--raw-size W,H "
                  "--raw-type u16|f32)"};
-  return load_image(path, options);
+  return load_image(path, options, report);
 }
 
 }  // namespace ridgeline::io

@@ -22,7 +22,12 @@ Result<std::vector<std::uint8_t>> load_material_ids(const LoadOptions& options, 
                                                     std::uint32_t height);
 
 /// Loads the material layer if any and builds the Heightfield from `desc` and raw `values`.
+/// Logs a warning (and adds it to `report`) when more than kFilledWarningFraction of the samples
+/// were filled.
 Result<Heightfield> finish_heightfield(const HeightfieldDesc& desc, std::span<const float> values,
-                                       const LoadOptions& options);
+                                       const LoadOptions& options, LoadReport* report);
+
+/// Logs a warning about `name` and records it (without the name) in `report` when not null.
+void warn(const std::string& name, const std::string& what, LoadReport* report);
 
 }  // namespace ridgeline::io::detail

@@ -48,7 +48,9 @@ Result<RawType> parse_raw_type(const std::string& text) {
 }
 
 Result<Heightfield> parse_raw(std::span<const std::byte> bytes, const RawFormat& format,
-                              const LoadOptions& options, const std::string& name) {
+                              const LoadOptions& options, const std::string& name,
+                              LoadReport* report) {
+  if (report != nullptr) report->pixel_type = type_name(format.type);
   const HeightfieldDesc desc = raw_desc(format, options, name);
   if (auto s = validate_heightfield_desc(desc); !s) return Error{s.message()};
   if (auto s = check_size(bytes.size(), format, name); !s) return Error{s.message()};
@@ -67,11 +69,11 @@ Result<Heightfield> parse_raw(std::span<const std::byte> bytes, const RawFormat&
       values[k] = std::bit_cast<float>(u);
     }
   }
-  return detail::finish_heightfield(desc, values, options);
+  return detail::finish_heightfield(desc, values, options, report);
 }
 
 Result<Heightfield> load_raw(const std::string& path, const RawFormat& format,
-                             const LoadOptions& options) {
+                             const LoadOptions& options, LoadReport* report) {
   const std::string name = detail::heightmap_name(path);
   if (auto s = detail::check_regular_file(path, name); !s) return Error{s.message()};
   // The cap and the file size are checked before reading a byte.
@@ -88,7 +90,7 @@ Result<Heightfield> load_raw(const std::string& path, const RawFormat& format,
   if (static_cast<std::uint64_t>(file.gcount()) != size)
     return Error{fmt("%s: read %lld of %llu bytes (file changed while reading?)", name.c_str(),
                      static_cast<long long>(file.gcount()), static_cast<unsigned long long>(size))};
-  return parse_raw(bytes, format, options, name);
+  return parse_raw(bytes, format, options, name, report);
 }
 
 }  // namespace ridgeline::io

@@ -24,7 +24,8 @@ namespace ridgeline::lua {
 ///   expected, got nil`;
 /// - `unknown field 'colour'` for a key of an option table that the function does not know.
 
-/// luaL_checknumber that also refuses NaN and infinities.
+/// A number argument: refuses every other type, strings that look like numbers included
+/// ("number expected, got string"), and NaN and infinities ("finite number expected, got nan").
 double check_finite(lua_State* L, int arg);
 /// Optional finite number: `def` when the argument is none or nil.
 double opt_finite(lua_State* L, int arg, double def);

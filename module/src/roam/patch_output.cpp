@@ -1,0 +1,173 @@
+// Per-patch buffers kept in step with the mesh, and the dirty slots an engine re-uploads.
+#include "roam/patch_output.h"
+
+#include <algorithm>
+#include <cfloat>
+#include <glm/geometric.hpp>
+
+#include "ridgeline/surface.h"
+#include "roam/diamond.h"
+
+namespace ridgeline::roam {
+
+
+void PatchOutput::reset(const Landscape& land) {
+  land_ = &land;
+  const std::uint32_t np = land.patch_count();
+  if (patches_.size() != np) patches_.assign(np, Patch{});
+  dirty_list_.clear();
+  const std::int64_t P = land.patch_cells();
+  for (std::uint32_t p = 0; p < np; ++p) {
+    Patch& pt = patches_[p];
+    const std::int64_t i0 = std::int64_t(p % land.patches_x()) * P;
+    const std::int64_t j0 = std::int64_t(p / land.patches_x()) * P;
+    pt.mesh.origin_x = land.world_x(i0);
+    pt.mesh.origin_z = land.world_z(j0);
+    pt.mesh.origin_y = land.terrain().heightfield().height_offset();
+    pt.mesh.vertices.clear();
+    pt.mesh.indices.clear();
+    pt.mesh.dirty_vertices.clear();
+    pt.mesh.dirty_triangles.clear();
+    pt.mesh.triangles = 0;
+    ++pt.mesh.version;
+    pt.free_tris.clear();
+    pt.free_verts.clear();
+    pt.tri_bits.clear();
+    pt.vert_bits.clear();
+    pt.hidden.clear();
+    pt.listed = false;
+    pt.grew = true;
+    pt.counted = false;
+    // Corners: slots 0 (0, 0), 1 (P, 0), 2 (0, P), 3 (P, P), never freed.
+    for (int c = 0; c < 4; ++c) add_vertex(p, i0 + (c & 1) * P, j0 + (c >> 1) * P);
+    // Root 0: apex (P, 0), left (0, 0), right (P, P); root 1: apex (0, P), left (P, P),
+    // right (0, 0) (landscape.h). Their slots are 0 and 1. A root over the padding is hidden.
+    const bool pad = i0 >= land.last_i() || j0 >= land.last_j();
+    add_triangle(p, {1, 0, 3}, pad);
+    add_triangle(p, {2, 3, 0}, pad);
+  }
+}
+
+void PatchOutput::write_vertex(std::uint32_t patch, std::uint32_t slot, std::int64_t i,
+                               std::int64_t j, const DiamondBound* bound) {
+  const Landscape& l = *land_;
+  Patch& p = patches_[patch];
+  const std::int64_t P = l.patch_cells();
+  const std::int64_t i0 = std::int64_t(patch % l.patches_x()) * P;
+  const std::int64_t j0 = std::int64_t(patch / l.patches_x()) * P;
+  const VertexShading sh = l.shading(i, j);
+  MeshVertex v;
+  v.x = static_cast<float>(double(i - i0) * l.spacing_x());
+  v.z = static_cast<float>(double(j - j0) * l.spacing_z());
+  v.y = l.lattice_height(i, j);
+  v.nx = sh.normal.x, v.ny = sh.normal.y, v.nz = sh.normal.z;
+  v.morph_dy = sh.morph_dy;
+  if (bound != nullptr) {
+    v.morph_bound = bound->morph;
+    v.morph_radius = bound->radius;
+  } else if (diamond_at(i, j, l.patch_log2()).corner) {
+    v.morph_bound = FLT_MAX;
+    v.morph_radius = 0.0f;
+  } else {
+    const DiamondBound b = l.diamond(i, j);
+    v.morph_bound = b.morph;
+    v.morph_radius = b.radius;
+  }
+  v.material = sh.material;
+  p.mesh.vertices[slot] = v;
+  mark(p.vert_bits, slot, sizeof(MeshVertex));
+}
+
+std::uint32_t PatchOutput::grow_vertices(Patch& p) {
+  const auto slot = std::uint32_t(p.mesh.vertices.size());
+  if (p.mesh.vertices.size() == p.mesh.vertices.capacity()) p.grew = true;
+  p.mesh.vertices.emplace_back();
+  if ((slot >> 6) >= p.vert_bits.size()) p.vert_bits.push_back(0);
+  return slot;
+}
+
+std::uint32_t PatchOutput::grow_triangles(Patch& p) {
+  const auto slot = std::uint32_t(p.mesh.indices.size() / 3);
+  if (p.mesh.indices.size() + 3 > p.mesh.indices.capacity()) p.grew = true;
+  p.mesh.indices.insert(p.mesh.indices.end(), 3, 0u);
+  if ((slot >> 6) >= p.tri_bits.size()) p.tri_bits.push_back(0);
+  return slot;
+}
+
+void PatchOutput::refresh_vertex(std::uint32_t patch, std::uint32_t slot) {
+  const auto c = coord(patch, slot);
+  write_vertex(patch, slot, c[0], c[1], nullptr);
+  touch(patch);
+}
+
+namespace {
+
+// Sorted, disjoint runs of the set bits (cleared as they are read).
+void to_ranges(std::vector<std::uint64_t>& bits, std::vector<MeshRange>& out) {
+  out.clear();
+  for (std::size_t w = 0; w < bits.size(); ++w) {
+    std::uint64_t b = bits[w];
+    bits[w] = 0;
+    while (b != 0) {
+      const auto s = std::uint32_t(w * 64 + std::size_t(__builtin_ctzll(b)));
+      b &= b - 1;
+      if (!out.empty() && out.back().first + out.back().count == s)
+        ++out.back().count;
+      else
+        out.push_back({s, 1});
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<std::uint32_t> PatchOutput::take_dirty() {
+  std::vector<std::uint32_t> out;
+  out.swap(dirty_list_);
+  std::sort(out.begin(), out.end());
+  for (std::uint32_t pi : out) {
+    Patch& p = patches_[pi];
+    p.listed = false;
+    p.mesh.resized = p.grew;
+    to_ranges(p.vert_bits, p.mesh.dirty_vertices);
+    to_ranges(p.tri_bits, p.mesh.dirty_triangles);
+    if (p.grew) {
+      p.mesh.dirty_vertices.assign(1, {0, std::uint32_t(p.mesh.vertices.size())});
+      p.mesh.dirty_triangles.assign(1, {0, std::uint32_t(p.mesh.indices.size() / 3)});
+    }
+    p.grew = false;
+    p.counted = false;
+  }
+  return out;
+}
+
+std::uint64_t PatchOutput::take_upload_bytes() {
+  // A patch whose buffers grew is uploaded whole.
+  for (std::uint32_t pi : dirty_list_) {
+    Patch& p = patches_[pi];
+    if (p.grew && !p.counted) {
+      upload_bytes_ += p.mesh.vertices.size() * sizeof(MeshVertex) +
+                       p.mesh.indices.size() * sizeof(std::uint32_t);
+      p.counted = true;
+    }
+  }
+  const std::uint64_t b = upload_bytes_;
+  upload_bytes_ = 0;
+  return b;
+}
+
+std::size_t PatchOutput::memory_bytes() const {
+  std::size_t b = patches_.capacity() * sizeof(Patch) + dirty_list_.capacity() * 4;
+  for (const Patch& p : patches_) {
+    b += p.mesh.vertices.capacity() * sizeof(MeshVertex) +
+         p.mesh.indices.capacity() * sizeof(std::uint32_t) +
+         (p.mesh.dirty_vertices.capacity() + p.mesh.dirty_triangles.capacity()) *
+             sizeof(MeshRange) +
+         (p.free_tris.capacity() + p.free_verts.capacity()) * 4 +
+         (p.tri_bits.capacity() + p.vert_bits.capacity()) * 8 +
+         p.hidden.size() * (sizeof(std::uint32_t) + 12 + 16) + p.hidden.bucket_count() * 8;
+  }
+  return b;
+}
+
+}  // namespace ridgeline::roam

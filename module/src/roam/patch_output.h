@@ -1,0 +1,169 @@
+// A RoamView's output: per-patch vertex and index buffers kept in step with the mesh, slot by
+// slot, so that a split or merge rewrites a few slots and an engine re-uploads only those.
+//
+// Nothing is stored beside what the engine draws but free-slot lists and dirty bits: a
+// triangle's corners are its indices (the few over the padding, drawn degenerate, keep theirs in
+// a side table), a vertex's lattice position follows from its patch-local x and z.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "ridgeline/landscape.h"
+#include "ridgeline/roam_view.h"
+
+namespace ridgeline::roam {
+
+class PatchOutput {
+ public:
+  /// Every patch back to its two root triangles over its four corner vertices.
+  void reset(const Landscape& land);
+
+  /// A vertex slot for finest-lattice vertex (i, j) in `patch`, its data written. `bound`, when
+  /// given, is the vertex's diamond bound (saves looking it up).
+  std::uint32_t add_vertex(std::uint32_t patch, std::int64_t i, std::int64_t j,
+                           const DiamondBound* bound = nullptr) {
+    Patch& p = patches_[patch];
+    std::uint32_t slot;
+    if (!p.free_verts.empty()) {
+      slot = p.free_verts.back();
+      p.free_verts.pop_back();
+    } else {
+      slot = grow_vertices(p);
+    }
+    write_vertex(patch, slot, i, j, bound);
+    touch(patch);
+    return slot;
+  }
+  void remove_vertex(std::uint32_t patch, std::uint32_t slot) {
+    Patch& p = patches_[patch];
+    p.mesh.vertices[slot].material = kFreeVertex;  // no upload: no index refers to it any more
+    p.free_verts.push_back(slot);
+  }
+  /// Rewrites a live vertex's data from the landscape (after an edit or a tile's arrival).
+  void refresh_vertex(std::uint32_t patch, std::uint32_t slot);
+
+  /// A triangle slot with corners (apex, left, right) as vertex slots; drawn unless `padding`.
+  std::uint32_t add_triangle(std::uint32_t patch, const std::array<std::uint32_t, 3>& corners,
+                             bool padding) {
+    Patch& p = patches_[patch];
+    std::uint32_t slot;
+    if (!p.free_tris.empty()) {
+      slot = p.free_tris.back();
+      p.free_tris.pop_back();
+    } else {
+      slot = grow_triangles(p);
+    }
+    write_triangle(p, slot, corners, padding);
+    return slot;
+  }
+  /// Rewrites the corners of a triangle slot in use.
+  void set_triangle(std::uint32_t patch, std::uint32_t slot,
+                    const std::array<std::uint32_t, 3>& corners, bool padding) {
+    Patch& p = patches_[patch];
+    std::uint32_t* ix = &p.mesh.indices[std::size_t(slot) * 3];
+    if (ix[0] != ix[1]) {
+      --p.mesh.triangles;
+    } else {
+      p.hidden.erase(slot);
+    }
+    write_triangle(p, slot, corners, padding);
+  }
+  void remove_triangle(std::uint32_t patch, std::uint32_t slot) {
+    Patch& p = patches_[patch];
+    std::uint32_t* ix = &p.mesh.indices[std::size_t(slot) * 3];
+    if (ix[0] != ix[1])
+      --p.mesh.triangles;
+    else
+      p.hidden.erase(slot);
+    ix[0] = ix[1] = ix[2] = 0;
+    p.free_tris.push_back(slot);
+    mark(p.tri_bits, slot, 3 * sizeof(std::uint32_t));
+    touch(patch);
+  }
+
+  /// The corners (apex, left, right) of a triangle slot in use.
+  std::array<std::uint32_t, 3> corners(std::uint32_t patch, std::uint32_t slot) const {
+    const Patch& p = patches_[patch];
+    const std::uint32_t* ix = &p.mesh.indices[std::size_t(slot) * 3];
+    if (ix[0] != ix[1]) return {ix[0], ix[1], ix[2]};
+    return p.hidden.at(slot);
+  }
+  /// Finest-lattice position of a vertex slot (from its patch-local x and z).
+  std::array<std::int64_t, 2> coord(std::uint32_t patch, std::uint32_t slot) const {
+    const MeshVertex& v = patches_[patch].mesh.vertices[slot];
+    const std::int64_t P = land_->patch_cells();
+    return {std::int64_t(patch % land_->patches_x()) * P +
+                std::llround(double(v.x) / land_->spacing_x()),
+            std::int64_t(patch / land_->patches_x()) * P +
+                std::llround(double(v.z) / land_->spacing_z())};
+  }
+  std::uint32_t vertex_slots(std::uint32_t patch) const {
+    return std::uint32_t(patches_[patch].mesh.vertices.size());
+  }
+  bool vertex_live(std::uint32_t patch, std::uint32_t slot) const {
+    return patches_[patch].mesh.vertices[slot].material != kFreeVertex;
+  }
+
+  const PatchMesh& mesh(std::uint32_t patch) const { return patches_[patch].mesh; }
+  std::uint32_t patch_count() const { return std::uint32_t(patches_.size()); }
+
+  /// Patches changed since the last call, ascending, with their dirty ranges filled in.
+  std::vector<std::uint32_t> take_dirty();
+  /// Bytes changed since the last call to this function (dirty slots, whole resized buffers).
+  std::uint64_t take_upload_bytes();
+  std::uint32_t dirty_patch_count() const { return std::uint32_t(dirty_list_.size()); }
+  std::size_t memory_bytes() const;
+
+ private:
+  static constexpr std::uint32_t kFreeVertex = 0xffffffffu;  // MeshVertex::material of a free slot
+  struct Patch {
+    PatchMesh mesh;
+    std::vector<std::uint32_t> free_tris, free_verts;
+    std::vector<std::uint64_t> tri_bits, vert_bits;  // slots changed since the last take
+    // Corners of the triangles over the padding (their indices are degenerate).
+    std::unordered_map<std::uint32_t, std::array<std::uint32_t, 3>> hidden;
+    bool listed = false, grew = false, counted = false;
+  };
+  void touch(std::uint32_t patch) {
+    Patch& p = patches_[patch];
+    ++p.mesh.version;
+    if (!p.listed) {
+      p.listed = true;
+      dirty_list_.push_back(patch);
+    }
+  }
+  void mark(std::vector<std::uint64_t>& bits, std::uint32_t slot, std::uint32_t bytes) {
+    std::uint64_t& w = bits[slot >> 6];
+    const std::uint64_t b = std::uint64_t{1} << (slot & 63);
+    if (!(w & b)) upload_bytes_ += bytes;
+    w |= b;
+  }
+  void write_triangle(Patch& p, std::uint32_t slot, const std::array<std::uint32_t, 3>& corners,
+                      bool padding) {
+    std::uint32_t* ix = &p.mesh.indices[std::size_t(slot) * 3];
+    if (padding) {
+      ix[0] = ix[1] = ix[2] = 0;
+      p.hidden[slot] = corners;
+    } else {
+      ix[0] = corners[0], ix[1] = corners[1], ix[2] = corners[2];
+      ++p.mesh.triangles;
+    }
+    mark(p.tri_bits, slot, 3 * sizeof(std::uint32_t));
+    touch(std::uint32_t(&p - patches_.data()));
+  }
+  void write_vertex(std::uint32_t patch, std::uint32_t slot, std::int64_t i, std::int64_t j,
+                    const DiamondBound* bound);
+  std::uint32_t grow_vertices(Patch& p);
+  std::uint32_t grow_triangles(Patch& p);
+
+  const Landscape* land_ = nullptr;
+  std::vector<Patch> patches_;
+  std::vector<std::uint32_t> dirty_list_;
+  std::uint64_t upload_bytes_ = 0;
+};
+
+}  // namespace ridgeline::roam

@@ -1,0 +1,522 @@
+// Frame-coherent ROAM (Duchaineau et al. 1997) driven by a front that is tested in full every
+// update: the update's phases.
+//
+//   1. pull edits (Landscape::changes_since) and tile arrivals: refresh the diamonds they reach
+//   2. test the front: one vectorised pass over every diamond that could split or merge
+//   3. merge the split diamonds whose test failed, split the unsplit ones whose test passed,
+//      and test each diamond that appears on the way (so one update goes as deep as it must)
+//   4. under a triangle cap or a time budget, 3 goes in priority order instead: the dual split
+//      and merge queues of D97 section 5, over the candidates of this update only
+//
+// With nested bounds and spheres (landscape.h) a diamond's test never passes when a parent's
+// fails, so the converged mesh is the unique one the threshold asks for, whatever the camera's
+// history: the same as a rebuild from the roots (RoamMode::kRebuild) and, for the same bounds,
+// as Lindstrom & Pascucci's stateless SOAR refinement.
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <unordered_set>
+
+#include "format.h"
+#include "ridgeline/detail.h"
+#include "ridgeline/log.h"
+#include "roam/view_impl.h"
+
+namespace ridgeline {
+
+using namespace roam;
+using detail::fmt;
+using detail::num;
+
+const char* stop_reason_name(StopReason r) noexcept {
+  switch (r) {
+    case StopReason::kConverged: return "converged";
+    case StopReason::kTriangleBudget: return "triangle_budget";
+    case StopReason::kTimeBudget: return "time_budget";
+  }
+  return "converged";
+}
+
+float morph_factor(const MeshVertex& v, const glm::vec3& eye, double projection_scale,
+                   double threshold_px, double morph_window) noexcept {
+  if (!(morph_window > 0.0) || !(threshold_px > 0.0)) return 1.0f;
+  const double dx = double(v.x) - eye.x, dy = double(v.y) - eye.y, dz = double(v.z) - eye.z;
+  const double d = std::sqrt(dx * dx + dy * dy + dz * dz) - double(v.morph_radius);
+  const double rho = double(v.morph_bound) * projection_scale / (threshold_px * std::max(d, 1e-6));
+  return static_cast<float>(std::clamp((rho - 1.0) / morph_window, 0.0, 1.0));
+}
+
+float morphed_height(const MeshVertex& v, const glm::vec3& eye, double projection_scale,
+                     double threshold_px, double morph_window) noexcept {
+  return v.y + (1.0f - morph_factor(v, eye, projection_scale, threshold_px, morph_window)) *
+                   v.morph_dy;
+}
+
+// ---- creation and settings --------------------------------------------------------------------
+
+Result<std::unique_ptr<RoamView>> RoamView::create(std::shared_ptr<const Landscape> landscape,
+                                                   const RoamSettings& settings) {
+  if (!landscape) return Error{"roam view: no landscape given"};
+  std::unique_ptr<RoamView> v(new RoamView());
+  v->landscape_ = std::move(landscape);
+  v->impl_ = std::make_unique<Impl>(*v->landscape_);
+  if (auto s = v->set_settings(settings); !s) return Error{s.message()};
+  v->impl_->reset();
+  v->impl_->synced_version = v->landscape_->version();
+  return v;
+}
+
+RoamView::~RoamView() = default;
+
+std::uint32_t RoamView::triangle_count() const noexcept { return impl_->triangles; }
+
+Status RoamView::set_settings(const RoamSettings& s) {
+  if (!std::isfinite(s.threshold) || s.threshold < 0.0)
+    return Error{
+        fmt("roam view: threshold %s; need a finite value >= 0", num(s.threshold).c_str())};
+  if (!std::isfinite(s.budget_ms) || s.budget_ms < 0.0)
+    return Error{
+        fmt("roam view: time budget %s ms; need a finite value >= 0", num(s.budget_ms).c_str())};
+  if (s.max_triangles != 0 && s.max_triangles < landscape_->root_count())
+    return Error{fmt("roam view: triangle budget %u is below the %u root triangles",
+                     s.max_triangles, landscape_->root_count())};
+  if (impl_ && (s.mode != settings_.mode || s.metric != settings_.metric))
+    impl_->reset_pending = true;
+  settings_ = s;
+  return {};
+}
+
+Result<RoamStats> RoamView::converge(const Camera& camera) {
+  const RoamSettings saved = settings_;
+  RoamSettings s = settings_;
+  s.budget_ms = 0;
+  (void)set_settings(s);
+  auto r = update(camera);
+  (void)set_settings(saved);
+  return r;
+}
+
+std::vector<std::uint32_t> RoamView::take_dirty_patches() { return impl_->out.take_dirty(); }
+
+const PatchMesh& RoamView::patch_mesh(std::uint32_t patch) const {
+  RIDGELINE_ASSERT(patch < landscape_->patch_count());
+  return impl_->out.mesh(std::min(patch, landscape_->patch_count() - 1));
+}
+
+// ---- phase 1: edits and tiles -------------------------------------------------------------------
+
+namespace {
+
+// True when the box of lattice cells [i0, i1] x [j0, j1], widened by `grow`, holds (i, j).
+bool reaches(const Landscape::Change& c, std::int64_t i, std::int64_t j, std::int64_t grow) {
+  return i >= c.i0 - grow && i <= c.i1 + grow && j >= c.j0 - grow && j <= c.j1 + grow;
+}
+
+}  // namespace
+
+// Refreshes what the landscape's changes since the last update reach: the front's diamonds
+// (bounds, positions) and the output vertices (heights, normals, bounds). A diamond's bound
+// depends on everything within its reach, a vertex's normal on its neighbours.
+void RoamView::Impl::pull_changes() {
+  Impl& m = *this;
+  bool trimmed = false;
+  const std::vector<Landscape::Change> changes = m.land.changes_since(m.synced_version, &trimmed);
+  m.synced_version = m.land.version();
+  if (changes.empty()) return;
+  for (const Landscape::Change& c : changes) {
+    for (std::uint32_t e = 0; e < m.front.size(); ++e) {
+      const std::int64_t s = std::int64_t{1} << m.front.t(e);
+      if (reaches(c, m.front.ci(e), m.front.cj(e), 3 * s + 1)) m.refresh_entry(e);
+    }
+    const std::int64_t P = m.land.patch_cells();
+    const std::int64_t px0 = std::max<std::int64_t>(0, (c.i0 - 2 * P) / P),
+                       px1 = std::min<std::int64_t>(m.land.patches_x() - 1, (c.i1 + 2 * P) / P),
+                       pz0 = std::max<std::int64_t>(0, (c.j0 - 2 * P) / P),
+                       pz1 = std::min<std::int64_t>(m.land.patches_z() - 1, (c.j1 + 2 * P) / P);
+    for (std::int64_t pz = pz0; pz <= pz1; ++pz)
+      for (std::int64_t px = px0; px <= px1; ++px) {
+        const auto p = std::uint32_t(px + pz * m.land.patches_x());
+        for (std::uint32_t v = 0; v < m.out.vertex_slots(p); ++v) {
+          if (!m.out.vertex_live(p, v)) continue;
+          const auto q = m.out.coord(p, v);
+          const Diamond d = diamond_at(q[0], q[1], m.K);
+          const std::int64_t grow = d.corner ? 1 : std::max<std::int64_t>(1, d.reach()) + 1;
+          if (reaches(c, q[0], q[1], grow)) m.out.refresh_vertex(p, v);
+        }
+      }
+  }
+}
+
+// Detail tiles that became resident since the last update: the diamonds whose vertex waited for
+// one get their true position and the measured bounds (tighter than the analytic ones); the
+// vertices of the mesh over them too.
+void RoamView::Impl::pull_tiles() {
+  Impl& m = *this;
+  if (m.cache == nullptr) return;
+  const std::uint64_t g = m.cache->generation();
+  if (g == m.tiles_generation) return;
+  m.tiles_generation = g;
+  const DetailSnapshot& snap = *m.snapshot;
+  const std::uint32_t L = m.land.detail_levels();
+  // Finest tiles new since the last look (their areas: measured bounds apply inside).
+  std::vector<DetailTileKey> arrived;
+  std::unordered_set<std::uint64_t> now;
+  now.reserve(snap.size());
+  for (std::size_t k = 0; k < snap.size(); ++k) {
+    const DetailTileKey& key = snap.tile(k).key();
+    if (key.level != L) continue;
+    const std::uint64_t id = (std::uint64_t(std::uint32_t(key.tx)) << 32) | std::uint32_t(key.tz);
+    now.insert(id);
+    if (!m.known_tiles.count(id)) arrived.push_back(key);
+  }
+  m.known_tiles.swap(now);
+  const std::int64_t cells = kDetailTileCells;
+  for (std::uint32_t e = 0; e < m.front.size(); ++e) {
+    const std::uint32_t kt = m.front.t(e);
+    const std::int64_t ki = m.front.ci(e), kj = m.front.cj(e);
+    if (kt >= L) continue;  // stored vertices: no detail
+    bool refresh = m.front.provisional(e);
+    if (!refresh) {
+      const std::int64_t reach = std::int64_t{3} << kt;  // Diamond::reach(), at most
+      for (const DetailTileKey& key : arrived) {
+        const std::int64_t i0 = std::int64_t(key.tx) * cells, j0 = std::int64_t(key.tz) * cells;
+        if (ki - reach >= i0 && ki + reach <= i0 + cells && kj - reach >= j0 &&
+            kj + reach <= j0 + cells) {
+          refresh = true;
+          break;
+        }
+      }
+    }
+    if (!refresh) continue;
+    const float before = m.front.mu(e);
+    m.refresh_entry(e);
+    if (m.front.mu(e) < before) ++m.st.rebounded;
+  }
+  if (arrived.empty()) return;
+  // The mesh's vertices over the new tiles carry the measured bounds too.
+  for (std::uint32_t p = 0; p < m.out.patch_count(); ++p)
+    for (std::uint32_t v = 0; v < m.out.vertex_slots(p); ++v) {
+      if (!m.out.vertex_live(p, v)) continue;
+      const auto q = m.out.coord(p, v);
+      const Diamond d = diamond_at(q[0], q[1], m.K);
+      if (d.corner || d.t >= int(L)) continue;
+      for (const DetailTileKey& key : arrived) {
+        const std::int64_t i0 = std::int64_t(key.tx) * cells, j0 = std::int64_t(key.tz) * cells;
+        if (q[0] >= i0 && q[0] <= i0 + cells && q[1] >= j0 && q[1] <= j0 + cells) {
+          m.out.refresh_vertex(p, v);
+          break;
+        }
+      }
+    }
+}
+
+// ---- phase 3: splits and merges --------------------------------------------------------------------
+
+bool RoamView::Impl::split_candidate(std::uint32_t n) const {
+  if (!nodes[n].leaf()) return false;
+  const std::uint32_t e = nodes[n].entry();
+  return !front.split(e) && (front.result(e) & kActive);
+}
+
+bool RoamView::Impl::merge_candidate(std::uint32_t n) const {
+  if (nodes[n].leaf() || nodes[n].entry() == kNoEntry) return false;
+  const std::uint32_t e = nodes[n].entry();
+  return front.split(e) && !(front.result(e) & kActive) && mergeable(n);
+}
+
+// Unbudgeted: every merge the test asks for (cascading up), then every split (cascading down).
+void RoamView::Impl::collect() {
+  to_merge.clear();
+  to_split.clear();
+  const std::uint32_t n = front.size();
+  // Few entries change per update: skip the blocks the pass found unchanged.
+  constexpr std::uint32_t kChangedBit = std::uint32_t(kChanged) << Front::kResultShift;
+  for (std::uint32_t b = 0; b * Front::kLanes < n; ++b) {
+    if (!front.block_changed(b)) continue;
+    const std::uint32_t* words = front.block_state(b);
+    for (std::uint32_t l = 0; l < Front::kLanes && b * Front::kLanes + l < n; ++l)
+      if (words[l] & kChangedBit) {
+        const std::uint32_t e = b * Front::kLanes + l;
+        (front.split(e) ? to_merge : to_split).push_back(front.node(e));
+      }
+  }
+}
+
+void RoamView::Impl::converge_all() {
+  Impl& m = *this;
+#ifdef RIDGELINE_ROAM_PARANOID
+  if (auto e = m.check(); !e.empty()) {
+    std::fprintf(stderr, "before converge_all: %s\n", e.c_str());
+    std::abort();
+  }
+#endif
+  std::vector<std::uint32_t>& list = m.to_merge;
+  while (!list.empty()) {
+    if (list.size() > 8) {
+      __builtin_prefetch(&m.nodes[list[list.size() - 8]]);
+      const Node& ahead = m.nodes[list[list.size() - 4]];
+      if (!ahead.leaf() && ahead.a < m.nodes.size()) __builtin_prefetch(&m.nodes[ahead.a]);
+    }
+    const std::uint32_t n = list.back();
+    list.pop_back();
+    if (m.merge_candidate(n)) m.merge(n, &list);
+#ifdef RIDGELINE_ROAM_PARANOID
+    if (auto e = m.check(); !e.empty()) {
+      std::fprintf(stderr, "after merge of %u: %s\n", n, e.c_str());
+      std::abort();
+    }
+#endif
+  }
+  std::vector<std::uint32_t>& work = m.to_split;
+  while (!work.empty()) {
+    // Software prefetch: the changes are independent memory walks; fetching the next ones'
+    // nodes and entries while this one runs overlaps their cache misses.
+    if (work.size() > 8) {
+      __builtin_prefetch(&m.nodes[work[work.size() - 8]]);
+      const Node& ahead = m.nodes[work[work.size() - 4]];
+      if (ahead.leaf()) m.front.prefetch(ahead.entry());
+    }
+    const std::uint32_t n = work.back();
+    work.pop_back();
+    if (m.split_candidate(n) && !m.split(n, false, &work)) ++m.st.pending_splits;
+#ifdef RIDGELINE_ROAM_PARANOID
+    if (auto e = m.check(); !e.empty()) {
+      std::fprintf(stderr, "after split of %u: %s\n", n, e.c_str());
+      std::abort();
+    }
+#endif
+  }
+}
+
+// Under a triangle cap or a time budget: the most important change first (D97's dual queues:
+// split the highest priority, merge the lowest; under a cap, trade a merge for a split while the
+// split matters more). Keys are this update's priorities; out-of-view diamonds merge first.
+void RoamView::Impl::converge_budgeted(double threshold, std::uint32_t cap) {
+  Impl& m = *this;
+  using Item = std::pair<float, std::uint32_t>;  // priority, node
+  std::vector<Item> splits, merges;
+  auto split_key = [&](std::uint32_t e) { return m.front.priority(e, m.cam); };
+  auto merge_key = [&](std::uint32_t e) {
+    return (m.front.result(e) & kInView) ? m.front.priority(e, m.cam) : -1.0f;
+  };
+  for (std::uint32_t e = 0; e < m.front.size(); ++e) {
+    if (m.front.split(e)) {
+      // Under a cap every mergeable diamond may be traded; otherwise only those the test fails.
+      if (cap != 0 || !(m.front.result(e) & kActive))
+        merges.push_back({-merge_key(e), m.front.node(e)});
+    } else if (m.front.result(e) & kActive) {
+      splits.push_back({split_key(e), m.front.node(e)});
+    }
+  }
+  std::make_heap(splits.begin(), splits.end());
+  std::make_heap(merges.begin(), merges.end());  // max of -key: the lowest key on top
+  std::vector<std::uint32_t> fresh;
+  auto push_fresh = [&] {
+    for (std::uint32_t n : fresh) {
+      const std::uint32_t e = m.nodes[n].entry();
+      if (e == kNoEntry) continue;
+      if (m.nodes[n].leaf()) {
+        if (!m.front.split(e) && (m.front.result(e) & kActive)) {
+          splits.push_back({split_key(e), n});
+          std::push_heap(splits.begin(), splits.end());
+        }
+      } else if (m.front.split(e)) {
+        merges.push_back({-merge_key(e), n});
+        std::push_heap(merges.begin(), merges.end());
+      }
+    }
+    fresh.clear();
+  };
+  auto top_split = [&]() -> const Item* {
+    while (!splits.empty() && !m.split_candidate(splits.front().second)) {
+      std::pop_heap(splits.begin(), splits.end());
+      splits.pop_back();
+    }
+    return splits.empty() ? nullptr : &splits.front();
+  };
+  auto top_merge = [&]() -> const Item* {
+    while (!merges.empty()) {
+      const std::uint32_t n = merges.front().second;
+      if (!m.nodes[n].leaf() && m.nodes[n].entry() != kNoEntry && m.front.split(m.nodes[n].entry()) &&
+          m.mergeable(n))
+        break;
+      std::pop_heap(merges.begin(), merges.end());
+      merges.pop_back();
+    }
+    return merges.empty() ? nullptr : &merges.front();
+  };
+  auto do_merge = [&] {
+    const std::uint32_t n = merges.front().second;
+    std::pop_heap(merges.begin(), merges.end());
+    merges.pop_back();
+    m.merge(n, nullptr);
+#ifdef RIDGELINE_ROAM_PARANOID
+    if (auto e = m.check(); !e.empty()) {
+      std::fprintf(stderr, "after budgeted merge of %u: %s\n", n, e.c_str());
+      std::abort();
+    }
+#endif
+    // The merged diamond may split again later (a trade back); its parents may merge next.
+    fresh.push_back(n);
+    for (std::uint32_t p : {m.nodes[n].parent, m.nodes[n].base != kNone
+                                                   ? m.nodes[m.nodes[n].base].parent
+                                                   : kNone})
+      if (p != kNone) fresh.push_back(p);
+    push_fresh();
+  };
+  std::uint64_t ops = 0;
+  bool alternate = false;
+  for (;;) {
+    if (++ops > 16ull * (m.triangles + 4096)) break;  // a safety net against a trade cycle
+    if (m.out_of_time()) {
+      m.st.stop = StopReason::kTimeBudget;
+      break;
+    }
+    const Item* s = top_split();
+    const Item* g = top_merge();
+    const float sp = s ? s->first : -INFINITY;
+    const float gp = g ? -g->first : INFINITY;
+    if (cap != 0 && m.triangles > cap) {
+      if (!g) break;
+      do_merge();
+      continue;
+    }
+    // Under a time budget a merge the test asks for goes first every other operation: splits
+    // alone would take the whole budget while the camera moves, and the mesh would keep every
+    // triangle it no longer needs.
+    alternate = !alternate;
+    if (g && gp <= threshold && (!s || alternate || cap != 0) &&
+        !(m.front.result(m.nodes[g->second].entry()) & kActive)) {
+      do_merge();
+      continue;
+    }
+    if (s) {
+      const std::uint32_t n = s->second;
+      if (cap != 0 && m.triangles + m.split_cost(n) > cap) {
+        // Trade a lower-priority diamond for this split, unless it is the leaf's own parent.
+        if (g && gp < sp && g->second != m.nodes[n].parent &&
+            m.nodes[g->second].base != m.nodes[n].parent) {
+          do_merge();
+          continue;
+        }
+        m.st.stop = StopReason::kTriangleBudget;
+        break;
+      }
+      std::pop_heap(splits.begin(), splits.end());
+      splits.pop_back();
+      const bool done = m.split(n, false, &fresh);
+#ifdef RIDGELINE_ROAM_PARANOID
+      if (auto e = m.check(); !e.empty()) {
+        std::fprintf(stderr, "after budgeted split of %u: %s\n", n, e.c_str());
+        std::abort();
+      }
+#endif
+      if (!done)
+        ++m.st.pending_splits;
+      else {
+        // The split diamond is mergeable now; its children may split next.
+        fresh.push_back(n);
+        for (std::uint32_t k = 0; k < 2; ++k) fresh.push_back(m.nodes[n].a + k);
+        if (m.nodes[n].base != kNone)
+          for (std::uint32_t k = 0; k < 2; ++k) fresh.push_back(m.nodes[m.nodes[n].base].a + k);
+      }
+      push_fresh();
+      continue;
+    }
+    if (g && gp <= threshold && !(m.front.result(m.nodes[g->second].entry()) & kActive)) {
+      do_merge();
+      continue;
+    }
+    break;
+  }
+}
+
+// ---- the update ------------------------------------------------------------------------------------
+
+Result<RoamStats> RoamView::update(const Camera& camera) {
+  const bool screen = settings_.metric == ErrorMetric::kScreenPixels;
+  if (screen)
+    if (auto s = validate_camera(camera); !s) return Error{s.message()};
+  const auto t0 = std::chrono::steady_clock::now();
+  Impl& m = *impl_;
+  m.st = RoamStats{};
+  const Landscape& l = *landscape_;
+  const double threshold = settings_.threshold;
+  const std::uint32_t cap = settings_.max_triangles;
+  m.cam = screen ? FrontCamera::screen(camera, threshold, l.world_x(0),
+                                       l.terrain().heightfield().height_offset(), l.world_z(0),
+                                       l.spacing_x(), l.spacing_z(), l.local_extent())
+                 : FrontCamera::world_metres(threshold);
+  m.has_deadline = settings_.budget_ms > 0.0;
+  m.deadline = t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                        std::chrono::duration<double, std::milli>(settings_.budget_ms));
+  m.clock_checks = 0;
+
+  // 1. Edits and detail tiles.
+  if (m.cache != nullptr) {
+    m.cache->update();  // integrate tiles generated since the last frame
+    m.snapshot = m.cache->snapshot();
+  }
+  l.sync();
+  if (m.reset_pending || settings_.mode == RoamMode::kRebuild) {
+    m.reset_pending = false;
+    m.synced_version = l.version();
+    m.reset();
+  } else {
+    m.pull_changes();
+  }
+  m.pull_tiles();
+
+#ifdef RIDGELINE_ROAM_PARANOID
+  if (auto e = m.check(); !e.empty()) {
+    std::fprintf(stderr, "before the test (rebuilt %d): %s\n", int(m.st.rebuilt), e.c_str());
+    std::abort();
+  }
+#endif
+  // 2. The test.
+  m.fresh_worst = m.front.evaluate(m.cam);
+  m.st.priority_updates += m.front.size();
+  m.collect();
+  // Coherence loses when much of the mesh must go at once (a teleport, a snap turn): a rebuild
+  // from the roots then costs less than merging it away first. The merge candidates tell (each
+  // cascades up its ancestors); splits alone never do (a threshold drop keeps the whole mesh).
+  // Not under a budget: a budgeted update keeps the mesh and improves it in priority order.
+  if (settings_.mode == RoamMode::kCoherent && !m.st.rebuilt && cap == 0 && !m.has_deadline &&
+      m.to_merge.size() > std::max<std::size_t>(512, m.front.size() / 8)) {
+    m.reset();
+    m.fresh_worst = m.front.evaluate(m.cam);
+    m.st.priority_updates += m.front.size();
+    m.collect();
+  }
+
+  // 3-4. Splits and merges.
+  if (cap != 0 || m.has_deadline)
+    m.converge_budgeted(threshold, cap);
+  else
+    m.converge_all();
+
+  // Statistics.
+  m.st.triangles = m.triangles;
+  m.st.front_size = m.front.size();
+  // Unbudgeted, every diamond whose test fails ends unsplit and every other one split (or
+  // waiting for a tile): the largest failing priority seen is the remaining error. Under a budget
+  // some that pass stay unsplit: read the front.
+  const float remaining =
+      (cap != 0 || m.has_deadline) ? m.front.max_unsplit_priority(m.cam) : m.fresh_worst;
+  m.st.max_remaining_error = remaining;
+  m.st.morph_threshold =
+      m.st.stop == StopReason::kTriangleBudget ? std::max(threshold, double(remaining)) : threshold;
+  m.st.memory_bytes = m.nodes.memory_bytes() + m.front.memory_bytes() +
+                      (m.to_merge.capacity() + m.to_split.capacity()) * sizeof(std::uint32_t);
+  m.st.output_bytes = m.out.memory_bytes();
+  m.st.upload_bytes = m.out.take_upload_bytes();
+  m.st.dirty_patches = m.out.dirty_patch_count();
+  m.st.update_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return m.st;
+}
+
+}  // namespace ridgeline

@@ -1,0 +1,136 @@
+// Private: the state of one RoamView and the operations its update is made of.
+//
+//   nodes.h         bintree nodes (24 bytes) in fixed chunks, sibling pairs
+//   front.h         the split and merge front: every diamond that may change, tested per update
+//   patch_output.h  per-patch buffers the engine uploads, patched slot by slot
+//   bintree.cpp     split (with forced splits) and merge of diamonds, links, front and output
+//                   kept in step
+//   roam_view.cpp   the update's phases: edits, detail tiles, the test, merges, splits, budgets
+//   mesh_walk.cpp   walks from the roots: leaves, hash, measurement, invariants
+#pragma once
+
+#include <array>
+#include <chrono>
+#include <cstdlib>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <unordered_set>
+#include <vector>
+
+#include "ridgeline/roam_view.h"
+#include "roam/diamond.h"
+#include "roam/front.h"
+#include "roam/nodes.h"
+#include "roam/patch_output.h"
+
+namespace ridgeline {
+
+class DetailCache;
+class DetailSnapshot;
+
+struct RoamView::Impl {
+  explicit Impl(const Landscape& l);
+
+  const Landscape& land;
+  const int K;  // log2 of patch cells (finest lattice)
+  roam::NodePool nodes;
+  roam::Front front;
+  roam::PatchOutput out;
+  roam::FrontCamera cam;
+  std::uint32_t triangles = 0;
+  // Procedural detail: the terrain's tile cache (null without detail).
+  DetailCache* cache = nullptr;
+  std::shared_ptr<const DetailSnapshot> snapshot;  // the cache's tiles for this update
+  std::uint64_t synced_version = 0;  // the landscape's change version this view has applied
+  std::uint64_t tiles_generation = ~std::uint64_t{0};  // the cache's snapshot last seen
+  bool reset_pending = true;
+  std::unordered_set<std::uint64_t> known_tiles;  // finest tiles resident at the last look
+
+  // Per update.
+  RoamStats st;
+  float fresh_worst = 0;  // largest priority of a failing test in view seen this update
+  std::vector<std::uint32_t> to_merge, to_split;  // nodes (worklists)
+  bool has_deadline = false;
+  std::chrono::steady_clock::time_point deadline;
+  std::uint32_t clock_checks = 0;
+
+  // ---- geometry of a node (from its front entry, or its parent's) ---------------------------
+
+  /// The lattice triangle of a leaf (from its entry's centre and its side bit).
+  LatticeTriangle leaf_triangle(std::uint32_t n) const;
+  /// The triangle of the node whose diamond is centred at (i, j), on apex side `side`, ordered
+  /// (apex, left, right) counter-clockwise from above.
+  LatticeTriangle diamond_triangle(std::int64_t i, std::int64_t j, std::uint32_t side) const;
+  /// Which apex of the diamond of triangle `t` (its hypotenuse midpoint) is t's.
+  std::uint32_t side_of(const LatticeTriangle& t) const;
+  /// The patch holding a triangle.
+  std::uint32_t patch_of(const LatticeTriangle& t) const;
+  bool padding(const LatticeTriangle& t) const;
+
+  // ---- front ---------------------------------------------------------------------------------
+
+  /// Adds the entry of the diamond centred at (i, j) for node `n` (split or not) and points the
+  /// diamond's nodes at it; returns it. The node's partner, when given, is pointed at it too.
+  std::uint32_t add_entry(std::int64_t i, std::int64_t j, std::uint32_t n, std::uint32_t partner,
+                          bool split);
+  /// Removes an entry; re-points the nodes of the entry moved into its place.
+  void remove_entry(std::uint32_t e);
+  /// The nodes of an entry's diamond: its node and its partner (kNone when alone).
+  std::array<std::uint32_t, 2> entry_nodes(std::uint32_t e) const;
+  /// Recomputes an entry's bounds and position from the landscape.
+  void refresh_entry(std::uint32_t e);
+  void entry_data(std::int64_t i, std::int64_t j, float& y, float& mu, float& r,
+                  bool& provisional) const;
+
+  // ---- bintree ---------------------------------------------------------------------------------
+
+  /// Splits leaf n's diamond (after forcing its base neighbour to be its partner). `queue`:
+  /// where the new children whose test is active go. Returns false when a detail tile the split
+  /// needs is not resident (requested; nothing changed).
+  bool split(std::uint32_t n, bool forced, std::vector<std::uint32_t>* queue);
+  /// Merges the mergeable diamond of interior node n. `queue`: where parent diamonds that become
+  /// mergeable and inactive go.
+  void merge(std::uint32_t n, std::vector<std::uint32_t>* queue);
+  bool mergeable(std::uint32_t n) const;
+  bool children_leaves(std::uint32_t n) const;
+  /// Triangles a split of leaf n adds, counting the forced splits it needs.
+  std::uint32_t split_cost(std::uint32_t n) const;
+  /// True when the vertices a split of n (and its forced chain) creates have their detail.
+  bool chain_ready(std::uint32_t n);
+  void replace_link(std::uint32_t n, std::uint32_t from, std::uint32_t to);
+  /// A leaf's entry: joins its partner's, or a new one.
+  void attach_leaf(std::uint32_t n, const LatticeTriangle& t);
+  void reset();
+  bool split_candidate(std::uint32_t n) const;
+  bool merge_candidate(std::uint32_t n) const;
+
+  // ---- the update's phases (roam_view.cpp) ------------------------------------------------------
+
+  void pull_changes();
+  void pull_tiles();
+  /// The front's entries whose test disagrees with their state, into to_merge and to_split.
+  void collect();
+  void converge_all();
+  void converge_budgeted(double threshold, std::uint32_t cap);
+
+  // ---- walks (mesh_walk.cpp) ---------------------------------------------------------------------
+
+  /// Depth first over every root's tree, child 0 first: fn(node, root, heap, triangle, leaf).
+  template <class Fn>
+  void walk(Fn&& fn) const;
+  /// RoamView::check_invariants().
+  std::string check() const;
+
+  bool out_of_time() {
+#ifdef RIDGELINE_ROAM_PARANOID
+    // Deterministic budgets for debugging: ROAM_OPS=N stops after N operations.
+    static const long ops = std::getenv("ROAM_OPS") ? std::atol(std::getenv("ROAM_OPS")) : 0;
+    if (ops > 0) return has_deadline && ++clock_checks > std::uint32_t(ops);
+#endif
+    if (!has_deadline || (++clock_checks & 7) != 0) return false;
+    return std::chrono::steady_clock::now() >= deadline;
+  }
+};
+
+}  // namespace ridgeline
