@@ -328,12 +328,9 @@ ViewFrame Game::update_view(double frame_ms) {
     render_scale_ = controller_.render_scale();
   }
   ViewFrame out;
-  // The views get the threshold on a 2 % geometric grid: RoamView re-keys its merge queue only
-  // when the threshold rises by more than 1 % between two updates, so a controller creeping up
-  // by less per frame would leave the mesh with the triangles of the lower threshold (measured:
-  // 18,500 instead of 12,800 after a ramp from 2 to 6 px at 0.5 % per frame; 40,000 at 6 px in
-  // the game).
-  const double view_threshold = controller_on_ ? quantise_threshold(threshold_) : threshold_;
+  // The controller's threshold as it is: the view re-tests its whole split and merge front every
+  // update, so any change, however small, moves the mesh both ways.
+  const double view_threshold = threshold_;
   out.threshold = view_threshold;
   out.render_scale = render_scale_;
   if (!options_.tessellate) return last_view_ = out;
@@ -343,17 +340,8 @@ ViewFrame Game::update_view(double frame_ms) {
   s.max_triangles = max_triangles_;
   s.budget_ms = tess_budget_ms_;
   if (Status st = v.set_settings(s); !st) scripts_->log("view settings: " + st.message());
-  ridgeline::Camera cam = camera();
-  // A falling threshold: RoamView keeps the split keys it computed for the higher threshold
-  // (their windows were sized for it), so leaves whose priority is now well below the threshold
-  // still split: ramping from 12 to 6 px left 59,000 triangles where a fresh view has 13,000.
-  // A change of the far plane makes the view recompute every key (within its time budget), so
-  // each step down moves the far plane by a part in 10^9 (alternating between two values, so
-  // that only the steps down re-key). The renderer's projection does not see it.
+  const ridgeline::Camera cam = camera();
   const int vi = int(rig_.mode);
-  if (view_threshold < last_view_threshold_[vi]) far_nudge_[vi] = !far_nudge_[vi];
-  last_view_threshold_[vi] = view_threshold;
-  if (far_nudge_[vi]) cam.far_m *= 1.0 + 1e-9;
   if (stream_) {  // tiles for where the camera is going, ahead of the view's own requests
     auto f = stream_->frame(cam);
     if (f) detail_frame_ = *f;
@@ -387,13 +375,6 @@ ViewFrame Game::update_view(double frame_ms) {
 double Game::morph_threshold() const noexcept {
   const int vi = int(rig_.mode);
   return morph_threshold_[vi] > 0 ? morph_threshold_[vi] : views_[vi]->settings().threshold;
-}
-
-double quantise_threshold(double px) noexcept {
-  if (!(px > 0) || !std::isfinite(px)) return px;
-  constexpr double kStep = 1.02;
-  const double k = std::round(std::log(px) / std::log(kStep));
-  return std::pow(kStep, k);
 }
 
 BudgetSettings Game::budget() const noexcept {

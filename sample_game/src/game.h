@@ -30,11 +30,6 @@ namespace game {
 /// stored spacing (1 m finest spacing) with a 0.2 m octave (0.1 x the base spacing).
 ridgeline::DetailParams default_world_detail();
 
-/// The threshold a view gets from the controller's `px`: the nearest step of a 2 % geometric
-/// grid, so that a slowly rising threshold still re-keys the view's merges (RoamView does when
-/// the threshold rises by more than 1 % between updates). A fixed threshold is used as given.
-double quantise_threshold(double px) noexcept;
-
 /// Settings from the command line (main.cpp) or a test.
 struct GameOptions {
   std::string assets_dir;   ///< folder with vehicles/*.glb
@@ -198,9 +193,7 @@ class Game final : public GameApi {
   std::uint32_t max_triangles_ = 60000;
   double tess_budget_ms_ = 8;
   ViewFrame last_view_;
-  double last_view_threshold_[3] = {0, 0, 0};  // per camera mode: the view's last threshold
-  double morph_threshold_[3] = {0, 0, 0};      // per camera mode: its last morph_threshold
-  bool far_nudge_[3] = {false, false, false};  // see update_view()
+  double morph_threshold_[3] = {0, 0, 0};  // per camera mode: its last morph_threshold
   std::optional<ridgeline::DetailStream> stream_;
   std::optional<ridgeline::DetailFrameStats> detail_frame_;
   std::uint64_t frame_ = 0;
