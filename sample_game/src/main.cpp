@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,7 @@
 #include "gl_context.h"
 #include "panel.h"
 #include "renderer.h"
+#include "ridgeline/camera_path.h"
 #include "run_stats.h"
 
 namespace {
@@ -44,7 +46,7 @@ struct Args {
   bool headless = false, offscreen = false, egl = false, no_panel = false, wireframe = false;
   std::uint64_t frames = 0;
   std::vector<std::string> scripts;
-  std::string screenshot, stats, out_dir = "out", camera;
+  std::string screenshot, stats, out_dir = "out", camera, record_path;
   std::uint64_t screenshot_every = 0, steady_from = 0;
   int width = 1280, height = 720;
   double threshold = 0, target_ms = 33, dt = 1.0 / 60.0, tess_ms = 8;
@@ -56,6 +58,29 @@ struct Args {
   bool full_fragments = false, unsorted = false;
   std::uint32_t patch_exponent = 4;
 };
+
+// Writes the frames as a PATH.json camera path (docs/cli.md, "Camera paths").
+ridgeline::Status write_camera_path(const std::string& file,
+                                    const std::vector<ridgeline::io::PathFrame>& frames) {
+  nlohmann::json out = {{"version", 1}, {"frames", nlohmann::json::array()}};
+  for (const ridgeline::io::PathFrame& f : frames) {
+    const ridgeline::Camera& c = f.camera;
+    out["frames"].push_back({{"eye", {c.eye.x, c.eye.y, c.eye.z}},
+                             {"target", {c.target.x, c.target.y, c.target.z}},
+                             {"up", {c.up.x, c.up.y, c.up.z}},
+                             {"fov_y", c.fov_y_deg},
+                             {"viewport", {c.viewport.x, c.viewport.y}},
+                             {"near", c.near_m},
+                             {"far", c.far_m},
+                             {"dt", f.dt}});
+  }
+  std::ofstream os(file);
+  if (!os) return ridgeline::Error{"camera path '" + file + "': cannot open for writing"};
+  os << out.dump() << "\n";
+  os.close();
+  if (!os) return ridgeline::Error{"camera path '" + file + "': write failed"};
+  return {};
+}
 
 void read_window_input(GLFWwindow* w, game::Game& g, bool keyboard_free, double dt) {
   auto down = [w](int k) { return glfwGetKey(w, k) == GLFW_PRESS; };
@@ -187,6 +212,7 @@ int run(const Args& a) {
   std::uint64_t frame = 0;
   const bool window = ctx && ctx->mode() == game::GlMode::kWindow;
   auto wall0 = Clock::now();
+  std::vector<ridgeline::io::PathFrame> recorded;  // --record-path: the active camera per frame
   while (a.frames == 0 || frame < a.frames) {
     if (ctx && ctx->should_close()) break;
     const auto t0 = Clock::now();
@@ -225,6 +251,7 @@ int run(const Args& a) {
     const double sim_ms = ms_since(ts);
     const game::StepTimes step_times = g.take_step_times();
     const game::ViewFrame vf = g.update_view(last_frame_ms);
+    if (!a.record_path.empty()) recorded.push_back({g.camera(), std::max(steps, 1) * g.dt()});
     game::RenderStats rstats;
     double render_ms = 0, panel_ms = 0;
     if (renderer) {
@@ -331,6 +358,12 @@ int run(const Args& a) {
     stats.record(g, std::move(rec));
     ++frame;
   }
+  if (!a.record_path.empty()) {
+    if (auto s = write_camera_path(a.record_path, recorded); !s) {
+      std::fprintf(stderr, "ridgeline_game: %s\n", s.message().c_str());
+      return 1;
+    }
+  }
   if (!a.stats.empty()) {
     if (auto s = stats.write(a.stats, mode, g, a.steady_from); !s) {
       std::fprintf(stderr, "ridgeline_game: %s\n", s.message().c_str());
@@ -386,6 +419,8 @@ int main(int argc, char** argv) {
   app.add_option("--dt", a.dt, "fixed simulation step, seconds")
       ->check(CLI::Range(0.001, 0.1))
       ->capture_default_str();
+  app.add_option("--record-path", a.record_path,
+                 "write the active camera of every frame as a PATH.json camera path");
   app.add_option("--camera", a.camera, "initial camera (overrides scripts)")
       ->check(CLI::IsMember({"free", "follow", "map"}));
   app.add_option("--render-scale", a.render_scale,
