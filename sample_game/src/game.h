@@ -48,11 +48,12 @@ struct GameOptions {
   double tessellation_budget_ms = 8;    ///< time budget of one view update
   bool tessellate = true;  ///< update the active view each frame (off: pure simulation)
   std::uint64_t instruction_limit = 20'000'000;  ///< per script call (an infinite loop ends)
-  /// ROAM patches of 2^k stored cells per side. 4 (32 m patches): a dirty patch's mesh is
-  /// rebuilt whole (RoamView::patch_mesh), and with detail the patches near the camera hold most
-  /// triangles; measured at 2 px, 1280 x 720: 3.5 ms of mesh building per frame with k = 4,
-  /// 16 ms with 5, 25 ms with 6 (docs/game.md, "Where the frame goes").
-  std::uint32_t patch_exponent = 4;
+  /// ROAM patches of 2^k stored cells per side. 5 (64 m patches, 1,024 of them): the core patches
+  /// meshes in place and the renderer uploads the dirty ranges, so the patch size no longer sets
+  /// the upload cost (0.2-0.35 ms per frame for k = 4..6 at 2 px, 1280 x 720); k = 5 had the
+  /// lowest game-thread CPU time and 6 % fewer triangles than k = 4 (docs/game.md, "Where the
+  /// frame goes").
+  std::uint32_t patch_exponent = 5;
   /// Procedural detail of the world (levels 0: none).
   ridgeline::DetailParams detail = default_world_detail();
   std::uint32_t detail_workers = 2;                          ///< the tile cache's worker threads

@@ -56,7 +56,7 @@ struct Args {
   double detail_amplitude = -1;
   bool prefill_detail = false;
   bool full_fragments = false, unsorted = false;
-  std::uint32_t patch_exponent = 4;
+  std::uint32_t patch_exponent = game::GameOptions{}.patch_exponent;
 };
 
 // Writes the frames as a PATH.json camera path (docs/cli.md, "Camera paths").
@@ -328,6 +328,8 @@ int run(const Args& a) {
     rec.pending_splits = vf.stats.pending_splits;
     rec.stop = vf.updated ? int(vf.stats.stop) : -1;
     rec.patches_uploaded = rstats.patches_uploaded;
+    rec.bytes_uploaded = rstats.bytes_uploaded;
+    rec.view_upload_bytes = vf.stats.upload_bytes;
     rec.contacts = g.contacts();
     if (auto ds = g.detail_stats()) {
       rec.tiles_resident = ds->resident_tiles;

@@ -86,6 +86,8 @@ ridgeline::Status RunStats::write(const std::string& path, const std::string& mo
                                : f.stop == 2 ? "time"
                                              : "none"},
                       {"patches_uploaded", f.patches_uploaded},
+                      {"bytes_uploaded", f.bytes_uploaded},
+                      {"view_upload_bytes", f.view_upload_bytes},
                       {"vehicle_contacts", f.contacts},
                       {"detail_tiles_resident", f.tiles_resident},
                       {"detail_tiles_pending", f.tiles_pending},
@@ -141,6 +143,16 @@ ridgeline::Status RunStats::write(const std::string& path, const std::string& mo
       if (f.frame >= skip_frames) pm.push_back(f.patch_mesh_ms);
     breakdown["upload_patch_mesh_part"] = {{"p50", percentile(pm, 50)}, {"mean", mean(pm)}};
   }
+  json upload_bytes;
+  {
+    std::vector<double> b;
+    for (const FrameRecord& f : frames_)
+      if (f.frame >= skip_frames) b.push_back(double(f.bytes_uploaded));
+    upload_bytes = {{"p50", percentile(b, 50)},
+                    {"p99", percentile(b, 99)},
+                    {"mean", mean(b)},
+                    {"max", b.empty() ? 0.0 : *std::max_element(b.begin(), b.end())}};
+  }
   const double n = steady > 0 ? double(steady) : 1.0;
   json summary = {
       {"frames", frames_.size()},
@@ -155,6 +167,7 @@ ridgeline::Status RunStats::write(const std::string& path, const std::string& mo
         {"p50", percentile(scale, 50)},
         {"p90", percentile(scale, 90)},
         {"min", scale.empty() ? 1.0 : *std::min_element(scale.begin(), scale.end())}}},
+      {"upload_bytes", upload_bytes},
       {"triangles",
        {{"p50", percentile(tris, 50)},
         {"max", tris.empty() ? 0.0 : *std::max_element(tris.begin(), tris.end())}}},

@@ -30,6 +30,9 @@ struct FrameRecord {
   std::uint32_t triangles = 0, splits = 0, merges = 0, patches_uploaded = 0, pending_splits = 0;
   int stop = -1;             ///< ridgeline::StopReason of the view update, -1 when none ran
   std::size_t contacts = 0;  ///< vehicle-vehicle contacts in the last step
+  /// Vertex and index bytes the renderer sent to GL (dirty ranges, whole buffers when they grew),
+  /// and the bytes the view's update changed (RoamStats::upload_bytes).
+  std::uint64_t bytes_uploaded = 0, view_upload_bytes = 0;
   std::size_t tiles_resident = 0, tiles_pending = 0;
   std::uint64_t tiles_generated = 0;  ///< since the start
   struct VehicleRecord {
