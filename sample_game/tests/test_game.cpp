@@ -457,7 +457,11 @@ TEST(Game, ArgumentErrorsUseTheBindingsMessages) {
   expect_error("game.camera{eye={1, 2}}", "field 'eye': array of 3 numbers expected");
   expect_error("game.set_budget{controller='yes'}", "field 'controller': boolean expected");
   expect_error("game.set_budget{render_scale=0.1}", "'render_scale': 0.25 .. 1");
-  expect_error("game.set_budget{triangles=5000}", "field 'triangles': 8192 .. 4000000 expected");
+  // Below the views' root triangles (2 per patch: 2,048 with the default 64 m patches).
+  const std::string roots =
+      "field 'triangles': " + std::to_string(g->root_triangles()) + " .. 4000000 expected";
+  EXPECT_EQ(g->root_triangles(), 2048u);
+  expect_error("game.set_budget{triangles=1000}", roots.c_str());
   // The same mistake in the binding's own functions gives the same text.
   expect_error("game.terrain:height(0/0, 1)", "finite number expected, got nan");
 }
@@ -499,6 +503,20 @@ TEST(Game, TimesOfScriptsAndPhysicsAreMeasured) {
   EXPECT_EQ(g->take_step_times().scripts_ms, 0.0) << "taken";
 }
 
+// Triangles of the default scenario's view after 30 updates at a fixed 6 px (no budgets).
+std::uint32_t triangles_of_a_fresh_view_at_6px() {
+  auto h = make_game(true);
+  EXPECT_TRUE(h->load_script(kScripts + "/default.lua").ok());
+  EXPECT_TRUE(h->host()
+                  .run("game.set_budget{controller=false, threshold=6, triangles=400000, "
+                       "tess_ms=0}",
+                       "b")
+                  .ok());
+  game::ViewFrame f;
+  for (int i = 0; i < 30; ++i) f = h->update_view(0);
+  return f.stats.triangles;
+}
+
 TEST(Game, ASlowlyRisingThresholdStillCoarsensTheMesh) {
   // The controller raises the threshold by well under 1 % per frame. The old ROAM core re-keyed
   // its merges only for a larger rise and kept the triangles of the lower threshold (40,000 at
@@ -512,18 +530,7 @@ TEST(Game, ASlowlyRisingThresholdStillCoarsensTheMesh) {
                        "b")
                   .ok());
   for (int i = 0; i < 30; ++i) g->update_view(0);
-  const auto fixed6 = [&] {
-    auto h = make_game(true);
-    EXPECT_TRUE(h->load_script(kScripts + "/default.lua").ok());
-    EXPECT_TRUE(h->host()
-                    .run("game.set_budget{controller=false, threshold=6, triangles=400000, "
-                         "tess_ms=0}",
-                         "b")
-                    .ok());
-    game::ViewFrame f;
-    for (int i = 0; i < 30; ++i) f = h->update_view(0);
-    return f.stats.triangles;
-  }();
+  const std::uint32_t fixed6 = triangles_of_a_fresh_view_at_6px();
   // The controller on, fed frames a little too slow: it creeps from 2 px towards its maximum.
   ASSERT_TRUE(g->host()
                   .run("game.set_budget{controller=true, threshold=2, min=1, max=6, "
@@ -543,18 +550,7 @@ TEST(Game, AFallingThresholdDoesNotOverRefineTheMesh) {
   // keys sized for the higher threshold and over-refined (59,000 triangles at 6 px instead of
   // 13,000) unless the game made it re-key on every step down (a far-plane nudge); the new core
   // re-tests its whole front every update and needs no help.
-  auto fixed6 = [&] {
-    auto h = make_game(true);
-    EXPECT_TRUE(h->load_script(kScripts + "/default.lua").ok());
-    EXPECT_TRUE(h->host()
-                    .run("game.set_budget{controller=false, threshold=6, triangles=400000, "
-                         "tess_ms=0}",
-                         "b")
-                    .ok());
-    game::ViewFrame f;
-    for (int i = 0; i < 30; ++i) f = h->update_view(0);
-    return f.stats.triangles;
-  }();
+  const std::uint32_t fixed6 = triangles_of_a_fresh_view_at_6px();
   auto g = make_game(true);
   ASSERT_TRUE(g->load_script(kScripts + "/default.lua").ok());
   ASSERT_TRUE(g->host()
