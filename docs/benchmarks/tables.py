@@ -44,7 +44,7 @@ if budget:
     out.append("")
 budgeted = [n for n in rows if rows[n].get("budget_ms", 0) > 0]
 if budgeted:
-    out.append("**Time budgets (SPEC.md: p99 <= 1.1 B + 0.1 ms; wall time, and the update thread's CPU time)**\n")
+    out.append("**Time budgets (met when p99 <= 1.1 B + 0.1 ms, docs/surface.md; wall time, and the update thread's CPU time)**\n")
     out.append("| run | budget ms | wall median | wall p99 | CPU p99 | met (wall) | met (CPU) | triangles | splits+merges/frame | RMS error m | max screen px |")
     out.append("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     for n in budgeted:

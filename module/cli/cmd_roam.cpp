@@ -177,7 +177,8 @@ int run_mesh(const MeshArgs& a) {
   auto st = (*view)->converge(c);
   if (!st) return report_error(st.error().message);
   // Every finest-lattice vertex up to 4M of them; beyond (detail, huge fields) a fixed
-  // stratified sample of every k-th vertex per axis (SPEC.md), reported as measured_stride.
+  // stratified sample of every k-th vertex per axis (docs/surface.md, "Error and budgets"),
+  // reported as measured_stride.
   const Landscape& land = (*view)->landscape();
   const double verts = double(land.last_i() + 1) * double(land.last_j() + 1);
   const auto stride = static_cast<std::uint32_t>(std::max(1.0, std::ceil(std::sqrt(verts / 4e6))));

@@ -1,5 +1,5 @@
 // A Terrain with procedural detail: the finest lattice (spacing / 2^L) whose vertex heights are
-// base + detail (SPEC.md "The surface"), and the point queries on it.
+// base + detail (docs/surface.md, "Detail and edits"), and the point queries on it.
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -46,8 +46,12 @@ const DetailSnapshot* current_snapshot(const DetailCache& cache) {
 // A terrain's finest lattice seen as a grid, for the vertex-normal template of surface_eval.h.
 struct FineGrid {
   const Terrain& t;
-  double spacing_x() const { return std::ldexp(t.heightfield().spacing_x(), -int(t.detail_levels())); }
-  double spacing_z() const { return std::ldexp(t.heightfield().spacing_z(), -int(t.detail_levels())); }
+  double spacing_x() const {
+    return std::ldexp(t.heightfield().spacing_x(), -int(t.detail_levels()));
+  }
+  double spacing_z() const {
+    return std::ldexp(t.heightfield().spacing_z(), -int(t.detail_levels()));
+  }
   std::int64_t width() const { return t.fine_width(); }
   std::int64_t height() const { return t.fine_height(); }
   double local(std::uint32_t i, std::uint32_t j) const { return t.fine_local_height(i, j); }
@@ -55,16 +59,18 @@ struct FineGrid {
 
 }  // namespace
 
-Result<std::shared_ptr<Terrain>> Terrain::create(Heightfield heightfield, const DetailParams& detail,
+Result<std::shared_ptr<Terrain>> Terrain::create(Heightfield heightfield,
+                                                 const DetailParams& detail,
                                                  const DetailCacheDesc& cache) {
   if (auto s = validate_detail_params(detail); !s) return Error{s.message()};
   const std::uint64_t fw = std::uint64_t(heightfield.width() - 1) << detail.levels;
   const std::uint64_t fh = std::uint64_t(heightfield.height() - 1) << detail.levels;
   if (std::max(fw, fh) >= (std::uint64_t{1} << 30))
-    return Error{fmt("detail: %u levels over %u x %u samples make a finest lattice of %llu cells "
-                     "per side; at most 2^30 (use fewer levels)",
-                     detail.levels, heightfield.width(), heightfield.height(),
-                     static_cast<unsigned long long>(std::max(fw, fh)))};
+    return Error{
+        fmt("detail: %u levels over %u x %u samples make a finest lattice of %llu cells "
+            "per side; at most 2^30 (use fewer levels)",
+            detail.levels, heightfield.width(), heightfield.height(),
+            static_cast<unsigned long long>(std::max(fw, fh)))};
   std::shared_ptr<Terrain> t = create(std::move(heightfield));
   if (detail.levels == 0) return t;
   auto field = DetailField::create_for(*t, detail);
@@ -98,7 +104,8 @@ double Terrain::detail_at(std::int64_t i, std::int64_t j) const noexcept {
   if (m == 0) return 0.0;
   const std::int64_t li = i >> t, lj = j >> t;
   if (const DetailSnapshot* s = current_snapshot(*cache_)) {
-    const DetailTileKey key{m, std::int32_t(li / kDetailTileCells), std::int32_t(lj / kDetailTileCells)};
+    const DetailTileKey key{m, std::int32_t(li / kDetailTileCells),
+                            std::int32_t(lj / kDetailTileCells)};
     if (const DetailTile* tile = s->find(key))
       return tile->detail(std::int32_t(li - std::int64_t{key.tx} * kDetailTileCells),
                           std::int32_t(lj - std::int64_t{key.tz} * kDetailTileCells));
@@ -129,8 +136,8 @@ double Terrain::fine_local_height(std::int64_t i, std::int64_t j) const noexcept
   if (k == hf.width() - 1) --k, fi = mask + 1;
   if (m == hf.height() - 1) --m, fj = mask + 1;
   const float fu = std::ldexp(float(fi), -L), fv = std::ldexp(float(fj), -L);  // exact
-  const detail::CellPlane plane = detail::cell_plane(
-      hf, std::uint32_t(k), std::uint32_t(m), locate_in_cell(k, m, fu, fv));
+  const detail::CellPlane plane =
+      detail::cell_plane(hf, std::uint32_t(k), std::uint32_t(m), locate_in_cell(k, m, fu, fv));
   return plane.at(fu, fv) + detail_at(i, j);
 }
 
@@ -142,7 +149,8 @@ bool Terrain::locate_fine(double x, double z, FineLocated& p) const noexcept {
   if (!(u >= 0.0 && u <= max_u && v >= 0.0 && v <= max_v)) return false;  // NaN fails too
   p.i = std::min(static_cast<std::int64_t>(u), fine_width() - 2);
   p.j = std::min(static_cast<std::int64_t>(v), fine_height() - 2);
-  p.tri = locate_in_cell(p.i, p.j, static_cast<float>(u - double(p.i)), static_cast<float>(v - double(p.j)));
+  p.tri = locate_in_cell(p.i, p.j, static_cast<float>(u - double(p.i)),
+                         static_cast<float>(v - double(p.j)));
   for (int k = 0; k < 3; ++k) p.h[k] = fine_local_height(p.i + p.tri.di[k], p.j + p.tri.dj[k]);
   return true;
 }
@@ -170,15 +178,15 @@ glm::vec3 Terrain::fine_smooth_normal(const FineLocated& p) const noexcept {
 glm::vec3 Terrain::lattice_vertex_normal(std::int64_t i, std::int64_t j) const noexcept {
   i = std::clamp<std::int64_t>(i, 0, fine_width() - 1);
   j = std::clamp<std::int64_t>(j, 0, fine_height() - 1);
-  if (detail_levels_ == 0) return detail::vertex_normal(heightfield_, std::uint32_t(i), std::uint32_t(j));
+  if (detail_levels_ == 0)
+    return detail::vertex_normal(heightfield_, std::uint32_t(i), std::uint32_t(j));
   return detail::vertex_normal(FineGrid{*this}, std::uint32_t(i), std::uint32_t(j));
 }
 
 std::uint8_t Terrain::fine_material(const FineLocated& p) const noexcept {
   const int L = int(detail_levels_);
-  return heightfield_.material(
-      std::min(std::uint32_t(p.i >> L), heightfield_.width() - 2),
-      std::min(std::uint32_t(p.j >> L), heightfield_.height() - 2));
+  return heightfield_.material(std::min(std::uint32_t(p.i >> L), heightfield_.width() - 2),
+                               std::min(std::uint32_t(p.j >> L), heightfield_.height() - 2));
 }
 
 }  // namespace ridgeline

@@ -1,6 +1,7 @@
-// Fuzz target: io::parse_edits (the edits JSON, SPEC.md "Edits"); every edit it accepts must pass
-// validate_edit and apply to a small terrain, failing only with the one refusal the default
-// limits have: a radius larger than the terrain (regression input crash-radius-beyond-terrain).
+// Fuzz target: io::parse_edits (the edits JSON, docs/deformation.md "Brushes"); every edit it
+// accepts must pass validate_edit and apply to a small terrain, failing only with the one refusal
+// the default limits have: a radius larger than the terrain (regression input
+// crash-radius-beyond-terrain).
 #include <cstdint>
 #include <string_view>
 

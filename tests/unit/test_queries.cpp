@@ -6,9 +6,10 @@
 // edit (rays of every slant and boxes against brute force after edits, the ray pyramid against a
 // rebuild).
 //
-// The reference code in this file derives the triangulation from SPEC.md's wording ("cell (i, j)
-// is split along (i, j)-(i+1, j+1) when i + j is even, along (i+1, j)-(i, j+1) when it is odd") on
-// its own; it does not call surface.h, so a mistake there cannot hide itself.
+// The reference code in this file derives the triangulation from the diagonal rule's wording in
+// docs/surface.md ("cell (i, j) is split along (i, j)-(i+1, j+1) when i + j is even, along
+// (i+1, j)-(i, j+1) when it is odd") on its own; it does not call surface.h, so a mistake there
+// cannot hide itself.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -24,9 +25,9 @@
 #include <tuple>
 #include <vector>
 
-#include "ridgeline/scenes.h"
 #include "ridgeline/detail.h"
 #include "ridgeline/edit.h"
+#include "ridgeline/scenes.h"
 #include "ridgeline/surface.h"
 #include "ridgeline/terrain.h"
 
@@ -73,7 +74,7 @@ struct RefTri {
   int i, j;
 };
 
-// The two triangles of cell (i, j), straight from SPEC.md's wording.
+// The two triangles of cell (i, j), straight from the diagonal rule's wording (docs/surface.md).
 std::array<std::array<int, 6>, 2> spec_cell_corners(int i, int j) {
   if ((i + j) % 2 == 0)                                 // split along (i, j)-(i+1, j+1)
     return {{{0, 0, 1, 1, 1, 0}, {0, 0, 0, 1, 1, 1}}};  // (di, dj) pairs
@@ -330,7 +331,8 @@ TEST(Queries, DiagonalRuleSeenThroughARaisedVertex) {
 }
 
 TEST(Queries, LocateInCellMatchesSpecTriangles) {
-  // Both triangles of every cell parity, against the SPEC corners, and counter-clockwise.
+  // Both triangles of every cell parity, against the corners of the rule's wording, and
+  // counter-clockwise.
   for (int j = 0; j < 2; ++j) {
     for (int i = 0; i < 2; ++i) {
       std::set<std::vector<int>> from_locate, from_spec;

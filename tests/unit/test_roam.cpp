@@ -145,7 +145,7 @@ TEST(Roam, ConvergedMeshMeetsTheThresholdInView) {
   EXPECT_EQ(st->stop, StopReason::kConverged);
   EXPECT_LE(st->max_remaining_error, 2.0);
   expect_converged(*view, c, 2.0);
-  // Move a little and update again: still converged (lazy keys stay conservative).
+  // Move a little and update again: still converged (the front is tested afresh every update).
   for (int k = 1; k <= 20; ++k) {
     Camera c2 = c;
     c2.eye += glm::dvec3(3.0 * k, -1.0 * k, 2.0 * k);
@@ -313,6 +313,47 @@ TEST(Roam, TriangleBudgetIsAHardCap) {
   EXPECT_EQ(check_crack_free(*view), "");
 }
 
+// Under a cap alone the view follows a moving camera at the threshold that fills the cap: every
+// update fits the cap and uses most of it, and its mesh is exactly the converged mesh of the
+// threshold it reports (morph_threshold): what a fresh view at that threshold builds.
+TEST(Roam, TriangleCapFollowsTheCameraAtOneThreshold) {
+  auto l = make_landscape(257, 5);
+  const std::uint32_t cap = 6000;
+  auto view = RoamView::create(l, {.threshold = 0.0, .max_triangles = cap}).value();
+  Camera c = camera_at({10, 150, 10}, {200, 50, 200});
+  int searched = 0;
+  for (int k = 0; k < 40; ++k) {
+    c.eye += glm::dvec3(4, 0.3, 3);
+    c.target += glm::dvec3(2, 0, 5);
+    auto st = view->update(c);
+    ASSERT_TRUE(st);
+    EXPECT_LE(st->triangles, cap) << "update " << k;
+    EXPECT_EQ(check_crack_free(*view), "") << "update " << k;
+    if (k < 5) continue;  // the search settles
+    EXPECT_GT(st->triangles, 0.9 * cap) << "update " << k;
+    EXPECT_EQ(st->stop, StopReason::kTriangleBudget);
+    EXPECT_LE(st->max_remaining_error, st->morph_threshold * (1 + 1e-6)) << "update " << k;
+    if (k % 8 == 0) {
+      auto fresh = RoamView::create(l, {.threshold = st->morph_threshold}).value();
+      ASSERT_TRUE(fresh->update(c));
+      EXPECT_EQ(fresh->mesh_hash(), view->mesh_hash()) << "update " << k;
+      ++searched;
+    }
+  }
+  EXPECT_GT(searched, 3);
+  // A threshold above what the cap needs: the cap does not bind and the view converges.
+  RoamSettings s = view->settings();
+  s.threshold = 20.0;
+  ASSERT_TRUE(view->set_settings(s));
+  auto st = view->update(c);
+  ASSERT_TRUE(st);
+  EXPECT_EQ(st->stop, StopReason::kConverged);
+  EXPECT_DOUBLE_EQ(st->morph_threshold, 20.0);
+  auto fresh = RoamView::create(l, {.threshold = 20.0}).value();
+  ASSERT_TRUE(fresh->update(c));
+  EXPECT_EQ(fresh->mesh_hash(), view->mesh_hash());
+}
+
 TEST(Roam, DeterministicMeshHash) {
   auto l = make_landscape(257, 5);
   auto run = [&] {
@@ -464,7 +505,8 @@ TEST(Roam, MeasuredErrorAgreesWithTheBoundsAndTheThreshold) {
 
 TEST(Roam, TimeBudgetStopsTheUpdateAndTheRestContinuesNextUpdate) {
   auto l = make_landscape(257, 5);
-  // A budget far below what converging takes: the first check (after 16 operations) stops it.
+  // A budget far below what converging takes: the first clock check (after 8 operations) stops
+  // it.
   auto view = RoamView::create(l, {.threshold = 1.0, .budget_ms = 1e-6}).value();
   const Camera c = camera_at({20, 120, 30}, {300, 60, 260});
   auto st = view->update(c);
@@ -523,7 +565,7 @@ TEST(Roam, DetailThatTurnsOutOfViewIsMergedBack) {
   auto look = [&](double yaw) {
     return camera_at(eye, eye + glm::dvec3(std::cos(yaw), -0.5, std::sin(yaw)), 50.0);
   };
-  // Turn on the spot by 180 degrees in 5-degree steps (no translation: only rotation moves keys).
+  // Turn on the spot by 180 degrees in 5-degree steps (no translation: only the frustum moves).
   RoamStats st{};
   for (int k = 0; k <= 36; ++k) {
     auto r = view->update(look(k * M_PI / 36));
@@ -562,15 +604,16 @@ TEST(Roam, ViewsUpdateOnDifferentThreadsOverOneLandscape) {
 }
 
 TEST(Roam, ATightTimeBudgetStillSplitsAndMerges) {
-  // A camera moving faster than a tiny budget can re-key: the refresh of expired keys may use
-  // only part of the budget, so splits and merges still happen and the mesh follows the camera
-  // (it froze before: every frame's budget went to re-keying).
+  // A camera moving fast under a tiny budget: splits and merges still happen every frame and the
+  // mesh follows the camera (with the old core's lazy keys it froze: every frame's budget went to
+  // re-keying).
   auto l = make_landscape(257, 5);
   auto view = RoamView::create(l, {.threshold = 1.0, .budget_ms = 0.02}).value();
   std::uint64_t changes = 0;
   for (int f = 0; f < 120; ++f) {
     const double a = f * 0.05;
-    const Camera c = camera_at({256 + 200 * std::cos(a), 90, 256 + 200 * std::sin(a)}, {256, 40, 256});
+    const Camera c =
+        camera_at({256 + 200 * std::cos(a), 90, 256 + 200 * std::sin(a)}, {256, 40, 256});
     auto st = view->update(c);
     ASSERT_TRUE(st);
     if (f >= 20) changes += st->splits + st->merges;

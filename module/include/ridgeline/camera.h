@@ -1,4 +1,4 @@
-// Camera: what a view is tessellated for (SPEC.md, camera paths).
+// Camera: what a view is tessellated for (one frame of a camera path, docs/cli.md).
 #pragma once
 
 #include <glm/vec2.hpp>
@@ -60,7 +60,8 @@ struct Frustum {
 };
 
 /// Pixels per metre at unit distance: viewport_height / (2 tan(fov_y / 2)). A world-space error e
-/// at distance d projects to e * projection_scale / d pixels (SPEC.md, projected bound).
+/// at distance d projects to e * projection_scale / d pixels (docs/surface.md, "Error and
+/// budgets": the projected bound).
 double projection_scale(const Camera& camera);
 
 }  // namespace ridgeline

@@ -1,4 +1,4 @@
-// Camera paths (SPEC.md "Camera paths", PATH.json version 1). Part of Ridgeline::io.
+// Camera paths (PATH.json version 1, docs/cli.md "Camera paths"). Part of Ridgeline::io.
 #pragma once
 
 #include <string>

@@ -1,4 +1,4 @@
-// Procedural detail below the stored resolution (SPEC.md "The surface", with L detail levels;
+// Procedural detail below the stored resolution (docs/surface.md "Detail and edits";
 // docs/detail.md): the detail function, its tiles, a tile cache with worker threads, and
 // conservative amplitude bounds. A Terrain created with DetailParams owns a field and a cache
 // and makes them part of its surface (queries, Landscape, RoamView).
@@ -18,7 +18,7 @@
 namespace ridgeline {
 
 /// Everything that defines the detail function. Changing any field changes the surface: do it
-/// only between sessions (SPEC.md). Defaults are sane for a 1-30 m base spacing.
+/// only between sessions (docs/surface.md). Defaults are sane for a 1-30 m base spacing.
 struct DetailParams {
   /// Number of detail levels L, 0..kMaxDetailLevels. Level l has lattice spacing spacing / 2^l;
   /// the finest lattice is level L. 0 disables detail (the surface is the stored one).
@@ -169,7 +169,8 @@ class DetailField {
   /// Generates a tile from its parent tile (the recurrence). `parent` must be the tile
   /// key.parent() for level >= 2 and null for level 1 (whose parent is the zero base detail);
   /// asserted (null is returned past the asserts). 1 <= key.level <= levels(). Thread-safe;
-  /// allocates one tile (about 73 KB; finest tiles also measure their per-level increments, about 0.08 ms).
+  /// allocates one tile (about 73 KB; finest tiles also measure their per-level increments, about
+  /// 0.08 ms).
   std::shared_ptr<const DetailTile> make_tile(const DetailTileKey& key,
                                               const DetailTile* parent) const;
   /// Generates a tile and every ancestor it needs, synchronously (tools and tests).

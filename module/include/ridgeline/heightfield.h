@@ -1,4 +1,5 @@
-// Heightfield: the stored samples of a terrain, validated, placed in the world (SPEC.md, Coordinates).
+// Heightfield: the stored samples of a terrain, validated, placed in the world (docs/surface.md,
+// Coordinates).
 #pragma once
 
 #include <cstdint>
@@ -27,14 +28,14 @@ enum class FillPolicy {
 
 /// Everything needed to turn raw sample values into a placed heightfield. Defaults are sane.
 struct HeightfieldDesc {
-  std::uint32_t width = 0;   ///< samples along x (image columns), >= 2
-  std::uint32_t height = 0;  ///< samples along z (image rows), >= 2
-  double spacing_x = 1.0;    ///< metres between samples along x; finite, > 0
-  double spacing_z = 1.0;    ///< metres between samples along z; finite, > 0
-  double origin_x = 0.0;     ///< world x of sample (0, 0), metres; finite
-  double origin_z = 0.0;     ///< world z of sample (0, 0), metres; finite
-  double height_scale = 1.0;   ///< height = height_offset + height_scale * value; finite, > 0
-  double height_offset = 0.0;  ///< metres; finite
+  std::uint32_t width = 0;       ///< samples along x (image columns), >= 2
+  std::uint32_t height = 0;      ///< samples along z (image rows), >= 2
+  double spacing_x = 1.0;        ///< metres between samples along x; finite, > 0
+  double spacing_z = 1.0;        ///< metres between samples along z; finite, > 0
+  double origin_x = 0.0;         ///< world x of sample (0, 0), metres; finite
+  double origin_z = 0.0;         ///< world z of sample (0, 0), metres; finite
+  double height_scale = 1.0;     ///< height = height_offset + height_scale * value; finite, > 0
+  double height_offset = 0.0;    ///< metres; finite
   std::optional<double> nodata;  ///< raw value that marks a missing sample
   FillPolicy fill = FillPolicy::kRefuse;
   double fill_constant = 0.0;  ///< raw value used by FillPolicy::kConstant; finite
@@ -85,7 +86,7 @@ class Heightfield {
   float local(std::uint32_t i, std::uint32_t j) const noexcept {
     return heights_[i + static_cast<std::size_t>(j) * width_];
   }
-  /// Like local() but clamps (i, j) into the grid: the edge-repeating padding of SPEC.md.
+  /// Like local() but clamps (i, j) into the grid: the edge-repeating padding of docs/surface.md.
   float local_clamped(std::int64_t i, std::int64_t j) const noexcept;
   /// World height of sample (i, j), metres.
   double world(std::uint32_t i, std::uint32_t j) const noexcept {

@@ -69,8 +69,9 @@ struct VertexShading {
 /// Bounds (docs/roam.md, "Error bounds"): for every diamond the exact error of its triangles
 /// (the largest |surface - triangle plane| over every lattice vertex under them), made nested
 /// over the diamond hierarchy, plus a nested bounding sphere. Stored per vertex of the stored
-/// lattice (12 bytes per sample); below the stored resolution (procedural detail) derived from
-/// the detail field's amplitude bounds, or from a resident tile's measured bounds.
+/// lattice (12 bytes of a 28-byte record per sample); below the stored resolution (procedural
+/// detail) derived from the detail field's amplitude bounds, or from a resident tile's measured
+/// bounds.
 ///
 /// Edits: after Terrain::apply_edit() the bounds over the changed region are out of date until
 /// sync() (RoamView::update() calls it first) recomputes exactly the diamonds whose bounds the
@@ -137,7 +138,8 @@ class Landscape {
     return diamond_slow(i, j);
   }
   /// Shading data of finest-lattice vertex (i, j), inside the landscape (padding included).
-  /// Stored once per sample without procedural detail (8 bytes), computed otherwise.
+  /// Stored once per sample without procedural detail (in the bounds' 28-byte record), computed
+  /// otherwise.
   VertexShading shading(std::int64_t i, std::int64_t j) const noexcept {
     if (detail_ == 0 && i >= 0 && j >= 0 && i < stored_w_ && j < stored_h_)
       return unpack(records_[stored_index(i, j)]);
@@ -226,7 +228,7 @@ class Landscape {
   // Recomputes the stored bounds reached by a change of samples [i0, i1] x [j0, j1] (stored
   // coordinates, inclusive); returns the diamonds recomputed.
   std::uint64_t update_region(std::int64_t i0, std::int64_t j0, std::int64_t i1, std::int64_t j1);
-  // Records in tiles of 4 x 4 vertices (384 bytes), tiles row by row: a diamond's neighbours and
+  // Records in tiles of 4 x 4 vertices (448 bytes), tiles row by row: a diamond's neighbours and
   // children at the fine levels share cache lines with it.
   std::size_t stored_index(std::int64_t i, std::int64_t j) const noexcept {
     return ((std::size_t(j) >> 2) * std::size_t(tiles_x_) + (std::size_t(i) >> 2)) * 16 +

@@ -39,7 +39,7 @@ struct RoamSettings {
   double threshold = 2.0;
   /// Hard cap on leaf triangles of the whole landscape; 0 = none. A split (with its chain of
   /// forced splits) that would exceed it is not started. The splits that make the mesh end on the
-  /// border of the sampled data are exempt (docs/roam.md, "The data border").
+  /// border of the sampled data count against it too (docs/roam.md, "The data border").
   std::uint32_t max_triangles = 0;
   /// Time budget per update, milliseconds; 0 = none. The splits and merges that matter most go
   /// first; what is left continues on the next update.
@@ -75,8 +75,8 @@ struct RoamStats {
   /// The threshold the mesh corresponds to (pixels): the threshold, or under a triangle cap the
   /// level at which the cap stopped the refinement. What a vertex shader's geomorph uses.
   double morph_threshold = 0;
-  std::size_t memory_bytes = 0;  ///< view state: nodes, front, free lists (output not counted)
-  std::size_t output_bytes = 0;  ///< patch meshes held for the engine
+  std::size_t memory_bytes = 0;     ///< view state: nodes, front, free lists (output not counted)
+  std::size_t output_bytes = 0;     ///< patch meshes held for the engine
   std::uint32_t dirty_patches = 0;  ///< patches whose mesh changed in this update
   /// Bytes of vertex and index data this update changed: what an engine re-uploads (the dirty
   /// ranges of take_dirty_patches(), or whole buffers that were resized).

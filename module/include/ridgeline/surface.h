@@ -1,4 +1,4 @@
-// The surface contract, defined once (SPEC.md "The surface"; docs/surface.md).
+// The surface contract, defined once (docs/surface.md).
 //
 // Every consumer (the full-detail mesh, height/normal/ray queries, error measurement, tests)
 // locates triangles through the functions in this header, so what physics sees and what the
@@ -23,7 +23,7 @@ constexpr bool cell_has_main_diagonal(std::int64_t i, std::int64_t j) noexcept {
 struct CellTriangle {
   std::uint8_t di[3];
   std::uint8_t dj[3];
-  float w[3];      ///< barycentric weights of the point, summing to 1
+  float w[3];          ///< barycentric weights of the point, summing to 1
   std::uint8_t which;  ///< 0 or 1: which of the cell's two triangles (0 is the one holding (0,0)
                        ///< for the main diagonal, the one holding (0,0) for the anti diagonal)
 };

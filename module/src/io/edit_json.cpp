@@ -1,4 +1,4 @@
-// Edit lists as JSON (SPEC.md "Edits"), parsed with nlohmann-json.
+// Edit lists as JSON (docs/deformation.md, "Brushes"), parsed with nlohmann-json.
 #include "ridgeline/edit_json.h"
 
 #include <algorithm>
@@ -33,11 +33,13 @@ Result<std::vector<Edit>> parse_edits(std::string_view text) {
     Edit ed;
     auto b = e.find("brush");
     if (b == e.end() || !b->is_string())
-      return Error{fmt("edits[%zu]: 'brush' must be one of crater, raise, lower, flatten, smooth", k)};
+      return Error{
+          fmt("edits[%zu]: 'brush' must be one of crater, raise, lower, flatten, smooth", k)};
     auto brush = parse_brush(b->get_ref<const std::string&>());
     if (!brush)
-      return Error{fmt("edits[%zu]: unknown brush '%s'; need crater, raise, lower, flatten or smooth",
-                       k, b->get_ref<const std::string&>().c_str())};
+      return Error{
+          fmt("edits[%zu]: unknown brush '%s'; need crater, raise, lower, flatten or smooth", k,
+              b->get_ref<const std::string&>().c_str())};
     ed.brush = *brush;
     std::string err;
     bool ok = detail::json_number(e, "x", ed.x, true, err) &&

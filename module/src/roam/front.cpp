@@ -32,8 +32,7 @@ inline std::uint32_t screen_test(std::int32_t i, std::int32_t j, float y, float 
   const float s2 = c.planes[2][0] * dx + c.planes[2][1] * dy + c.planes[2][2] * dz;
   const float s3 = c.planes[3][0] * dx + c.planes[3][1] * dy + c.planes[3][2] * dz;
   const float nr = -r, fr = c.far_m + r;
-  const std::uint32_t in =
-      (s0 >= nr) & (s1 >= nr) & (s2 >= nr) & (s3 >= nr) & (d2 <= fr * fr);
+  const std::uint32_t in = (s0 >= nr) & (s1 >= nr) & (s2 >= nr) & (s3 >= nr) & (d2 <= fr * fr);
   float den = std::sqrt(d2) - r;
   den = den > c.near_m ? den : c.near_m;
   p = mu * c.scale / den;
@@ -108,7 +107,8 @@ FrontCamera FrontCamera::screen(const Camera& camera, double threshold_px, doubl
   c.sz = float(sz);
   // Positions are floats of magnitude up to the extent (and the eye's): their rounding, a few
   // units in the last place, is what the test must not lose: 2^-17 of the magnitude, ~64 ulps.
-  const double mag = extent + std::abs(double(c.ex)) + std::abs(double(c.ey)) + std::abs(double(c.ez));
+  const double mag =
+      extent + std::abs(double(c.ex)) + std::abs(double(c.ey)) + std::abs(double(c.ez));
   c.margin = float(std::ldexp(mag, -17));
   return c;
 }
@@ -175,7 +175,11 @@ float Front::evaluate(const FrontCamera& c) {
     return worst;
   }
   changed_.resize(blocks_.size());
-  return std::bit_cast<float>(screen_pass(blocks_.data(), nb, c, changed_.data()));
+  const float worst = std::bit_cast<float>(screen_pass(blocks_.data(), nb, c, changed_.data()));
+  // A lane past the last entry (zeros: a sphere of radius 0 at the lattice origin, bound 0)
+  // never tests active or changed, but tests in view when the origin is: keep it all zeros.
+  for (std::uint32_t e = n_; e < nb * kLanes; ++e) blk(e).state[e & 3] = 0;
+  return worst;
 }
 
 std::uint8_t Front::test_one(std::uint32_t e, const FrontCamera& c) noexcept {

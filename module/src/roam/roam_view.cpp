@@ -5,8 +5,9 @@
 //   2. test the front: one vectorised pass over every diamond that could split or merge
 //   3. merge the split diamonds whose test failed, split the unsplit ones whose test passed,
 //      and test each diamond that appears on the way (so one update goes as deep as it must)
-//   4. under a triangle cap or a time budget, 3 goes in priority order instead: the dual split
-//      and merge queues of D97 section 5, over the candidates of this update only
+//   4. under a time budget, 3 goes in priority order instead: the dual split and merge queues
+//      of D97 section 5, over the candidates of this update only. Under a triangle cap alone
+//      the view searches the threshold that fills the cap instead (converge_capped())
 //
 // With nested bounds and spheres (landscape.h) a diamond's test never passes when a parent's
 // fails, so the converged mesh is the unique one the threshold asks for, whatever the camera's
@@ -33,9 +34,12 @@ using detail::num;
 
 const char* stop_reason_name(StopReason r) noexcept {
   switch (r) {
-    case StopReason::kConverged: return "converged";
-    case StopReason::kTriangleBudget: return "triangle_budget";
-    case StopReason::kTimeBudget: return "time_budget";
+    case StopReason::kConverged:
+      return "converged";
+    case StopReason::kTriangleBudget:
+      return "triangle_budget";
+    case StopReason::kTimeBudget:
+      return "time_budget";
   }
   return "converged";
 }
@@ -51,8 +55,8 @@ float morph_factor(const MeshVertex& v, const glm::vec3& eye, double projection_
 
 float morphed_height(const MeshVertex& v, const glm::vec3& eye, double projection_scale,
                      double threshold_px, double morph_window) noexcept {
-  return v.y + (1.0f - morph_factor(v, eye, projection_scale, threshold_px, morph_window)) *
-                   v.morph_dy;
+  return v.y +
+         (1.0f - morph_factor(v, eye, projection_scale, threshold_px, morph_window)) * v.morph_dy;
 }
 
 // ---- creation and settings --------------------------------------------------------------------
@@ -71,7 +75,9 @@ Result<std::unique_ptr<RoamView>> RoamView::create(std::shared_ptr<const Landsca
 
 RoamView::~RoamView() = default;
 
-std::uint32_t RoamView::triangle_count() const noexcept { return impl_->triangles; }
+std::uint32_t RoamView::triangle_count() const noexcept {
+  return impl_->triangles;
+}
 
 Status RoamView::set_settings(const RoamSettings& s) {
   if (!std::isfinite(s.threshold) || s.threshold < 0.0)
@@ -85,6 +91,7 @@ Status RoamView::set_settings(const RoamSettings& s) {
                      s.max_triangles, landscape_->root_count())};
   if (impl_ && (s.mode != settings_.mode || s.metric != settings_.metric))
     impl_->reset_pending = true;
+  if (impl_ && s.max_triangles != settings_.max_triangles) impl_->cap_threshold = 0;
   settings_ = s;
   return {};
 }
@@ -99,7 +106,9 @@ Result<RoamStats> RoamView::converge(const Camera& camera) {
   return r;
 }
 
-std::vector<std::uint32_t> RoamView::take_dirty_patches() { return impl_->out.take_dirty(); }
+std::vector<std::uint32_t> RoamView::take_dirty_patches() {
+  return impl_->out.take_dirty();
+}
 
 const PatchMesh& RoamView::patch_mesh(std::uint32_t patch) const {
   RIDGELINE_ASSERT(patch < landscape_->patch_count());
@@ -213,7 +222,8 @@ void RoamView::Impl::pull_tiles() {
     }
 }
 
-// ---- phase 3: splits and merges --------------------------------------------------------------------
+// ---- phase 3: splits and merges
+// --------------------------------------------------------------------
 
 bool RoamView::Impl::split_candidate(std::uint32_t n) const {
   if (!nodes[n].leaf()) return false;
@@ -294,7 +304,7 @@ void RoamView::Impl::converge_all() {
 // Under a triangle cap or a time budget: the most important change first (D97's dual queues:
 // split the highest priority, merge the lowest; under a cap, trade a merge for a split while the
 // split matters more). Keys are this update's priorities; out-of-view diamonds merge first.
-void RoamView::Impl::converge_budgeted(double threshold, std::uint32_t cap) {
+float RoamView::Impl::converge_budgeted(double threshold, std::uint32_t cap) {
   Impl& m = *this;
   using Item = std::pair<float, std::uint32_t>;  // priority, node
   std::vector<Item> splits, merges;
@@ -302,13 +312,21 @@ void RoamView::Impl::converge_budgeted(double threshold, std::uint32_t cap) {
   auto merge_key = [&](std::uint32_t e) {
     return (m.front.result(e) & kInView) ? m.front.priority(e, m.cam) : -1.0f;
   };
-  for (std::uint32_t e = 0; e < m.front.size(); ++e) {
-    if (m.front.split(e)) {
-      // Under a cap every mergeable diamond may be traded; otherwise only those the test fails.
-      if (cap != 0 || !(m.front.result(e) & kActive))
+  if (cap == 0) {
+    // Without a cap the candidates are the entries whose test disagrees with their state:
+    // collect()'s lists, which skip the blocks the pass found unchanged.
+    splits.reserve(m.to_split.size());
+    merges.reserve(m.to_merge.size());
+    for (std::uint32_t n : m.to_split) splits.push_back({split_key(m.nodes[n].entry()), n});
+    for (std::uint32_t n : m.to_merge) merges.push_back({-merge_key(m.nodes[n].entry()), n});
+  } else {
+    for (std::uint32_t e = 0; e < m.front.size(); ++e) {
+      if (m.front.split(e)) {
+        // Under a cap every mergeable diamond may be traded.
         merges.push_back({-merge_key(e), m.front.node(e)});
-    } else if (m.front.result(e) & kActive) {
-      splits.push_back({split_key(e), m.front.node(e)});
+      } else if (m.front.result(e) & kActive) {
+        splits.push_back({split_key(e), m.front.node(e)});
+      }
     }
   }
   std::make_heap(splits.begin(), splits.end());
@@ -340,8 +358,8 @@ void RoamView::Impl::converge_budgeted(double threshold, std::uint32_t cap) {
   auto top_merge = [&]() -> const Item* {
     while (!merges.empty()) {
       const std::uint32_t n = merges.front().second;
-      if (!m.nodes[n].leaf() && m.nodes[n].entry() != kNoEntry && m.front.split(m.nodes[n].entry()) &&
-          m.mergeable(n))
+      if (!m.nodes[n].leaf() && m.nodes[n].entry() != kNoEntry &&
+          m.front.split(m.nodes[n].entry()) && m.mergeable(n))
         break;
       std::pop_heap(merges.begin(), merges.end());
       merges.pop_back();
@@ -361,9 +379,8 @@ void RoamView::Impl::converge_budgeted(double threshold, std::uint32_t cap) {
 #endif
     // The merged diamond may split again later (a trade back); its parents may merge next.
     fresh.push_back(n);
-    for (std::uint32_t p : {m.nodes[n].parent, m.nodes[n].base != kNone
-                                                   ? m.nodes[m.nodes[n].base].parent
-                                                   : kNone})
+    for (std::uint32_t p :
+         {m.nodes[n].parent, m.nodes[n].base != kNone ? m.nodes[m.nodes[n].base].parent : kNone})
       if (p != kNone) fresh.push_back(p);
     push_fresh();
   };
@@ -432,9 +449,70 @@ void RoamView::Impl::converge_budgeted(double threshold, std::uint32_t cap) {
     }
     break;
   }
+  // What stays unsplit in view: the splits left in the queue (active), and the tests that failed
+  // (fresh_worst: this update's pass and every diamond tested since).
+  const Item* s = top_split();
+  return std::max(m.fresh_worst, s ? s->first : 0.0f);
 }
 
-// ---- the update ------------------------------------------------------------------------------------
+roam::FrontCamera RoamView::Impl::front_camera(const Camera& camera, double px) const {
+  return FrontCamera::screen(camera, px, land.world_x(0),
+                             land.terrain().heightfield().height_offset(), land.world_z(0),
+                             land.spacing_x(), land.spacing_z(), land.local_extent());
+}
+
+// Under a triangle cap alone. Splitting the highest priority first until the cap is reached
+// (the dual queues) ends in the mesh of one threshold: the priority of the last split. So the
+// view looks for that threshold instead of ordering every change: it converges at the last
+// update's threshold (the unbudgeted path: a pass over the front and only the changes), raises
+// the threshold while the mesh exceeds the cap (merges, the cheap direction), and when the mesh
+// ends well under the cap, starts the next update lower. The mesh then follows the camera at
+// the cost of an unbudgeted update, where ordering the whole front by priority each update cost
+// ~2x. The first update (and any that does not fit after a few raises) uses the queues, which
+// hit the cap exactly; their remaining priority seeds the search.
+double RoamView::Impl::converge_capped(const Camera& camera, double threshold, std::uint32_t cap) {
+  Impl& m = *this;
+  if (m.cap_threshold <= 0.0) {
+    m.fresh_worst = converge_budgeted(threshold, cap);
+    const double reached = m.st.stop == StopReason::kTriangleBudget
+                               ? std::max(threshold, double(m.fresh_worst))
+                               : threshold;
+    m.cap_threshold = reached;
+    return reached;
+  }
+  // N(tau) falls roughly as tau^-1.5 on terrain: steps of the ratio^(2/3), at least 1 %.
+  constexpr double kExponent = 2.0 / 3.0, kTarget = 0.99, kLowerBelow = 0.985;
+  double tau = std::max(threshold, m.cap_threshold);
+  for (int pass = 0;; ++pass) {
+    if (pass > 0) {
+      m.cam = front_camera(camera, tau);
+      m.fresh_worst = m.front.evaluate(m.cam);
+      m.st.priority_updates += m.front.size();
+      m.collect();
+    }
+    converge_all();
+    if (m.triangles <= cap) break;
+    if (pass == 4) {
+      // Still over: let the queues trade down to the cap at this threshold.
+      m.fresh_worst = converge_budgeted(tau, cap);
+      tau = std::max(tau, double(m.fresh_worst));
+      break;
+    }
+    tau *= std::clamp(std::pow(double(m.triangles) / (kTarget * cap), kExponent), 1.01, 4.0);
+  }
+  // Where the next update starts: lower when this mesh ended well under the cap.
+  double next = tau;
+  if (m.triangles < kLowerBelow * cap && tau > threshold)
+    next = std::max(
+        threshold,
+        tau * std::clamp(std::pow(double(m.triangles) / (kTarget * cap), kExponent), 0.25, 0.99));
+  m.cap_threshold = next;
+  m.st.stop = tau > threshold ? StopReason::kTriangleBudget : StopReason::kConverged;
+  return tau;
+}
+
+// ---- the update
+// ------------------------------------------------------------------------------------
 
 Result<RoamStats> RoamView::update(const Camera& camera) {
   const bool screen = settings_.metric == ErrorMetric::kScreenPixels;
@@ -446,10 +524,11 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
   const Landscape& l = *landscape_;
   const double threshold = settings_.threshold;
   const std::uint32_t cap = settings_.max_triangles;
-  m.cam = screen ? FrontCamera::screen(camera, threshold, l.world_x(0),
-                                       l.terrain().heightfield().height_offset(), l.world_z(0),
-                                       l.spacing_x(), l.spacing_z(), l.local_extent())
-                 : FrontCamera::world_metres(threshold);
+  // Under a cap alone, the test starts at the threshold the last update's search ended at.
+  const bool capped =
+      cap != 0 && !(settings_.budget_ms > 0.0) && screen && settings_.mode == RoamMode::kCoherent;
+  const double start_px = capped ? std::max(threshold, m.cap_threshold) : threshold;
+  m.cam = screen ? m.front_camera(camera, start_px) : FrontCamera::world_metres(threshold);
   m.has_deadline = settings_.budget_ms > 0.0;
   m.deadline = t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                         std::chrono::duration<double, std::milli>(settings_.budget_ms));
@@ -484,8 +563,8 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
   // from the roots then costs less than merging it away first. The merge candidates tell (each
   // cascades up its ancestors); splits alone never do (a threshold drop keeps the whole mesh).
   // Not under a budget: a budgeted update keeps the mesh and improves it in priority order.
-  if (settings_.mode == RoamMode::kCoherent && !m.st.rebuilt && cap == 0 && !m.has_deadline &&
-      m.to_merge.size() > std::max<std::size_t>(512, m.front.size() / 8)) {
+  if (settings_.mode == RoamMode::kCoherent && !m.st.rebuilt && (cap == 0 || capped) &&
+      !m.has_deadline && m.to_merge.size() > std::max<std::size_t>(512, m.front.size() / 8)) {
     m.reset();
     m.fresh_worst = m.front.evaluate(m.cam);
     m.st.priority_updates += m.front.size();
@@ -493,8 +572,11 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
   }
 
   // 3-4. Splits and merges.
-  if (cap != 0 || m.has_deadline)
-    m.converge_budgeted(threshold, cap);
+  double reached_px = threshold;
+  if (capped)
+    reached_px = m.converge_capped(camera, threshold, cap);
+  else if (cap != 0 || m.has_deadline)
+    m.fresh_worst = m.converge_budgeted(threshold, cap);
   else
     m.converge_all();
 
@@ -503,12 +585,13 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
   m.st.front_size = m.front.size();
   // Unbudgeted, every diamond whose test fails ends unsplit and every other one split (or
   // waiting for a tile): the largest failing priority seen is the remaining error. Under a budget
-  // some that pass stay unsplit: read the front.
-  const float remaining =
-      (cap != 0 || m.has_deadline) ? m.front.max_unsplit_priority(m.cam) : m.fresh_worst;
+  // the splits left in the queue are added (converge_budgeted()).
+  const float remaining = m.fresh_worst;
   m.st.max_remaining_error = remaining;
-  m.st.morph_threshold =
-      m.st.stop == StopReason::kTriangleBudget ? std::max(threshold, double(remaining)) : threshold;
+  m.st.morph_threshold = capped ? reached_px
+                         : m.st.stop == StopReason::kTriangleBudget
+                             ? std::max(threshold, double(remaining))
+                             : threshold;
   m.st.memory_bytes = m.nodes.memory_bytes() + m.front.memory_bytes() +
                       (m.to_merge.capacity() + m.to_split.capacity()) * sizeof(std::uint32_t);
   m.st.output_bytes = m.out.memory_bytes();

@@ -11,8 +11,8 @@
 
 #include <array>
 #include <chrono>
-#include <cstdlib>
 #include <cstdint>
+#include <cstdlib>
 #include <memory>
 #include <string>
 #include <unordered_set>
@@ -54,6 +54,8 @@ struct RoamView::Impl {
   bool has_deadline = false;
   std::chrono::steady_clock::time_point deadline;
   std::uint32_t clock_checks = 0;
+  // Under a triangle cap: the threshold the last update ended at (0: none yet).
+  double cap_threshold = 0;
 
   // ---- geometry of a node (from its front entry, or its parent's) ---------------------------
 
@@ -112,9 +114,16 @@ struct RoamView::Impl {
   /// The front's entries whose test disagrees with their state, into to_merge and to_split.
   void collect();
   void converge_all();
-  void converge_budgeted(double threshold, std::uint32_t cap);
+  /// Returns the largest priority in view left unsplit.
+  float converge_budgeted(double threshold, std::uint32_t cap);
+  /// Under a triangle cap alone: converges at the smallest threshold (>= `threshold`) found
+  /// whose mesh fits the cap, starting from the last update's; returns that threshold.
+  double converge_capped(const Camera& camera, double threshold, std::uint32_t cap);
+  /// The camera of the front's test at threshold `px`.
+  roam::FrontCamera front_camera(const Camera& camera, double px) const;
 
-  // ---- walks (mesh_walk.cpp) ---------------------------------------------------------------------
+  // ---- walks (mesh_walk.cpp)
+  // ---------------------------------------------------------------------
 
   /// Depth first over every root's tree, child 0 first: fn(node, root, heap, triangle, leaf).
   template <class Fn>

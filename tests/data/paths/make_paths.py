@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes the camera paths (SPEC.md PATH.json) used by tests and benchmarks on the built-in
+"""Writes the camera paths (PATH.json, docs/cli.md "Camera paths") used by tests and benchmarks on the built-in
 default terrain (2048 m x 2048 m, heights about 0..260 m):
   flyover.json   360 frames, a circle of radius 600 m at 380 m, looking ahead and down
   drive.json     600 frames, 2 m above the ground along a winding road at 20 m/s

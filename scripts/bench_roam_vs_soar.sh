@@ -1,0 +1,105 @@
+#!/usr/bin/env bash
+# ROAM (frame-coherent RoamView) against the stateless SOAR refinement, like for like, on the
+# 1025 x 1025 value-noise field and its 360-frame circular flyover (written by
+# `ridge report --write-noise-field`): per row the two runs alternate ROUNDS times in one script
+# run, so that a change in the machine's load hits both; each run's figures are medians over the
+# path, and the row reports the median over rounds of each figure and of the per-round ratio.
+#
+#   ROAM: update + output (the update, which patches the per-patch buffers in place, plus taking
+#         the dirty ranges an engine uploads)
+#   SOAR: refinement + emission of the whole triangle strip, from scratch every frame
+#
+# Rows: at equal whole-landscape triangle counts (--triangles N --threshold 0: ROAM's cap; SOAR's
+# one kappa whose median count over the path is closest to N), and both at --threshold 1.
+# Usage: scripts/bench_roam_vs_soar.sh [OUT.json]   (default docs/benchmarks/roam_vs_soar.json)
+# ROUNDS=N (default 3).
+set -euo pipefail
+source "$(dirname "$0")/lib/common.sh"
+cd "$RIDGELINE_ROOT"
+out=${1:-docs/benchmarks/roam_vs_soar.json}
+rounds=${ROUNDS:-3}
+work=build/bench
+mkdir -p "$work" "$(dirname "$out")"
+ensure_packages "${RIDGELINE_PACKAGES[@]}" python3
+configure_and_build build/release -DCMAKE_BUILD_TYPE=Release > /dev/null
+ridge=build/release/module/ridge
+[ -f "$work/noise1025.png" ] && [ -f "$work/noise1025_circle.json" ] ||
+  "$ridge" report --write-noise-field "$work"
+noise=(--heightmap "$work/noise1025.png" --spacing 1 --height-scale 0.005
+       --path "$work/noise1025_circle.json" --warmup 60 --error-every 10)
+
+rm -f "$work/vs_soar.jsonl"
+run() {  # ROW MODE ROUND ARGS...
+  local row=$1 mode=$2 round=$3; shift 3
+  local f="$work/vs_soar_${row}_${mode}_${round}.json"
+  "$ridge" bench lod "${noise[@]}" --mode "$mode" "$@" --json "$f" ||
+    { echo "bench_roam_vs_soar.sh: $row $mode failed" >&2; exit 1; }
+  python3 - "$f" "$row" "$mode" "$round" "$(cut -d' ' -f1 /proc/loadavg)" \
+    >> "$work/vs_soar.jsonl" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))["summary"]
+print(json.dumps({"row": sys.argv[2], "mode": sys.argv[3], "round": int(sys.argv[4]),
+                  "load": float(sys.argv[5]), "summary": s}))
+PY
+}
+for row in n5250 n20800 n53000 t1; do
+  case $row in
+    t1) args=(--threshold 1) ;;
+    *) args=(--triangles "${row#n}" --threshold 0) ;;
+  esac
+  for ((k = 0; k < rounds; ++k)); do
+    run "$row" coherent "$k" "${args[@]}"
+    run "$row" soar "$k" "${args[@]}"
+  done
+done
+
+python3 - "$work/vs_soar.jsonl" "$out" "$rounds" <<'PY'
+import json, statistics, sys
+runs = [json.loads(l) for l in open(sys.argv[1])]
+med = statistics.median
+rows = []
+for row in dict.fromkeys(r["row"] for r in runs):
+    c = [r for r in runs if r["row"] == row and r["mode"] == "coherent"]
+    s = [r for r in runs if r["row"] == row and r["mode"] == "soar"]
+    def m(rs, key):
+        v = [r["summary"][key] for r in rs if r["summary"].get(key) is not None]
+        return med(v) if v else None
+    ratio_wall = [b["summary"]["update_ms_median"] / a["summary"]["update_plus_output_ms_median"]
+                  for a, b in zip(c, s)]
+    ratio_cpu = [b["summary"]["update_cpu_ms_median"] /
+                 a["summary"]["update_plus_output_cpu_ms_median"] for a, b in zip(c, s)]
+    rows.append({
+        "row": row,
+        "roam_update_plus_output_ms": m(c, "update_plus_output_ms_median"),
+        "roam_update_plus_output_cpu_ms": m(c, "update_plus_output_cpu_ms_median"),
+        "roam_update_ms": m(c, "update_ms_median"),
+        "roam_output_ms": m(c, "output_ms_median"),
+        "soar_refine_and_emit_ms": m(s, "update_ms_median"),
+        "soar_refine_and_emit_cpu_ms": m(s, "update_cpu_ms_median"),
+        "soar_refine_only_ms": m(s, "refine_only_ms_median"),
+        "soar_over_roam_wall": med(ratio_wall),
+        "soar_over_roam_cpu": med(ratio_cpu),
+        "roam_triangles": m(c, "triangles_median"),
+        "soar_triangles": m(s, "triangles_median"),
+        "roam_triangles_in_view": m(c, "triangles_in_view_median"),
+        "soar_triangles_in_view": m(s, "triangles_in_view_median"),
+        "roam_rms_error_m": m(c, "rms_error_median"),
+        "soar_rms_error_m": m(s, "rms_error_median"),
+        "roam_max_screen_error_px": m(c, "max_screen_error_px_median"),
+        "soar_max_screen_error_px": m(s, "max_screen_error_px_median"),
+        "roam_upload_bytes": m(c, "upload_bytes_median"),
+        "soar_upload_bytes": m(s, "upload_bytes_median"),
+        "roam_changes_per_frame": m(c, "changes_per_frame_median"),
+        "roam_view_bytes_per_triangle": m(c, "view_bytes_per_triangle"),
+        "roam_output_bytes_per_triangle": m(c, "output_bytes_per_triangle"),
+        "load_average": [r["load"] for r in c + s],
+    })
+json.dump({"command": "scripts/bench_roam_vs_soar.sh", "rounds": int(sys.argv[3]),
+           "rows": rows}, open(sys.argv[2], "w"), indent=1)
+for r in rows:
+    print(f'{r["row"]:>7}: ROAM {r["roam_update_plus_output_ms"]:.3f} ms, SOAR '
+          f'{r["soar_refine_and_emit_ms"]:.3f} ms, SOAR/ROAM {r["soar_over_roam_wall"]:.2f} (wall) '
+          f'{r["soar_over_roam_cpu"]:.2f} (cpu); triangles {r["roam_triangles"]:.0f} / '
+          f'{r["soar_triangles"]:.0f}; RMS {r["roam_rms_error_m"]:.3f} / {r["soar_rms_error_m"]:.3f} m')
+PY
+echo "wrote $out"
