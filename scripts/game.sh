@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The main command: builds Ridgeline and runs the sample game's default scenario (a convoy on a
-# loop of waypoints over the hills while artillery drops craters near it, with the LOD budget
-# controller holding the frame time).
+# loop of waypoints over the hills of the detail world while artillery drops craters and
+# engineers reshape the ground near it, with the LOD budget controller holding the frame time by
+# the pixel threshold and the render scale).
 #  - With a display: opens a window (close it to quit). Keys in docs/game.md.
 #  - Without one: renders offscreen (under xvfb-run when it is installed, else EGL surfaceless)
 #    for FRAMES frames (default 600 = 10 s of game time) and writes screenshots and per-frame
@@ -34,13 +35,22 @@ python3 - "$out/stats.json" <<'PY' 2>/dev/null || true
 import json, sys
 d = json.load(open(sys.argv[1]))
 s = d["summary"]
-print("frame ms p50 %.1f p90 %.1f p99 %.1f (target %.0f ms); threshold p50 %.2f px; "
-      "%d craters; %d script errors" % (s["frame_ms"]["p50"], s["frame_ms"]["p90"],
-      s["frame_ms"]["p99"], s["target_ms"], s["threshold_px"]["p50"], s["craters"],
-      s["script_errors"]))
+print("frame ms p50 %.1f p90 %.1f p99 %.1f (target %.0f ms); threshold p50 %.2f px; render scale "
+      "p50 %.2f; %d craters; %d script errors" % (s["frame_ms"]["p50"], s["frame_ms"]["p90"],
+      s["frame_ms"]["p99"], s["target_ms"], s["threshold_px"]["p50"], s["render_scale"]["p50"],
+      s["craters"], s["script_errors"]))
+b = s["frame_time_breakdown_ms"]
+print("where the frame goes (median ms): " + ", ".join("%s %.1f" % (k, b[k]["p50"]) for k in
+      ("scripts", "physics", "tessellation", "upload", "render", "panel")))
+print("procedural detail: %d level(s); tiles resident up to %d, pending up to %d; view converged "
+      "in %.0f %% of frames" % (s["detail_levels"], s["detail_tiles_resident_max"],
+      s["detail_tiles_pending_max"], 100 * s["view_stop_fraction"]["converged"]))
 last = d["frames"][-1]
+names = ["grass", "rock", "sand", "snow", "mud", "gravel"]
 for v in last["vehicles"]:
-    print("vehicle %d at (%.0f, %.0f, %.0f), %d waypoints reached" % (v["id"], *v["position"],
-          v["waypoints_reached"]))
+    m = v["material"]
+    print("vehicle %d at (%.0f, %.0f, %.0f) on %s, %d waypoints reached, %d collisions" % (
+          v["id"], *v["position"], names[m] if m < len(names) else m, v["waypoints_reached"],
+          v["collisions"]))
 PY
 echo "done: $(ls "$out"/*.png | wc -l) screenshots in $out/ (last: $out/last_frame.png), per-frame statistics in $out/stats.json"

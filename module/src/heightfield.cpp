@@ -250,17 +250,32 @@ Result<Heightfield> make_default_heightfield(const DefaultTerrainParams& p) {
       values[i + j * n] = static_cast<float>(h - 40.0);
     }
   }
-  // Materials per cell from slope and height.
+  // The material map, per cell, from slope, height and two noise fields (ids listed in
+  // heightfield.h): rock on cliffs, gravel (scree) on steep slopes below them, snow on the
+  // highest ground, sand in the lowest valleys, mud in patches of flat low ground, grass
+  // elsewhere. Heights are compared as fractions of the terrain's range so that other sizes and
+  // seeds get the same mix.
+  float lo = values[0], hi = values[0];
+  for (float v : values) lo = std::min(lo, v), hi = std::max(hi, v);
+  const double range = std::max(1.0, double(hi) - double(lo));
   std::vector<std::uint8_t> mats((n - 1) * (n - 1));
   for (std::size_t j = 0; j + 1 < n; ++j) {
     for (std::size_t i = 0; i + 1 < n; ++i) {
       const float h00 = values[i + j * n], h10 = values[i + 1 + j * n];
       const float h01 = values[i + (j + 1) * n];
       const double slope = std::max(std::abs(h10 - h00), std::abs(h01 - h00)) / p.spacing;
-      std::uint8_t m = 0;
-      if (h00 < 15.0f) m = 2;
-      if (h00 > 200.0f) m = 3;
-      if (slope > 0.8) m = 1;
+      const double t = (double(h00) - lo) / range;  // 0 lowest .. 1 highest
+      const double u = double(i) * 1024.0 / double(n - 1), v = double(j) * 1024.0 / double(n - 1);
+      // Patchiness: low-frequency noise (about 60 m features) for mud, and a little
+      // higher-frequency noise to fray the borders of sand and snow.
+      const double patch = value_noise(u / 30.0, v / 30.0, p.seed + 200);
+      const double fray = 0.04 * (value_noise(u / 6.0, v / 6.0, p.seed + 300) - 0.5);
+      std::uint8_t m = 0;                                             // grass
+      if (t + fray < 0.12) m = 2;                                     // sand
+      if (t + fray > 0.80) m = 3;                                     // snow
+      if (m == 0 && slope < 0.15 && t < 0.45 && patch > 0.66) m = 4;  // mud
+      if (slope > 0.55) m = 5;                                        // gravel
+      if (slope > 0.8) m = 1;                                         // rock
       mats[i + j * (n - 1)] = m;
     }
   }

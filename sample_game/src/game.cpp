@@ -6,12 +6,10 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <lua.hpp>
 #include <sstream>
 
-#include <lua.hpp>
-
-#include "ridgeline/log.h"
-
+#include "collision.h"
 #include "ridgeline/edit.h"
 
 namespace game {
@@ -22,14 +20,32 @@ using ridgeline::Status;
 
 const char* to_string(CameraMode mode) noexcept {
   switch (mode) {
-    case CameraMode::kFree: return "free";
-    case CameraMode::kFollow: return "follow";
-    default: return "map";
+    case CameraMode::kFree:
+      return "free";
+    case CameraMode::kFollow:
+      return "follow";
+    default:
+      return "map";
   }
 }
 
+ridgeline::DetailParams default_world_detail() {
+  ridgeline::DetailParams d;
+  d.levels = 1;       // 2 m stored spacing -> 1 m finest spacing
+  d.amplitude = 0.2;  // first octave, metres (0.1 x the stored spacing)
+  d.gain = 0.5;
+  d.seed = 17;
+  return d;
+}
+
+namespace {
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+}  // namespace
+
 Game::~Game() {
-  host_.reset();  // Lua first: its userdata refer to the game
+  scripts_.reset();  // Lua first: its userdata refer to the game
 }
 
 Result<std::unique_ptr<Game>> Game::create(const GameOptions& options) {
@@ -39,7 +55,21 @@ Result<std::unique_ptr<Game>> Game::create(const GameOptions& options) {
     return Error{"game: time step " + std::to_string(options.dt) + " s; need 0 < dt <= 0.1"};
   auto hf = ridgeline::make_default_heightfield();
   if (!hf) return Error{hf.error().message};
-  g->terrain_ = ridgeline::Terrain::create(std::move(*hf));
+  if (options.detail.levels > 0) {
+    ridgeline::DetailCacheDesc cd;
+    cd.worker_threads = options.detail_workers;
+    cd.budget_bytes = options.detail_budget_bytes;
+    auto t = ridgeline::Terrain::create(std::move(*hf), options.detail, cd);
+    if (!t) return Error{"game: " + t.error().message};
+    g->terrain_ = std::move(*t);
+    ridgeline::DetailViewRule rule;
+    rule.pixels = options.detail_stream_pixels;
+    auto stream = ridgeline::DetailStream::create(*g->terrain_->detail_cache(), rule);
+    if (!stream) return Error{"game: " + stream.error().message};
+    g->stream_.emplace(std::move(*stream));
+  } else {
+    g->terrain_ = ridgeline::Terrain::create(std::move(*hf));
+  }
   auto land = ridgeline::Landscape::create(g->terrain_, {.patch_exponent = options.patch_exponent});
   if (!land) return Error{land.error().message};
   g->landscape_ = *land;
@@ -58,6 +88,9 @@ Result<std::unique_ptr<Game>> Game::create(const GameOptions& options) {
   if (!ctl) return Error{ctl.error().message};
   g->controller_ = *ctl;
   g->threshold_ = options.fixed_threshold > 0 ? options.fixed_threshold : ctl->threshold();
+  g->render_scale_ = options.fixed_threshold > 0 && options.fixed_render_scale > 0
+                         ? options.fixed_render_scale
+                         : ctl->render_scale();
   g->controller_on_ = options.fixed_threshold <= 0;
   for (const char* name : {"truck", "buggy"}) {
     const std::string path = options.assets_dir + "/vehicles/" + name + ".glb";
@@ -68,64 +101,10 @@ Result<std::unique_ptr<Game>> Game::create(const GameOptions& options) {
   ridgeline::lua::HostOptions ho;
   ho.instruction_limit = options.instruction_limit;
   ho.data_root = options.scripts_dir;
-  auto host = ridgeline::lua::Host::create(ho);
-  if (!host) return Error{host.error().message};
-  g->host_ = std::move(*host);
-  if (Status s = install_game_api(*g); !s) return Error{s.message()};
+  auto runner = ScriptRunner::create(*g, ho, options.console);
+  if (!runner) return Error{runner.error().message};
+  g->scripts_ = std::move(*runner);
   return g;
-}
-
-void Game::log(const std::string& line) {
-  ridgeline::log_message(ridgeline::LogLevel::kInfo, line);
-  log_lines.push_back(line);
-  while (log_lines.size() > 200) log_lines.pop_front();
-}
-
-void Game::record_error(int script, const std::string& message) {
-  ScriptError e;
-  e.script = script >= 0 && script < int(scripts.size()) ? scripts[script].name : "(game)";
-  e.message = message;
-  e.frame = frame_;
-  std::fprintf(stderr, "script error in %s (frame %llu): %s\n", e.script.c_str(),
-               static_cast<unsigned long long>(frame_), message.c_str());
-  errors_.push_back(std::move(e));
-  while (errors_.size() > 20) errors_.pop_front();
-  ++error_count_;
-  if (script >= 0 && script < int(scripts.size())) scripts[script].failed = true;
-}
-
-std::vector<std::string> Game::script_names() const {
-  std::vector<std::string> out;
-  for (const Script& s : scripts) out.push_back(s.name);
-  return out;
-}
-
-Status Game::load_script(const std::string& path) {
-  for (std::size_t i = 0; i < scripts.size(); ++i)
-    if (scripts[i].path == path) return run_script(int(i));
-  Script s;
-  s.path = path;
-  s.name = std::filesystem::path(path).filename().string();
-  scripts.push_back(s);
-  return run_script(int(scripts.size() - 1));
-}
-
-int Game::reload_changed_scripts() {
-  int n = 0;
-  for (std::size_t i = 0; i < scripts.size(); ++i) {
-    std::error_code ec;
-    const auto t = std::filesystem::last_write_time(scripts[i].path, ec);
-    if (!ec && t != scripts[i].mtime) {
-      (void)run_script(int(i));
-      ++n;
-    }
-  }
-  return n;
-}
-
-int Game::reload_all_scripts() {
-  for (std::size_t i = 0; i < scripts.size(); ++i) (void)run_script(int(i));
-  return int(scripts.size());
 }
 
 ridgeline::Result<int> Game::spawn(const std::string& model, double x, double z, double heading,
@@ -133,19 +112,24 @@ ridgeline::Result<int> Game::spawn(const std::string& model, double x, double z,
   const VehicleModel* m = this->model(model);
   if (m == nullptr) return Error{"spawn: unknown model '" + model + "' (truck, buggy)"};
   const auto h = terrain_->height(x, z);
-  if (!h) return Error{"spawn: (" + std::to_string(x) + ", " + std::to_string(z) +
-                       ") is off the terrain"};
+  if (!h)
+    return Error{"spawn: (" + std::to_string(x) + ", " + std::to_string(z) +
+                 ") is off the terrain"};
   if (vehicles_.size() >= 64) return Error{"spawn: 64 vehicles at most"};
   VehicleParams p = params_from_model(*m, model == "truck" ? 3000.0 : 1200.0);
   if (model == "buggy") p.max_speed = 30;
   const double start_y = *h + p.com_in_model.y + p.rest_length * 0.5;
-  VehicleEntry e{next_vehicle_id_++, name.empty() ? model : name, model,
-                 Vehicle(p, {x, start_y, z}, heading), {}, 0};
+  VehicleEntry e{next_vehicle_id_++,
+                 name.empty() ? model : name,
+                 model,
+                 Vehicle(p, {x, start_y, z}, heading),
+                 {},
+                 0};
   e.body.chassis_min = glm::dvec3(m->body_min) - p.com_in_model;
   e.body.chassis_max = glm::dvec3(m->body_max) - p.com_in_model;
   // The chassis box check uses the bottom of the frame, not the (lower) wheels.
-  e.body.chassis_min.y = std::max(e.body.chassis_min.y,
-                                  double(m->wheel_centres[0].y) - p.com_in_model.y);
+  e.body.chassis_min.y =
+      std::max(e.body.chassis_min.y, double(m->wheel_centres[0].y) - p.com_in_model.y);
   e.body.place_on_surface(*terrain_, x, z, heading);
   const int id = e.id;
   vehicles_.emplace(id, std::move(e));
@@ -157,7 +141,12 @@ VehicleEntry* Game::vehicle(int id) {
   return it == vehicles_.end() ? nullptr : &it->second;
 }
 
-bool Game::remove_vehicle(int id) { return vehicles_.erase(id) > 0; }
+bool Game::remove_vehicle(int id) {
+  if (vehicles_.erase(id) == 0) return false;
+  for (auto it = touching_.begin(); it != touching_.end();)
+    it = it->first.first == id || it->first.second == id ? touching_.erase(it) : std::next(it);
+  return true;
+}
 
 const VehicleModel* Game::model(const std::string& name) const {
   auto it = models_.find(name);
@@ -187,12 +176,13 @@ void Game::clamp_to_terrain(VehicleEntry& e) {
 void Game::step() {
   burned_ms_ = 0;
   const double dt = options_.dt;
+  const double scripts_before = scripts_->take_script_ms();
   // Craters made since the last step (from scripts: handlers do not nest inside a script call).
   for (; craters_emitted_ < craters_.size(); ++craters_emitted_) {
     const CraterRecord& c = craters_[craters_emitted_];
     double a[4] = {c.x, c.z, c.radius, c.depth};
-    emit_event(
-        *this, "crater",
+    emit(
+        "crater",
         [](lua_State* L, void* u) -> int {
           for (int i = 0; i < 4; ++i) lua_pushnumber(L, static_cast<const double*>(u)[i]);
           return 4;
@@ -200,8 +190,8 @@ void Game::step() {
         a);
   }
   double args[2] = {dt, time()};
-  emit_event(
-      *this, "tick",
+  emit(
+      "tick",
       [](lua_State* L, void* u) -> int {
         const double* a = static_cast<const double*>(u);
         lua_pushnumber(L, a[0]);
@@ -209,11 +199,17 @@ void Game::step() {
         return 2;
       },
       args);
+  const auto t_physics = std::chrono::steady_clock::now();
+  double waypoint_scripts_ms = 0;
   for (auto& [id, e] : vehicles_) {
     if (e.autopilot.drive(e.body)) {
-      struct Arg { int id; std::size_t index; } arg{id, e.autopilot.next};
-      emit_event(
-          *this, "waypoint",
+      struct Arg {
+        int id;
+        std::size_t index;
+      } arg{id, e.autopilot.next};
+      const auto t0 = std::chrono::steady_clock::now();
+      emit(
+          "waypoint",
           [](lua_State* L, void* u) -> int {
             const auto* a = static_cast<const Arg*>(u);
             lua_pushinteger(L, a->id);
@@ -221,6 +217,7 @@ void Game::step() {
             return 2;
           },
           &arg);
+      waypoint_scripts_ms += ms_since(t0);
     }
   }
   follow_terrain_edits();
@@ -232,7 +229,16 @@ void Game::step() {
     const glm::dvec3 d = e.body.position() - before;
     e.distance_m += std::hypot(d.x, d.z);
   }
+  contacts_ = resolve_vehicle_contacts(vehicles_, touching_);
+  step_times_.physics_ms += ms_since(t_physics) - waypoint_scripts_ms;
+  step_times_.scripts_ms += scripts_->take_script_ms() + scripts_before;
   ++frame_;
+}
+
+StepTimes Game::take_step_times() noexcept {
+  const StepTimes t = step_times_;
+  step_times_ = {};
+  return t;
 }
 
 Result<std::size_t> Game::crater(double x, double z, double radius, double depth) {
@@ -288,8 +294,10 @@ ridgeline::Camera Game::camera() const {
     case CameraMode::kFollow: {
       const VehicleEntry* e = nullptr;
       auto it = vehicles_.find(rig_.follow_vehicle);
-      if (it != vehicles_.end()) e = &it->second;
-      else if (!vehicles_.empty()) e = &vehicles_.begin()->second;
+      if (it != vehicles_.end())
+        e = &it->second;
+      else if (!vehicles_.empty())
+        e = &vehicles_.begin()->second;
       if (e == nullptr) {
         c.eye = rig_.free_eye;
         c.target = c.eye + glm::dvec3(0.5, -0.3, 0.5);
@@ -315,25 +323,75 @@ ridgeline::Camera Game::camera() const {
 }
 
 ViewFrame Game::update_view(double frame_ms) {
-  if (controller_on_ && frame_ms > 0)
+  if (controller_on_ && frame_ms > 0) {
     threshold_ = controller_.update(frame_ms, frame_ms / 1000.0);
+    render_scale_ = controller_.render_scale();
+  }
   ViewFrame out;
-  out.threshold = threshold_;
+  // The controller's threshold as it is: the view re-tests its whole split and merge front every
+  // update, so any change, however small, moves the mesh both ways.
+  const double view_threshold = threshold_;
+  out.threshold = view_threshold;
+  out.render_scale = render_scale_;
   if (!options_.tessellate) return last_view_ = out;
   ridgeline::RoamView& v = active_view();
   ridgeline::RoamSettings s = v.settings();
-  s.threshold = threshold_;
+  s.threshold = view_threshold;
   s.max_triangles = max_triangles_;
   s.budget_ms = tess_budget_ms_;
-  if (Status st = v.set_settings(s); !st) log("view settings: " + st.message());
-  auto r = v.update(camera());
+  if (Status st = v.set_settings(s); !st) scripts_->log("view settings: " + st.message());
+  const ridgeline::Camera cam = camera();
+  const int vi = int(rig_.mode);
+  if (stream_) {  // tiles for where the camera is going, ahead of the view's own requests
+    auto f = stream_->frame(cam);
+    if (f) detail_frame_ = *f;
+  }
+  auto r = v.update(cam);
+  ridgeline::DetailCache* cache = terrain_->detail_cache();
+  // Prefill: wait for the tiles the splits asked for and go on refining, so the mesh does not
+  // depend on when tiles arrive (bounded: each round completes the chains that waited).
+  double tess_ms = r ? r->update_ms : 0;
+  for (int round = 0; options_.prefill_detail && cache != nullptr && r && round < 64 &&
+                      r->stop != ridgeline::StopReason::kTriangleBudget &&
+                      (r->pending_splits > 0 || r->stop != ridgeline::StopReason::kConverged);
+       ++round) {
+    (void)cache->wait_idle(30.0);
+    auto again = v.update(cam);
+    if (!again) break;
+    tess_ms += again->update_ms;
+    r = again;
+  }
+  if (r) r->update_ms = tess_ms;
   if (r) {
     out.stats = *r;
     out.updated = true;
+    morph_threshold_[vi] = r->morph_threshold;
   } else {
-    log("view update: " + r.error().message);
+    scripts_->log("view update: " + r.error().message);
   }
   return last_view_ = out;
+}
+
+double Game::morph_threshold() const noexcept {
+  const int vi = int(rig_.mode);
+  return morph_threshold_[vi] > 0 ? morph_threshold_[vi] : views_[vi]->settings().threshold;
+}
+
+BudgetSettings Game::budget() const noexcept {
+  return {controller_on_, threshold_, render_scale_, max_triangles_, tess_budget_ms_};
+}
+
+void Game::set_budget(const BudgetSettings& b) {
+  controller_on_ = b.controller;
+  threshold_ = b.threshold;
+  render_scale_ = b.render_scale;
+  max_triangles_ = b.max_triangles;
+  tess_budget_ms_ = b.tessellation_ms;
+}
+
+std::optional<ridgeline::DetailCacheStats> Game::detail_stats() const {
+  if (const ridgeline::DetailCache* c = terrain_->detail_cache()) return c->stats();
+  return std::nullopt;
 }
 
 }  // namespace game

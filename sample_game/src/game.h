@@ -1,180 +1,177 @@
-// Game: the sample game's simulation (terrain, vehicles, cameras, scripts, the LOD budget), with
-// no GL: the window, offscreen and headless modes all drive this one class.
+// Game: the sample game's simulation (terrain with procedural detail, vehicles, cameras,
+// scripts, the LOD budget), with no GL: the window, offscreen and headless modes all drive this
+// one class. Scripts see it through GameApi (game_api.h).
 #pragma once
 
 #include <cstdint>
 #include <deque>
-#include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "game_api.h"
 #include "ridgeline/budget_controller.h"
 #include "ridgeline/camera.h"
+#include "ridgeline/detail.h"
+#include "ridgeline/detail_stream.h"
 #include "ridgeline/landscape.h"
-#include "ridgeline/lua/host.h"
 #include "ridgeline/roam_view.h"
 #include "ridgeline/terrain.h"
+#include "script_runner.h"
 #include "vehicle.h"
 #include "vehicle_model.h"
 
-struct lua_State;
-
 namespace game {
+
+/// The default world's procedural detail (docs/game.md, "The world"): one level below the 2 m
+/// stored spacing (1 m finest spacing) with a 0.2 m octave (0.1 x the base spacing).
+ridgeline::DetailParams default_world_detail();
 
 /// Settings from the command line (main.cpp) or a test.
 struct GameOptions {
-  std::string assets_dir;  ///< folder with vehicles/*.glb
-  std::string scripts_dir; ///< folder scripts may name relatively (game.load_script)
-  double dt = 1.0 / 60.0;  ///< fixed simulation step, seconds
+  std::string assets_dir;   ///< folder with vehicles/*.glb
+  std::string scripts_dir;  ///< folder scripts may name relatively (game.load_script)
+  double dt = 1.0 / 60.0;   ///< fixed simulation step, seconds
   glm::ivec2 viewport{1280, 720};
   /// > 0: the threshold stays at this value (the controller is off): reproducible pictures.
   double fixed_threshold = 0;
-  ridgeline::BudgetControllerDesc budget{};  ///< target 33 ms by default
-  std::uint32_t max_triangles = 60000;       ///< triangle budget of every view
-  double tessellation_budget_ms = 8;         ///< time budget of one view update
+  /// > 0 (with fixed_threshold): the render scale stays at this value, else 1.
+  double fixed_render_scale = 0;
+  /// Target 33 ms; 30 warm-up frames: the game's first frames build every patch's mesh while
+  /// the view refines from its roots under the tessellation budget (about 20 frames of 50-140
+  /// ms in the default scenario), which must not steer the controller.
+  ridgeline::BudgetControllerDesc budget{.warmup_frames = 30};
+  std::uint32_t max_triangles = 60000;  ///< triangle budget of every view
+  double tessellation_budget_ms = 8;    ///< time budget of one view update
   bool tessellate = true;  ///< update the active view each frame (off: pure simulation)
   std::uint64_t instruction_limit = 20'000'000;  ///< per script call (an infinite loop ends)
-  std::uint32_t patch_exponent = 6;
+  /// ROAM patches of 2^k stored cells per side. 5 (64 m patches, 1,024 of them): the core patches
+  /// meshes in place and the renderer uploads the dirty ranges, so the patch size no longer sets
+  /// the upload cost (0.2-0.35 ms per frame for k = 4..6 at 2 px, 1280 x 720); k = 5 had the
+  /// lowest game-thread CPU time and 6 % fewer triangles than k = 4 (docs/game.md, "Where the
+  /// frame goes").
+  std::uint32_t patch_exponent = 5;
+  /// Procedural detail of the world (levels 0: none).
+  ridgeline::DetailParams detail = default_world_detail();
+  std::uint32_t detail_workers = 2;                          ///< the tile cache's worker threads
+  std::size_t detail_budget_bytes = std::size_t{128} << 20;  ///< resident tiles, bytes
+  /// Tiles streamed ahead of the view's own requests (DetailStream, the request rule of
+  /// docs/detail.md): where a level's spacing projects to at least this many pixels.
+  double detail_stream_pixels = 1.0;
+  /// Each view update waits until every tile its splits asked for has arrived (and updates
+  /// again): the mesh does not depend on when tiles arrive (render tests, reference pictures).
+  bool prefill_detail = false;
+  /// Where script lines and errors go in every mode (null: stderr).
+  std::function<void(const std::string&)> console;
 };
 
-enum class CameraMode { kFree, kFollow, kMap };
-const char* to_string(CameraMode mode) noexcept;
-
-/// The three cameras; each one has its own RoamView.
-struct CameraRig {
-  CameraMode mode = CameraMode::kFollow;
-  glm::dvec3 free_eye{300, 400, 300};
-  double free_yaw = 0.8, free_pitch = -0.35;  ///< radians; yaw 0 = +z
-  int follow_vehicle = -1;   ///< vehicle id; -1: the first vehicle
-  double follow_distance = 22, follow_height = 9;
-  glm::dvec2 map_centre{1024, 1024};
-  double map_height = 1500;
-};
-
-struct ScriptError {
-  std::string script;
-  std::string message;  ///< error and traceback
-  std::uint64_t frame = 0;
-};
-
-/// One vehicle in play.
-struct VehicleEntry {
-  int id = 0;
-  std::string name, model;
-  Vehicle body;
-  Autopilot autopilot;
-  double distance_m = 0;  ///< path length driven
-};
-
-/// A deformation the game applied (for stats and the renderer).
-struct CraterRecord {
-  double x = 0, z = 0, radius = 0, depth = 0;
-  std::uint64_t frame = 0;
-};
-
-/// Per-frame statistics of the active view and the controller.
-struct ViewFrame {
-  ridgeline::RoamStats stats{};
-  double threshold = 0;
-  bool updated = false;
-};
-
-/// Player input from the window (keys), read by scripts through game.input().
-struct Input {
-  bool up = false, down = false, left = false, right = false, brake = false;
+/// Milliseconds one frame's simulation spent, by part.
+struct StepTimes {
+  double scripts_ms = 0;  ///< Lua chunks and handlers (game.burn_ms load included)
+  double physics_ms = 0;  ///< vehicles: autopilots, suspension, contacts, collisions
 };
 
 /// Threading: one thread.
-class Game {
+class Game final : public GameApi {
  public:
   static ridgeline::Result<std::unique_ptr<Game>> create(const GameOptions& options);
-  ~Game();
+  ~Game() override;
 
-  // ---- scripts -----------------------------------------------------------------------------
-  /// Loads and runs a script file; it stays registered for reload. A failing script is recorded
-  /// in errors() and logged; the game goes on (the Status says what failed).
-  ridgeline::Status load_script(const std::string& path);
-  /// Re-runs every script whose file changed since it was loaded (its event handlers are
-  /// replaced). Returns how many were reloaded.
-  int reload_changed_scripts();
-  /// Re-runs every script (the panel's Reload button, F5).
-  int reload_all_scripts();
-  const std::deque<ScriptError>& errors() const noexcept { return errors_; }
-  std::uint64_t error_count() const noexcept { return error_count_; }
-  std::vector<std::string> script_names() const;
+  // ---- scripts (script_runner.h) ------------------------------------------------------------
+  ScriptRunner& scripts() noexcept { return *scripts_; }
+  const ScriptRunner& scripts() const noexcept { return *scripts_; }
+  ridgeline::Status load_script(const std::string& path) { return scripts_->load(path); }
+  int reload_changed_scripts() { return scripts_->reload_changed(); }
+  int reload_all_scripts() { return scripts_->reload_all(); }
+  const std::deque<ScriptError>& errors() const noexcept { return scripts_->errors(); }
+  std::uint64_t error_count() const noexcept { return scripts_->error_count(); }
+  ridgeline::lua::Host& host() noexcept { return scripts_->host(); }
 
   // ---- simulation ----------------------------------------------------------------------------
   /// One fixed step: scripts' tick handlers, autopilots, the vehicles' reaction to every terrain
   /// edit since the last step (from any brush, C++ or Lua, or a loaded edit state: the terrain's
-  /// change log is polled once here), vehicle physics.
+  /// change log is polled once here), vehicle physics, vehicle-vehicle contacts.
   void step();
-  std::uint64_t frame() const noexcept { return frame_; }  ///< steps taken
-  double time() const noexcept { return double(frame_) * options_.dt; }
-  double dt() const noexcept { return options_.dt; }
-  /// Milliseconds of load scripts asked for this frame with game.burn_ms (already spent).
+  /// Times of the steps since the last call (a frame may take several steps), and resets them.
+  StepTimes take_step_times() noexcept;
+  /// Milliseconds of load scripts asked for in the last step with game.burn_ms (already spent).
   double burned_ms() const noexcept { return burned_ms_; }
-
-  ridgeline::Result<int> spawn(const std::string& model, double x, double z, double heading,
-                               const std::string& name);
-  VehicleEntry* vehicle(int id);
+  void set_input(const Input& in) noexcept { input_ = in; }
+  void set_last_frame_ms(double ms) noexcept { last_frame_ms_ = ms; }
   std::map<int, VehicleEntry>& vehicles() noexcept { return vehicles_; }
-  bool remove_vehicle(int id);
   const VehicleModel* model(const std::string& name) const;
-  std::vector<std::string> model_names() const;
-
-  /// Deforms the terrain with a crater (the edit layer). Vehicles follow it at the next step(),
-  /// as they follow every edit. Returns the number of lattice samples changed.
-  ridgeline::Result<std::size_t> crater(double x, double z, double radius, double depth);
   const std::vector<CraterRecord>& craters() const noexcept { return craters_; }
+  /// Vehicle-vehicle contacts in the last step.
+  std::size_t contacts() const noexcept { return contacts_; }
 
   // ---- views, cameras, budget ----------------------------------------------------------------
-  CameraRig& rig() noexcept { return rig_; }
-  /// The camera of the current mode, for the given viewport.
-  ridgeline::Camera camera() const;
-  /// Feeds the last frame's time to the controller (when on) and updates the active view.
+  /// Feeds the last frame's time to the controller (when on) and updates the active view (with
+  /// prefill_detail: until no split waits for a tile).
   ViewFrame update_view(double frame_ms);
   ridgeline::RoamView& view(CameraMode mode) noexcept { return *views_[int(mode)]; }
   ridgeline::RoamView& active_view() noexcept { return view(rig_.mode); }
-  ridgeline::BudgetController& controller() noexcept { return controller_; }
+  /// The threshold the active view's mesh corresponds to (RoamStats::morph_threshold of its last
+  /// update; its settings' threshold before any): what the renderer's geomorph uses.
+  double morph_threshold() const noexcept;
   const ridgeline::BudgetController& controller() const noexcept { return controller_; }
   bool controller_on() const noexcept { return controller_on_; }
   void set_controller_on(bool on) noexcept { controller_on_ = on; }
   double threshold() const noexcept { return threshold_; }
   void set_threshold(double px) noexcept { threshold_ = px; }
+  /// Fraction of the output resolution (per axis) the scene renders at.
+  double render_scale() const noexcept { return render_scale_; }
+  void set_render_scale(double s) noexcept { render_scale_ = s; }
   std::uint32_t max_triangles() const noexcept { return max_triangles_; }
   void set_max_triangles(std::uint32_t n) noexcept { max_triangles_ = n; }
   double tessellation_budget_ms() const noexcept { return tess_budget_ms_; }
   void set_tessellation_budget_ms(double ms) noexcept { tess_budget_ms_ = ms; }
-  const ViewFrame& last_view_frame() const noexcept { return last_view_; }
+  /// The tile cache's statistics (empty without detail).
+  std::optional<ridgeline::DetailCacheStats> detail_stats() const;
+  /// The streaming figures of the last frame (empty without detail).
+  const std::optional<ridgeline::DetailFrameStats>& detail_frame() const noexcept {
+    return detail_frame_;
+  }
 
   const ridgeline::Terrain& terrain() const noexcept { return *terrain_; }
-  const std::shared_ptr<ridgeline::Terrain>& terrain_ptr() const noexcept { return terrain_; }
   const GameOptions& options() const noexcept { return options_; }
-  Input input;
-  /// Wall-clock time of the last rendered frame, milliseconds (set by the frame loop).
-  double last_frame_ms = 0;
-  /// Messages scripts printed with game.log (last 200), for the panel.
-  std::deque<std::string> log_lines;
 
-  // Used by the Lua API (scripting.cpp).
-  struct Script {
-    std::string name, path;
-    std::filesystem::file_time_type mtime{};
-    bool failed = false;  ///< its handlers are off until it is reloaded
-  };
-  ridgeline::lua::Host& host() noexcept { return *host_; }
-  int current_script = -1;  ///< script whose chunk or handler is running
-  std::vector<Script> scripts;
-  void record_error(int script, const std::string& message);
-  void log(const std::string& line);
-  void add_burn(double ms) noexcept { burned_ms_ += ms; }
+  // ---- GameApi (what scripts reach) -----------------------------------------------------------
+  std::uint64_t frame() const noexcept override { return frame_; }
+  double time() const noexcept override { return double(frame_) * options_.dt; }
+  double dt() const noexcept override { return options_.dt; }
+  const Input& input() const noexcept override { return input_; }
+  double last_frame_ms() const noexcept override { return last_frame_ms_; }
+  void add_burn(double ms) noexcept override { burned_ms_ += ms; }
+  ridgeline::Result<int> spawn(const std::string& model, double x, double z, double heading,
+                               const std::string& name) override;
+  VehicleEntry* vehicle(int id) override;
+  const std::map<int, VehicleEntry>& vehicles() const noexcept override { return vehicles_; }
+  bool remove_vehicle(int id) override;
+  std::vector<std::string> model_names() const override;
+  const std::shared_ptr<ridgeline::Terrain>& terrain_ptr() const noexcept override {
+    return terrain_;
+  }
+  /// Deforms the terrain with a crater (the edit layer); bodies inside the changed box are lifted
+  /// out of the surface. Returns the number of lattice samples changed.
+  ridgeline::Result<std::size_t> crater(double x, double z, double radius, double depth) override;
+  std::size_t crater_count() const noexcept override { return craters_.size(); }
+  CameraRig& rig() noexcept override { return rig_; }
+  ridgeline::Camera camera() const override;
+  ridgeline::BudgetController& controller() noexcept override { return controller_; }
+  BudgetSettings budget() const noexcept override;
+  void set_budget(const BudgetSettings& settings) override;
+  const ViewFrame& last_view_frame() const noexcept override { return last_view_; }
+  std::uint32_t root_triangles() const noexcept override { return 2 * landscape_->patch_count(); }
 
  private:
   Game() = default;
-  ridgeline::Status run_script(int index);
   void clamp_to_terrain(VehicleEntry& e);
+  void emit(const char* event, int (*push)(lua_State*, void*), void* user) {
+    scripts_->emit(event, push, user);
+  }
   // Pulls the terrain's change log: vehicles near a changed box follow the new ground.
   void follow_terrain_edits();
 
@@ -187,24 +184,26 @@ class Game {
   int next_vehicle_id_ = 1;
   std::vector<CraterRecord> craters_;
   std::size_t craters_emitted_ = 0;
+  std::map<std::pair<int, int>, bool> touching_;
+  std::size_t contacts_ = 0;
   CameraRig rig_;
   ridgeline::BudgetController controller_ = ridgeline::BudgetController::create().value();
   bool controller_on_ = true;
   double threshold_ = 2;
+  double render_scale_ = 1;
   std::uint32_t max_triangles_ = 60000;
   double tess_budget_ms_ = 8;
   ViewFrame last_view_;
+  double morph_threshold_[3] = {0, 0, 0};  // per camera mode: its last morph_threshold
+  std::optional<ridgeline::DetailStream> stream_;
+  std::optional<ridgeline::DetailFrameStats> detail_frame_;
   std::uint64_t frame_ = 0;
   std::uint64_t seen_edit_version_ = 0;  // the terrain edit version the vehicles have followed
   double burned_ms_ = 0;
-  std::unique_ptr<ridgeline::lua::Host> host_;
-  std::deque<ScriptError> errors_;
-  std::uint64_t error_count_ = 0;
+  double last_frame_ms_ = 0;
+  Input input_;
+  StepTimes step_times_;
+  std::unique_ptr<ScriptRunner> scripts_;  // last: destroyed first (its Lua state refers to us)
 };
-
-/// Installs the `game` table in the host's script environment (scripting.cpp).
-ridgeline::Status install_game_api(Game& game);
-/// Calls the handlers of `event` (scripting.cpp); args are pushed by the callback.
-void emit_event(Game& game, const char* event, int (*push)(lua_State*, void*), void* user);
 
 }  // namespace game

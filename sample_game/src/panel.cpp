@@ -2,11 +2,13 @@
 // panel is a few lines per figure, which is why the game uses it instead of its own UI.
 #include "panel.h"
 
-#include <imgui.h>
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
+#include <imgui.h>
 
 #include <cstdio>
+
+#include "materials.h"
 
 namespace game {
 
@@ -28,7 +30,9 @@ Panel::~Panel() {
   ImGui::DestroyContext();
 }
 
-bool Panel::wants_keyboard() const { return ImGui::GetIO().WantCaptureKeyboard; }
+bool Panel::wants_keyboard() const {
+  return ImGui::GetIO().WantCaptureKeyboard;
+}
 
 void Panel::draw(Game& game, RenderSettings& settings, const PanelInput& in, double dt_s) {
   frame_history_.push_back(static_cast<float>(in.frame_ms));
@@ -67,17 +71,33 @@ void Panel::draw(Game& game, RenderSettings& settings, const PanelInput& in, dou
   if (ImGui::SliderFloat("target ms", &target, 10.0f, 100.0f, "%.0f"))
     (void)game.controller().set_target_ms(target);
   int tris = int(game.max_triangles());
-  if (ImGui::SliderInt("triangle budget", &tris, 5000, 400000))
+  if (ImGui::SliderInt("triangle budget", &tris, int(game.root_triangles()), 400000))
     game.set_max_triangles(std::uint32_t(tris));
   float tess = float(game.tessellation_budget_ms());
   if (ImGui::SliderFloat("tessellation ms", &tess, 0.0f, 30.0f, "%.1f"))
     game.set_tessellation_budget_ms(tess);
   ImGui::Text("triangles %u  splits %u (+%u forced)  merges %u", vf.stats.triangles,
               vf.stats.splits, vf.stats.forced_splits, vf.stats.merges);
-  ImGui::Text("tessellation %.2f ms  upload %.2f ms (%u patches)  draw %.2f ms",
-              vf.stats.update_ms, in.render.upload_ms, in.render.patches_uploaded,
-              in.render.draw_ms);
-  ImGui::Text("tiles resident: n/a (the game runs without procedural detail)");
+  ImGui::Text("render scale %.2f (%d x %d)%s", game.render_scale(), in.render.scene_width,
+              in.render.scene_height, game.controller_on() ? "" : " fixed");
+  ImGui::Text("tessellation %.2f ms (%s)  upload %.2f ms (%u patches)  draw %.2f ms",
+              vf.stats.update_ms,
+              vf.stats.stop == ridgeline::StopReason::kConverged        ? "converged"
+              : vf.stats.stop == ridgeline::StopReason::kTriangleBudget ? "triangle cap"
+                                                                        : "time budget",
+              in.render.upload_ms, in.render.patches_uploaded, in.render.draw_ms);
+  if (auto ds = game.detail_stats()) {
+    const std::uint64_t gen = ds->generated - last_generated_;
+    last_generated_ = ds->generated;
+    ImGui::Text("detail: %u levels, tiles resident %zu, pending %zu, generated %llu this frame",
+                game.terrain().detail_levels(), ds->resident_tiles, ds->pending,
+                static_cast<unsigned long long>(gen));
+    ImGui::Text("  %.1f MB, %.0f tiles/s, %u splits waiting for tiles",
+                double(ds->resident_bytes) / 1048576.0, ds->generated_per_second,
+                vf.stats.pending_splits);
+  } else {
+    ImGui::Text("detail: off (--detail-levels 0)");
+  }
   ImGui::Separator();
   int mode = int(game.rig().mode);
   ImGui::RadioButton("free", &mode, 0);
@@ -89,12 +109,24 @@ void Panel::draw(Game& game, RenderSettings& settings, const PanelInput& in, dou
   ImGui::Checkbox("wireframe", &settings.wireframe);
   ImGui::SameLine();
   ImGui::Checkbox("geomorphs", &settings.geomorph);
-  ImGui::Text("vehicles %zu  craters %zu  t = %.1f s", game.vehicles().size(),
-              game.craters().size(), game.time());
+  ImGui::Checkbox("cheap fragments", &settings.cheap_fragments);
+  ImGui::SameLine();
+  ImGui::Checkbox("front to back", &settings.front_to_back);
+  ImGui::Text("vehicles %zu  craters %zu  contacts %zu  t = %.1f s", game.vehicles().size(),
+              game.craters().size(), game.contacts(), game.time());
+  if (const VehicleEntry* e =
+          game.vehicle(game.rig().follow_vehicle >= 0
+                           ? game.rig().follow_vehicle
+                           : (game.vehicles().empty() ? -1 : game.vehicles().begin()->first))) {
+    const Material& m = material(e->body.ground_material());
+    ImGui::Text("%s: %.1f m/s on %s (grip x%.2f), %llu collisions", e->name.c_str(),
+                e->body.speed(), m.name, m.friction,
+                static_cast<unsigned long long>(e->body.collisions));
+  }
   ImGui::Separator();
   if (ImGui::Button("reload scripts (F5)")) game.reload_all_scripts();
   ImGui::SameLine();
-  ImGui::Text("%zu scripts, %llu errors", game.scripts.size(),
+  ImGui::Text("%zu scripts, %llu errors", game.scripts().size(),
               static_cast<unsigned long long>(game.error_count()));
   if (!game.errors().empty()) {
     const ScriptError& e = game.errors().back();
@@ -104,9 +136,9 @@ void Panel::draw(Game& game, RenderSettings& settings, const PanelInput& in, dou
     ImGui::PopStyleColor();
   }
   if (ImGui::CollapsingHeader("script log")) {
-    const std::size_t n = game.log_lines.size();
-    for (std::size_t i = n > 12 ? n - 12 : 0; i < n; ++i)
-      ImGui::TextUnformatted(game.log_lines[i].c_str());
+    const auto& lines = game.scripts().log_lines();
+    const std::size_t n = lines.size();
+    for (std::size_t i = n > 12 ? n - 12 : 0; i < n; ++i) ImGui::TextUnformatted(lines[i].c_str());
   }
   ImGui::End();
   ImGui::Render();

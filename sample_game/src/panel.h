@@ -2,6 +2,7 @@
 // errors with their tracebacks, the script log, reload.
 #pragma once
 
+#include <cstdint>
 #include <deque>
 
 #include "game.h"
@@ -32,6 +33,7 @@ class Panel {
   GLFWwindow* window_;
   int width_, height_;
   std::deque<float> frame_history_;
+  std::uint64_t last_generated_ = 0;  // detail tiles generated up to the last frame
 };
 
 }  // namespace game

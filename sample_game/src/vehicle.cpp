@@ -8,6 +8,8 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/mat3x3.hpp>
 
+#include "materials.h"
+
 namespace game {
 namespace {
 constexpr double kGravity = 9.81;
@@ -90,7 +92,9 @@ double Vehicle::heading() const noexcept {
   return std::atan2(f.x, f.z);
 }
 
-double Vehicle::speed() const noexcept { return glm::dot(v_, forward()); }
+double Vehicle::speed() const noexcept {
+  return glm::dot(v_, forward());
+}
 
 std::array<glm::dvec3, 4> Vehicle::chassis_corners() const {
   const glm::dvec3 a = chassis_min, b = chassis_max;
@@ -161,8 +165,8 @@ void Vehicle::substep(const ridgeline::Terrain& terrain, double dt) {
       const double stop = std::abs(vf) * quarter / dt * 0.5;
       ff -= (vf > 0 ? 1 : -1) * std::min(brake * params_.brake_force / 4, stop);
       ff -= vf * 0.02 * quarter;  // rolling resistance
-      // Friction circle.
-      const double limit = params_.friction * fn;
+      // Friction circle, scaled by the ground's material (sand, mud and snow slip earlier).
+      const double limit = params_.friction * material(hit->material).friction * fn;
       const double mag = std::hypot(ff, fs);
       if (mag > limit && mag > 0) {
         ff *= limit / mag;
@@ -218,7 +222,8 @@ double Vehicle::resolve_penetration(const ridgeline::Terrain& terrain) {
   for (int i = 0; i < 4; ++i) {
     const glm::dvec3 a = pos_ + R * params_.attach[i];
     if (auto hn = terrain.height_normal(a.x, a.z)) {
-      const double need = hn->height + params_.wheel_radius / std::max(0.2, double(hn->face_normal.y));
+      const double need =
+          hn->height + params_.wheel_radius / std::max(0.2, double(hn->face_normal.y));
       lift = std::max(lift, need - a.y);
     }
   }
@@ -251,8 +256,38 @@ void Vehicle::measure_contacts(const ridgeline::Terrain& terrain) {
     const glm::dvec3 bottom = w.centre - up * params_.wheel_radius;
     const auto h = terrain.height(bottom.x, bottom.z);
     w.surface_gap = h ? bottom.y - *h : 0.0;
+    w.material = hit ? hit->material : 0;
     ground_[i] = {a.x, a.z, terrain.height(a.x, a.z).value_or(std::nan(""))};
   }
+  // The ground's material: the one under most wheels in contact (ties: the lowest id).
+  int votes[256] = {};
+  for (const WheelState& w : wheels_)
+    if (w.contact) ++votes[w.material];
+  int best = 0;
+  for (int m = 1; m < 256; ++m)
+    if (votes[m] > votes[best]) best = m;
+  ground_material_ = static_cast<std::uint8_t>(best);
+}
+
+glm::dmat3 Vehicle::inverse_inertia_world() const noexcept {
+  const glm::dmat3 R = glm::mat3_cast(q_);
+  const glm::dmat3 inv_body(glm::dvec3(1.0 / inertia_.x, 0, 0), glm::dvec3(0, 1.0 / inertia_.y, 0),
+                            glm::dvec3(0, 0, 1.0 / inertia_.z));
+  return R * inv_body * glm::transpose(R);
+}
+
+glm::dvec3 Vehicle::velocity_at(const glm::dvec3& p) const noexcept {
+  return v_ + glm::cross(w_, p - pos_);
+}
+
+void Vehicle::apply_impulse(const glm::dvec3& p, const glm::dvec3& impulse) noexcept {
+  v_ += impulse / params_.mass;
+  w_ += inverse_inertia_world() * glm::cross(p - pos_, impulse);
+}
+
+void Vehicle::nudge(const glm::dvec3& d) noexcept {
+  pos_ += d;
+  for (WheelState& w : wheels_) w.centre += d;
 }
 
 double Vehicle::follow_ground(const ridgeline::Terrain& terrain) {

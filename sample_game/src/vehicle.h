@@ -3,11 +3,11 @@
 
 #include <array>
 #include <cstdint>
-#include <vector>
-
 #include <glm/gtc/quaternion.hpp>
+#include <glm/mat3x3.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
+#include <vector>
 
 #include "ridgeline/terrain.h"
 #include "vehicle_model.h"
@@ -17,17 +17,18 @@ namespace game {
 /// Physical constants of a vehicle kind. Units: kg, metres, newtons, seconds, radians.
 struct VehicleParams {
   double mass = 1500;
-  glm::dvec3 inertia_extent{2, 1.5, 4};  ///< box whose inertia the body takes (width, height, length)
+  glm::dvec3 inertia_extent{2, 1.5,
+                            4};        ///< box whose inertia the body takes (width, height, length)
   std::array<glm::dvec3, 4> attach{};  ///< suspension tops in the body frame (from the COM)
   double wheel_radius = 0.5;
-  double rest_length = 0.35;  ///< suspension length (attach -> wheel centre) with no load
-  double spring_k = 40000;    ///< N/m per wheel
-  double damper_c = 4000;     ///< N s/m per wheel
-  double friction = 1.0;      ///< tyre friction coefficient (friction circle radius / load)
-  double engine_force = 9000;  ///< N at full throttle, shared by the four wheels
-  double brake_force = 14000;  ///< N at full brake, shared by the four wheels
-  double max_steer = 0.55;     ///< radians at steer = +-1
-  double max_speed = 25;       ///< m/s; the engine gives no force above it
+  double rest_length = 0.35;         ///< suspension length (attach -> wheel centre) with no load
+  double spring_k = 40000;           ///< N/m per wheel
+  double damper_c = 4000;            ///< N s/m per wheel
+  double friction = 1.0;             ///< tyre friction coefficient (friction circle radius / load)
+  double engine_force = 9000;        ///< N at full throttle, shared by the four wheels
+  double brake_force = 14000;        ///< N at full brake, shared by the four wheels
+  double max_steer = 0.55;           ///< radians at steer = +-1
+  double max_speed = 25;             ///< m/s; the engine gives no force above it
   glm::dvec3 com_in_model{0, 1, 0};  ///< centre of mass in the model frame (the body origin)
 };
 
@@ -55,6 +56,7 @@ struct WheelState {
   /// Terrain::height after the step: about 0 in contact, positive in the air, negative when the
   /// wheel sinks in. Set by Vehicle::measure_contacts().
   double surface_gap = 0;
+  std::uint8_t material = 0;  ///< material id under the wheel (valid with contact)
 };
 
 /// A vehicle body. Positions in world metres (double precision); the body frame is +y up,
@@ -93,11 +95,26 @@ class Vehicle {
   void place(glm::dvec3 position, double heading_rad);
   /// Teleports to (x, z) with the given heading, tilted to the surface normal there and lifted
   /// so that the wheels just touch: how vehicles are spawned on slopes. False off-terrain.
-  bool place_on_surface(const ridgeline::Terrain& terrain, double x, double z,
-                        double heading_rad);
+  bool place_on_surface(const ridgeline::Terrain& terrain, double x, double z, double heading_rad);
   /// Bottom corners of the chassis box in world coordinates.
   std::array<glm::dvec3, 4> chassis_corners() const;
   glm::dvec3 chassis_min{-1, -0.5, -2}, chassis_max{1, 0.5, 2};  ///< body-frame box (from COM)
+
+  // ---- contacts with other bodies (collision.cpp) ------------------------------------------
+  /// Material id under most of the wheels in contact at the last measure_contacts() (0 when no
+  /// wheel touches).
+  std::uint8_t ground_material() const noexcept { return ground_material_; }
+  double inverse_mass() const noexcept { return 1.0 / params_.mass; }
+  /// Inverse inertia tensor in world coordinates.
+  glm::dmat3 inverse_inertia_world() const noexcept;
+  /// Velocity of the body at world point `p`, m/s.
+  glm::dvec3 velocity_at(const glm::dvec3& p) const noexcept;
+  /// Applies `impulse` (N s, world) at world point `p`: changes linear and angular velocity.
+  void apply_impulse(const glm::dvec3& p, const glm::dvec3& impulse) noexcept;
+  /// Moves the body (and its wheels) by `d` metres without touching its velocity.
+  void nudge(const glm::dvec3& d) noexcept;
+  /// Contacts with other vehicles so far (counted by collision.cpp).
+  std::uint64_t collisions = 0;
 
  private:
   void substep(const ridgeline::Terrain& terrain, double dt);
@@ -106,6 +123,7 @@ class Vehicle {
   glm::dquat q_{1, 0, 0, 0};
   glm::dvec3 inertia_{1};  // body-frame diagonal
   std::array<WheelState, 4> wheels_{};
+  std::uint8_t ground_material_ = 0;
   // Ground under the four suspension tops at the last measure_contacts() (height NaN
   // off-terrain).
   struct GroundPoint {

@@ -56,3 +56,42 @@ T.case("bad input", function()
   T.raises("ridgeline.budget_controller expected", c.update, {}, 30, dt)
   T.eq(c:threshold(), 2, "nothing changed after the errors")
 end)
+
+T.case("warm-up: start-up frames do not steer it", function()
+  local c = ridgeline.budget_controller{max = 12}
+  T.eq(c:state().warming_up, true)
+  for _, ms in ipairs{221, 95, 60, 48, 41, 36, 35, 34, 36, 35} do c:update(ms, ms / 1000) end
+  T.eq(c:threshold(), 2, "the first 10 frames are not acted on")
+  c:update(35, dt)
+  T.eq(c:state().warming_up, false)
+  T.eq(c:state().updates, 11)
+end)
+
+T.case("render scale: the second lever", function()
+  -- fill-bound: 6 ms fixed, 8 ms of triangles at 2 px (1 / threshold^2), 22 ms of fill at
+  -- full resolution (scale^2), plus 15 ms of load.
+  local function fill_ms(t, s, extra) return 6 + 32 / (t * t) + 22 * s * s + extra end
+  local c = ridgeline.budget_controller{max = 12, min_render_scale = 0.5, render_scale_from = 3}
+  T.eq(c:render_scale(), 1)
+  local t, s = c:threshold(), c:render_scale()
+  for _ = 1, 300 do t, s = c:update(fill_ms(t, s, 15), dt) end
+  T.eq(t, 3, "the threshold waits at the scale's step")
+  T.truthy(s < 0.85 and s >= 0.5, "scale " .. s)
+  T.eq(c:state().render_scale, s)
+  T.truthy(math.abs(fill_ms(t, s, 15) / 33 - 1) < 0.1, "the frame is back near the target")
+  for _ = 1, 120 do t, s = c:update(fill_ms(t, s, 0), dt) end
+  T.truthy(s > 0.99, "the scale comes back first (into the band): " .. s)
+  c:set_render_scale_range(1)
+  T.eq(c:state().min_render_scale, 1)
+  c:reset(3, 1)
+  T.raises("render scale 0.7 outside [1, 1]", c.reset, c, 3, 0.7)
+  T.raises("min_render_scale 0", c.set_render_scale_range, c, 0)
+  T.raises("min_render_scale 2", ridgeline.budget_controller, {min_render_scale = 2})
+  T.raises("render_scale_from_px 40", ridgeline.budget_controller,
+           {min_render_scale = 0.5, render_scale_from = 40})
+  T.raises("field 'median_frames': integer 1 .. 15", ridgeline.budget_controller,
+           {median_frames = 2.5})
+  T.raises("median_frames 4", ridgeline.budget_controller, {median_frames = 4})
+  T.raises("field 'warmup_frames': integer 0 .. 1000", ridgeline.budget_controller,
+           {warmup_frames = -1})
+end)

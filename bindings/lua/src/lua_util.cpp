@@ -1,4 +1,5 @@
-// Argument checking, metatables and path confinement shared by the wrap files.
+// Argument checking (the public ridgeline/lua/check.h), metatables and path confinement shared by
+// the wrap files.
 #include "lua_util.h"
 
 #include <algorithm>
@@ -8,12 +9,7 @@
 #include <string>
 #include <system_error>
 
-namespace ridgeline::lua::detail {
-
-void copy_error(char* err, const char* text) noexcept {
-  std::strncpy(err, text, kErrSize - 1);
-  err[kErrSize - 1] = '\0';
-}
+namespace ridgeline::lua {
 
 namespace {
 
@@ -76,6 +72,38 @@ bool get_number_field(lua_State* L, int arg, const char* name, double* out) {
   return true;
 }
 
+bool get_bool_field(lua_State* L, int arg, const char* name, bool* out) {
+  const int type = lua_getfield(L, arg, name);
+  if (type == LUA_TNIL) {
+    lua_pop(L, 1);
+    return false;
+  }
+  if (type != LUA_TBOOLEAN) {
+    lua_pushfstring(L, "field '%s': boolean expected, got %s", name, luaL_typename(L, -1));
+    luaL_argerror(L, arg, lua_tostring(L, -1));
+  }
+  *out = lua_toboolean(L, -1) != 0;
+  lua_pop(L, 1);
+  return true;
+}
+
+bool get_string_field(lua_State* L, int arg, const char* name, const char** out, std::size_t* len) {
+  const int type = lua_getfield(L, arg, name);
+  if (type == LUA_TNIL) {
+    lua_pop(L, 1);
+    return false;
+  }
+  if (type != LUA_TSTRING) {  // no number-to-string coercion either
+    lua_pushfstring(L, "field '%s': string expected, got %s", name, luaL_typename(L, -1));
+    luaL_argerror(L, arg, lua_tostring(L, -1));
+  }
+  std::size_t n = 0;
+  *out = lua_tolstring(L, -1, &n);  // the table holds the string: it outlives the pop
+  if (len != nullptr) *len = n;
+  lua_pop(L, 1);
+  return true;
+}
+
 bool get_vector_field(lua_State* L, int arg, const char* name, int n, double* out) {
   const int type = lua_getfield(L, arg, name);
   if (type == LUA_TNIL) {
@@ -102,6 +130,15 @@ bool get_vector_field(lua_State* L, int arg, const char* name, int n, double* ou
   }
   lua_pop(L, 1);
   return true;
+}
+
+}  // namespace ridgeline::lua
+
+namespace ridgeline::lua::detail {
+
+void copy_error(char* err, const char* text) noexcept {
+  std::strncpy(err, text, kErrSize - 1);
+  err[kErrSize - 1] = '\0';
 }
 
 void* check_self(lua_State* L, const char* tname) {
@@ -158,10 +195,10 @@ bool resolve_path(bool confine_paths, const char* config_root, const char* name,
     }
     // The name as given, shortened so that the reason still fits the error buffer.
     const std::string_view given(name);
-    std::string msg = "file '" +
-                      (given.size() > 160 ? std::string(given.substr(0, 160)) + "..."
-                                          : std::string(given)) +
-                      "': ";
+    std::string msg =
+        "file '" +
+        (given.size() > 160 ? std::string(given.substr(0, 160)) + "..." : std::string(given)) +
+        "': ";
     if (config_root[0] == '\0') {
       copy_error(err, (msg + "file access is not granted to scripts").c_str());
       return false;

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "ridgeline/landscape.h"
+#include "ridgeline/lua/check.h"
 #include "ridgeline/lua/module.h"
 #include "ridgeline/roam_view.h"
 #include "ridgeline/terrain.h"
@@ -56,20 +57,14 @@ struct ViewBox {
 /// Copies `text` into `err` (kErrSize bytes), truncating.
 void copy_error(char* err, const char* text) noexcept;
 
-/// A number argument: refuses every other type, strings that look like numbers included
-/// ("number expected, got string"), and NaN and infinities ("finite number expected, got nan").
-double check_finite(lua_State* L, int arg);
-/// Optional finite number: `def` when the argument is none or nil.
-double opt_finite(lua_State* L, int arg, double def);
-
-/// Raises `bad argument #arg (...unknown field 'k'...)` for a key of table `arg` not in `names`
-/// (a null-terminated list): catches typos in option tables.
-void check_fields(lua_State* L, int arg, const char* const* names);
-/// Reads number field `name` of the table at `arg`. Returns false when absent (nil); raises
-/// `bad argument #arg (field 'name': finite number expected, got ...)` otherwise.
-bool get_number_field(lua_State* L, int arg, const char* name, double* out);
-/// Reads field `name` as an array of exactly `n` finite numbers (n <= 4).
-bool get_vector_field(lua_State* L, int arg, const char* name, int n, double* out);
+// The argument checks are public (ridgeline/lua/check.h, for games binding their own types).
+using ridgeline::lua::check_fields;
+using ridgeline::lua::check_finite;
+using ridgeline::lua::get_bool_field;
+using ridgeline::lua::get_number_field;
+using ridgeline::lua::get_string_field;
+using ridgeline::lua::get_vector_field;
+using ridgeline::lua::opt_finite;
 
 /// Metatable check against upvalue 1 of the running method (fast: no registry lookup). Raises a
 /// type error naming `tname` when argument 1 is not such a userdata.
@@ -100,12 +95,12 @@ void set_path_rules(TerrainBox* box, const ConfigBox& config);
 void account_memory(lua_State* L, std::size_t bytes);
 
 /// Method tables, for `open_module`.
-int new_view(lua_State* L);  // terrain:new_view, defined in wrap_view.cpp
+int new_view(lua_State* L);               // terrain:new_view, defined in wrap_view.cpp
 int new_budget_controller(lua_State* L);  // ridgeline.budget_controller, wrap_budget.cpp
-int t_deform(lua_State* L);      // terrain:deform, wrap_edit.cpp
-int r_save_edits(lua_State* L);  // ridgeline.save_edits, wrap_edit.cpp
-int r_load_edits(lua_State* L);  // ridgeline.load_edits, wrap_edit.cpp
-int t_save_edits(lua_State* L);  // terrain:save_edits, wrap_edit.cpp
-int t_load_edits(lua_State* L);  // terrain:load_edits, wrap_edit.cpp
+int t_deform(lua_State* L);               // terrain:deform, wrap_edit.cpp
+int r_save_edits(lua_State* L);           // ridgeline.save_edits, wrap_edit.cpp
+int r_load_edits(lua_State* L);           // ridgeline.load_edits, wrap_edit.cpp
+int t_save_edits(lua_State* L);           // terrain:save_edits, wrap_edit.cpp
+int t_load_edits(lua_State* L);           // terrain:load_edits, wrap_edit.cpp
 
 }  // namespace ridgeline::lua::detail

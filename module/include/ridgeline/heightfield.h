@@ -143,8 +143,10 @@ class Heightfield {
 };
 
 /// The built-in default terrain: 1025 x 1025 samples, 2 m spacing (a 2048 m square) at origin
-/// (0, 0), seed 1337, fBm value noise with ridges, heights 16.3 .. 218.1 m, with a material layer
-/// (0 grass, 1 rock on steep cells, 2 sand near the lowest heights, 3 snow near the top).
+/// (0, 0), seed 1337, fBm value noise with ridges, heights 16.3 .. 218.1 m, with a material map
+/// per cell (0 grass; 1 rock on cliffs, slope > 0.8; 2 sand in the lowest 12 % of the height
+/// range; 3 snow in the highest 20 %; 4 mud in patches of flat low ground; 5 gravel on slopes
+/// 0.55 .. 0.8), from slope, height and noise.
 /// Deterministic: the same bytes on every machine. Benchmark figures quoted with
 /// `--default-terrain` depend on exactly these parameters.
 struct DefaultTerrainParams {

@@ -1,0 +1,109 @@
+// game_pop: the pop metric of `ridge report` (docs/report.md, "Pop") for a camera path the game
+// recorded (`ridgeline_game --record-path PATH.json`), on the game's own world: the default
+// terrain with the default world's procedural detail, the game's ROAM patches, a coherent
+// RoamView at a fixed threshold, geomorphs as the game's renderer draws them. Prints the
+// report's figures for the path as JSON (pop_geomorph_max_px is the one the renderer shows).
+// Usage: game_pop PATH.json [--threshold PX] [--every K] [--stride S] [--json FILE]
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "game.h"
+#include "report/modes.h"
+#include "ridgeline/camera_path.h"
+#include "ridgeline/heightfield.h"
+#include "ridgeline/landscape.h"
+#include "ridgeline/terrain.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"Pop metric of a recorded game camera path (docs/game.md, \"Geomorphs\")"};
+  std::string path_file, json_file;
+  double threshold = 2;
+  int every = 2;
+  std::uint32_t stride = 1, patch_exponent = game::GameOptions{}.patch_exponent;
+  app.add_option("path", path_file, "PATH.json written by ridgeline_game --record-path")
+      ->required();
+  app.add_option("--threshold", threshold, "pixel threshold of the view (the game's default: 2)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--every", every, "measure the pop between frames nK-1 and nK")
+      ->check(CLI::Range(2, 1000));
+  app.add_option("--stride", stride, "measure every S-th lattice vertex per axis")
+      ->check(CLI::Range(1, 64));
+  app.add_option("--patch-exponent", patch_exponent, "ROAM patches of 2^k stored cells")
+      ->check(CLI::Range(2, 10));
+  app.add_option("--json", json_file, "also write the figures to this file");
+  CLI11_PARSE(app, argc, argv);
+
+  auto frames = ridgeline::io::load_camera_path(path_file);
+  if (!frames) {
+    std::fprintf(stderr, "game_pop: %s\n", frames.error().message.c_str());
+    return 1;
+  }
+  if (frames->size() < 3) {
+    std::fprintf(stderr, "game_pop: camera path '%s' has %zu frames; need at least 3\n",
+                 path_file.c_str(), frames->size());
+    return 1;
+  }
+  auto hf = ridgeline::make_default_heightfield();
+  if (!hf) {
+    std::fprintf(stderr, "game_pop: %s\n", hf.error().message.c_str());
+    return 1;
+  }
+  ridgeline::DetailCacheDesc cd;
+  cd.worker_threads = 2;
+  auto terrain = ridgeline::Terrain::create(std::move(*hf), game::default_world_detail(), cd);
+  if (!terrain) {
+    std::fprintf(stderr, "game_pop: %s\n", terrain.error().message.c_str());
+    return 1;
+  }
+  auto land = ridgeline::Landscape::create(*terrain, {.patch_exponent = patch_exponent});
+  if (!land) {
+    std::fprintf(stderr, "game_pop: %s\n", land.error().message.c_str());
+    return 1;
+  }
+  auto fine = ridgeline::report::finest_lattice(**terrain);
+  if (!fine) {
+    std::fprintf(stderr, "game_pop: %s\n", fine.error().message.c_str());
+    return 1;
+  }
+  ridgeline::report::Scene scene;
+  scene.name = "game_world";
+  scene.terrain = *terrain;
+  scene.landscape = *land;
+  scene.fine = std::make_shared<const ridgeline::Heightfield>(std::move(*fine));
+  ridgeline::report::NamedPath path;
+  path.name = "recorded";
+  for (const ridgeline::io::PathFrame& f : *frames) path.frames.push_back(f.camera);
+  ridgeline::report::Options o;
+  o.frames = int(path.frames.size());
+  o.error_every = every;
+  o.stride = stride;
+  const ridgeline::report::Setting setting{"threshold", threshold};
+  auto r = ridgeline::report::run_roam(scene, path, setting, ridgeline::RoamMode::kCoherent, o);
+  if (!r) {
+    std::fprintf(stderr, "game_pop: %s\n", r.error().message.c_str());
+    return 1;
+  }
+  nlohmann::ordered_json out = r->json();
+  out["path"] = path_file;
+  out["frames"] = path.frames.size();
+  out["threshold_px"] = threshold;
+  out["every"] = every;
+  out["stride"] = stride;
+  out["patch_exponent"] = patch_exponent;
+  out["morph_window"] = (*land)->morph_window();
+  const std::string text = out.dump(2);
+  std::printf("%s\n", text.c_str());
+  if (!json_file.empty()) {
+    std::ofstream os(json_file);
+    os << text << "\n";
+    if (!os) {
+      std::fprintf(stderr, "game_pop: cannot write '%s'\n", json_file.c_str());
+      return 1;
+    }
+  }
+  return 0;
+}
