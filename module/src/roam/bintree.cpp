@@ -54,8 +54,10 @@ LatticeTriangle RoamView::Impl::leaf_triangle(std::uint32_t n) const {
 
 std::uint32_t RoamView::Impl::patch_of(const LatticeTriangle& t) const {
   // The centroid's patch (coordinates are never negative; a constant divisor and a shift).
-  const std::int64_t px = std::min<std::int64_t>(((t.ax + t.lx + t.rx) / 3) >> K, land.patches_x() - 1);
-  const std::int64_t pz = std::min<std::int64_t>(((t.az + t.lz + t.rz) / 3) >> K, land.patches_z() - 1);
+  const std::int64_t px =
+      std::min<std::int64_t>(((t.ax + t.lx + t.rx) / 3) >> K, land.patches_x() - 1);
+  const std::int64_t pz =
+      std::min<std::int64_t>(((t.az + t.lz + t.rz) / 3) >> K, land.patches_z() - 1);
   return std::uint32_t(px + pz * land.patches_x());
 }
 
@@ -64,7 +66,8 @@ bool RoamView::Impl::padding(const LatticeTriangle& t) const {
          std::min({t.az, t.lz, t.rz}) >= land.last_j();
 }
 
-// ---- front entries --------------------------------------------------------------------------------
+// ---- front entries
+// --------------------------------------------------------------------------------
 
 void RoamView::Impl::entry_data(std::int64_t i, std::int64_t j, float& y, float& mu, float& r,
                                 bool& provisional) const {
@@ -76,8 +79,7 @@ void RoamView::Impl::entry_data(std::int64_t i, std::int64_t j, float& y, float&
     const int L = int(land.detail_levels());
     const int tz = std::min({ctz64(i), ctz64(j), L});
     if (tz < L) {
-      const DetailTileKey key{std::uint32_t(L - tz),
-                              std::int32_t((i >> tz) / kDetailTileCells),
+      const DetailTileKey key{std::uint32_t(L - tz), std::int32_t((i >> tz) / kDetailTileCells),
                               std::int32_t((j >> tz) / kDetailTileCells)};
       if (snapshot->find(key) == nullptr) {
         // Its height is the stored surface's plus an unknown detail: widen the sphere by the
@@ -98,8 +100,7 @@ std::uint32_t RoamView::Impl::add_entry(std::int64_t i, std::int64_t j, std::uin
   bool prov;
   entry_data(i, j, y, mu, r, prov);
   const std::uint32_t t = std::uint32_t(std::min(ctz64(i), ctz64(j)));
-  const std::uint32_t e =
-      front.add(std::int32_t(i), std::int32_t(j), t, y, mu, r, n, split, prov);
+  const std::uint32_t e = front.add(std::int32_t(i), std::int32_t(j), t, y, mu, r, n, split, prov);
   nodes[n].set_entry(e);
   if (partner != kNone) nodes[partner].set_entry(e);
   return e;
@@ -127,7 +128,8 @@ void RoamView::Impl::refresh_entry(std::uint32_t e) {
   front.set_provisional(e, prov);
 }
 
-// ---- links ----------------------------------------------------------------------------------------
+// ---- links
+// ----------------------------------------------------------------------------------------
 
 void RoamView::Impl::replace_link(std::uint32_t n, std::uint32_t from, std::uint32_t to) {
   if (n == kNone) return;
@@ -175,7 +177,8 @@ void RoamView::Impl::attach_leaf(std::uint32_t n, const LatticeTriangle& t) {
   add_entry((t.lx + t.rx) / 2, (t.lz + t.rz) / 2, n, kNone, false);
 }
 
-// ---- detail tiles ---------------------------------------------------------------------------------
+// ---- detail tiles
+// ---------------------------------------------------------------------------------
 
 bool RoamView::Impl::chain_ready(std::uint32_t n) {
   if (cache == nullptr) return true;
@@ -190,7 +193,8 @@ bool RoamView::Impl::chain_ready(std::uint32_t n) {
       const DetailTileKey key{std::uint32_t(L - tz), std::int32_t((ci >> tz) / kDetailTileCells),
                               std::int32_t((cj >> tz) / kDetailTileCells)};
       // Request every missing tile of the chain at once.
-      if (snapshot == nullptr || snapshot->find(key) == nullptr) ready = cache->request(key) && ready;
+      if (snapshot == nullptr || snapshot->find(key) == nullptr)
+        ready = cache->request(key) && ready;
     }
     const std::uint32_t b = nodes[x].base;
     if (b == kNone || nodes[b].base == x) break;
@@ -199,7 +203,8 @@ bool RoamView::Impl::chain_ready(std::uint32_t n) {
   return ready;
 }
 
-// ---- split ----------------------------------------------------------------------------------------
+// ---- split
+// ----------------------------------------------------------------------------------------
 
 bool RoamView::Impl::split(std::uint32_t n, bool forced, std::vector<std::uint32_t>* queue) {
   // Make the base neighbour a diamond partner first (forced splits): it is coarser, and its
@@ -305,7 +310,8 @@ bool RoamView::Impl::split(std::uint32_t n, bool forced, std::vector<std::uint32
   return true;
 }
 
-// ---- merge ----------------------------------------------------------------------------------------
+// ---- merge
+// ----------------------------------------------------------------------------------------
 
 void RoamView::Impl::merge(std::uint32_t n, std::vector<std::uint32_t>* queue) {
   ++st.merges;
@@ -365,7 +371,8 @@ void RoamView::Impl::merge(std::uint32_t n, std::vector<std::uint32_t>* queue) {
   }
 }
 
-// ---- reset ------------------------------------------------------------------------------------------
+// ---- reset
+// ------------------------------------------------------------------------------------------
 
 void RoamView::Impl::reset() {
   const std::uint32_t px = land.patches_x(), pz = land.patches_z();

@@ -46,8 +46,8 @@ struct Diamond {
   int depth(int K) const noexcept { return 2 * (K - 1 - t) + (square ? 0 : 1); }
 
   /// The two ends of the shared hypotenuse.
-  void hypotenuse(std::int64_t& ax, std::int64_t& az, std::int64_t& bx, std::int64_t& bz) const
-      noexcept {
+  void hypotenuse(std::int64_t& ax, std::int64_t& az, std::int64_t& bx,
+                  std::int64_t& bz) const noexcept {
     if (square) {
       // Main diagonal when (i - s)/2s + (j - s)/2s is even (and for patch centres).
       const bool main = top || ((((i - s) >> (t + 1)) + ((j - s) >> (t + 1))) & 1) == 0;
@@ -63,8 +63,8 @@ struct Diamond {
 
   /// The two apexes of the diamond's triangles (its parents' centres, or patch corners for a
   /// patch centre), in either order.
-  void apexes(std::int64_t& ax, std::int64_t& az, std::int64_t& bx, std::int64_t& bz) const
-      noexcept {
+  void apexes(std::int64_t& ax, std::int64_t& az, std::int64_t& bx,
+              std::int64_t& bz) const noexcept {
     std::int64_t hx0, hz0, hx1, hz1;
     hypotenuse(hx0, hz0, hx1, hz1);
     // Turn the half hypotenuse by 90 degrees about the centre.

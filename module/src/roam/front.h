@@ -32,13 +32,13 @@ struct FrontCamera {
   float kappa = 1;
   float planes[4][3] = {};  ///< inward unit normals of the side planes (through the eye)
   float far_m = 1e30f;
-  float scale = 1;      ///< projection scale K: pixels per metre at 1 m
-  float near_m = 0.5f;  ///< distances below this count as this in priorities
+  float scale = 1;       ///< projection scale K: pixels per metre at 1 m
+  float near_m = 0.5f;   ///< distances below this count as this in priorities
   float sx = 1, sz = 1;  ///< metres per finest-lattice step (a centre's x is i * sx)
   /// Metres added to every radius: more than the float rounding of the positions and the eye
   /// (so that the test stays conservative against the exact distances).
   float margin = 0;
-  bool world = false;    ///< ErrorMetric::kWorldMetres: active when mu > threshold; no culling
+  bool world = false;  ///< ErrorMetric::kWorldMetres: active when mu > threshold; no culling
   float threshold = 0;
 
   /// The camera in the frame whose origin is (ox, oy, oz) in world coordinates, over a lattice

@@ -47,7 +47,9 @@ constexpr std::size_t kLogCapacity = 1024;
 // Radius of a sphere centred at a diamond's vertex that holds its descendants' xz positions, in
 // units of s * hypot(spacing): 3 for square diamonds, 2 for edge diamonds (each at least its
 // children's plus the distance to them: 3 >= 2 + 1, 2 >= 3/2 + 1/2).
-double xz_radius_units(const Diamond& d) noexcept { return d.square ? 3.0 : 2.0; }
+double xz_radius_units(const Diamond& d) noexcept {
+  return d.square ? 3.0 : 2.0;
+}
 
 // Bits set in x, inline (without -mpopcnt the builtin is a libgcc call).
 constexpr int popcount64(std::uint64_t x) noexcept {
@@ -66,9 +68,9 @@ float round_up(double v) noexcept {
 }  // namespace
 
 struct Landscape::Impl {
-  std::mutex sync_mutex;                // one sync() at a time
+  std::mutex sync_mutex;                 // one sync() at a time
   std::atomic<std::uint64_t> synced{0};  // the terrain edit_version() the bounds describe
-  mutable std::mutex mutex;             // the landscape's own change log
+  mutable std::mutex mutex;              // the landscape's own change log
   std::deque<Change> log;
   std::uint64_t version = 0;
   std::uint64_t trimmed_before = 0;  // changes up to this version are no longer in the log
@@ -100,13 +102,17 @@ LatticeTriangle Landscape::triangle_at(std::int64_t ax, std::int64_t az, std::ui
   const int k = (((root & 1) ? 7 : 3) + 3 * level + 2 * (popcount64(heap) - 1)) & 7;
   const std::int64_t s2 = patch_cells() >> (level / 2);  // twice the apex-midpoint distance
   const std::int64_t ux = kUx[k], uz = kUz[k], px = -uz, pz = ux;  // p: u turned +90 degrees
-  return {ax, az, ax + (ux + px) * s2 / 2, az + (uz + pz) * s2 / 2, ax + (ux - px) * s2 / 2,
+  return {ax,
+          az,
+          ax + (ux + px) * s2 / 2,
+          az + (uz + pz) * s2 / 2,
+          ax + (ux - px) * s2 / 2,
           az + (uz - pz) * s2 / 2};
 }
 
 Landscape::LatticeBox Landscape::box_of(const LatticeTriangle& t) noexcept {
-  return {std::min({t.ax, t.lx, t.rx}), std::max({t.ax, t.lx, t.rx}),
-          std::min({t.az, t.lz, t.rz}), std::max({t.az, t.lz, t.rz})};
+  return {std::min({t.ax, t.lx, t.rx}), std::max({t.ax, t.lx, t.rx}), std::min({t.az, t.lz, t.rz}),
+          std::max({t.az, t.lz, t.rz})};
 }
 
 float Landscape::base_lattice_height(std::int64_t i, std::int64_t j) const noexcept {
@@ -182,9 +188,9 @@ VertexShading Landscape::compute_shading(std::int64_t i, std::int64_t j) const n
   }
   const Heightfield& hf = terrain_->heightfield();
   const int L = int(detail_);
-  out.material = hf.material(
-      std::min(std::uint32_t(std::max<std::int64_t>(i, 0) >> L), hf.width() - 2),
-      std::min(std::uint32_t(std::max<std::int64_t>(j, 0) >> L), hf.height() - 2));
+  out.material =
+      hf.material(std::min(std::uint32_t(std::max<std::int64_t>(i, 0) >> L), hf.width() - 2),
+                  std::min(std::uint32_t(std::max<std::int64_t>(j, 0) >> L), hf.height() - 2));
   return out;
 }
 
@@ -295,8 +301,8 @@ DiamondBound Landscape::compute_detail(std::int64_t i, std::int64_t j) const noe
   // "Bounds"), over the diamond's reach (which nests); a resident finest tile's measured
   // contribution replaces the analytic one where it is smaller.
   double err = 2.0 * analytic(std::uint32_t(from));
-  double morph = 2.0 * (smax * detail_amp_growth_[k] / 32768.0 + detail_round_growth_[k]) *
-                 kDetailUnit;
+  double morph =
+      2.0 * (smax * detail_amp_growth_[k] / 32768.0 + detail_round_growth_[k]) * kDetailUnit;
   const double measured = terrain_->measured_detail_bound(std::uint32_t(from), i0, j0, i1, j1);
   if (measured < err / 2.0) {
     err = 2.0 * measured;
@@ -394,8 +400,8 @@ DiamondBound Landscape::compute_stored(std::int64_t i, std::int64_t j) const noe
       fd.child(k, ci, cj);
       if (ci < 0 || cj < 0 || ci > (W << L) || cj > (H << L)) continue;
       const double dx = double(ci - (i << L)) * spacing_x_, dz = double(cj - (j << L)) * spacing_z_;
-      const double dy = std::abs(double(base_lattice_height(ci, cj)) - hv) +
-                        double(detail_offset_bound(ci, cj));
+      const double dy =
+          std::abs(double(base_lattice_height(ci, cj)) - hv) + double(detail_offset_bound(ci, cj));
       visit(compute_detail(ci, cj), std::sqrt(dx * dx + dz * dz + dy * dy));
     }
   }
@@ -485,8 +491,9 @@ std::uint64_t Landscape::update_region(std::int64_t i0, std::int64_t j0, std::in
   const int L = int(detail_);
   // Finest vertices inside the cells around the changed samples moved too (the stored surface
   // is interpolated there).
-  Change c{++m.version, std::max<std::int64_t>(i0 - 1, 0) << L, std::max<std::int64_t>(j0 - 1, 0) << L,
-           std::min(i1 + 1, W) << L, std::min(j1 + 1, H) << L};
+  Change c{++m.version, std::max<std::int64_t>(i0 - 1, 0) << L,
+           std::max<std::int64_t>(j0 - 1, 0) << L, std::min(i1 + 1, W) << L,
+           std::min(j1 + 1, H) << L};
   m.log.push_back(c);
   while (m.log.size() > kLogCapacity) {
     m.trimmed_before = m.log.front().version;

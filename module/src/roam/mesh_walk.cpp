@@ -40,7 +40,7 @@ void RoamView::Impl::walk(Fn&& fn) const {
 void RoamView::for_each_leaf(
     const std::function<void(std::uint32_t, std::uint64_t, const LatticeTriangle&)>& fn) const {
   impl_->walk([&](std::uint32_t, std::uint32_t root, std::uint64_t heap, const LatticeTriangle& t,
-                   bool leaf) {
+                  bool leaf) {
     if (leaf) fn(root, heap, t);
   });
 }
@@ -56,7 +56,9 @@ std::uint64_t RoamView::mesh_hash() const {
   return h;
 }
 
-std::string RoamView::check_invariants() const { return impl_->check(); }
+std::string RoamView::check_invariants() const {
+  return impl_->check();
+}
 
 std::string RoamView::Impl::check() const {
   const Impl& m = *this;
@@ -65,7 +67,7 @@ std::string RoamView::Impl::check() const {
   std::vector<std::uint32_t> drawn(m.land.patch_count(), 0);
   std::vector<std::uint8_t> reached(m.nodes.size(), 0);
   m.walk([&](std::uint32_t n, std::uint32_t root, std::uint64_t heap, const LatticeTriangle& t,
-              bool leaf) {
+             bool leaf) {
     if (!err.empty()) return;
     reached[n] = 1;
     const Node& nd = m.nodes[n];
@@ -109,8 +111,7 @@ std::string RoamView::Impl::check() const {
                     m.front.split(nd.entry()))) {
       err = fmt("leaf %u (root %u heap %llu): entry (%d, %d) split %d, diamond (%lld, %lld)", n,
                 root, static_cast<unsigned long long>(heap), m.front.ci(nd.entry()),
-                m.front.cj(nd.entry()),
-                int(m.front.split(nd.entry())), static_cast<long long>(ci),
+                m.front.cj(nd.entry()), int(m.front.split(nd.entry())), static_cast<long long>(ci),
                 static_cast<long long>(cj));
       return;
     }
@@ -126,8 +127,9 @@ std::string RoamView::Impl::check() const {
     for (int q = 0; q < 3; ++q) {
       const auto pos = m.out.coord(patch, k[q]);
       if (!m.out.vertex_live(patch, k[q]) || pos[0] != want[q][0] || pos[1] != want[q][1]) {
-        err = fmt("leaf %u: output corner %d is (%lld, %lld), want (%lld, %lld)", n, q, (long long)pos[0],
-                  (long long)pos[1], static_cast<long long>(want[q][0]), static_cast<long long>(want[q][1]));
+        err = fmt("leaf %u: output corner %d is (%lld, %lld), want (%lld, %lld)", n, q,
+                  (long long)pos[0], (long long)pos[1], static_cast<long long>(want[q][0]),
+                  static_cast<long long>(want[q][1]));
         return;
       }
     }
@@ -175,8 +177,8 @@ std::string RoamView::Impl::check() const {
   if (err.empty())
     for (std::uint32_t p = 0; p < m.land.patch_count() && err.empty(); ++p)
       if (m.out.mesh(p).triangles != drawn[p])
-        err = fmt("patch %u draws %u triangles, its leaves %u", p, m.out.mesh(p).triangles,
-                  drawn[p]);
+        err =
+            fmt("patch %u draws %u triangles, its leaves %u", p, m.out.mesh(p).triangles, drawn[p]);
   return err;
 }
 
@@ -185,7 +187,7 @@ RoamView::MeasuredError RoamView::measure_error(const Camera& camera, std::uint3
   const MeshErrorMeter meter(landscape_->terrain(), stride);
   const DrawnHeights drawn = meter.rasterize(leaves_mesh(*this));
   const MeshError e = settings_.metric == ErrorMetric::kScreenPixels ? meter.measure(drawn, camera)
-                                                                      : meter.measure_all(drawn);
+                                                                     : meter.measure_all(drawn);
   return {e.max_m, e.rms_m, e.max_px, e.p99_px, e.vertices - e.uncovered};
 }
 

@@ -10,7 +10,6 @@
 
 namespace ridgeline::roam {
 
-
 void PatchOutput::reset(const Landscape& land) {
   land_ = &land;
   const std::uint32_t np = land.patch_count();
@@ -159,13 +158,13 @@ std::uint64_t PatchOutput::take_upload_bytes() {
 std::size_t PatchOutput::memory_bytes() const {
   std::size_t b = patches_.capacity() * sizeof(Patch) + dirty_list_.capacity() * 4;
   for (const Patch& p : patches_) {
-    b += p.mesh.vertices.capacity() * sizeof(MeshVertex) +
-         p.mesh.indices.capacity() * sizeof(std::uint32_t) +
-         (p.mesh.dirty_vertices.capacity() + p.mesh.dirty_triangles.capacity()) *
-             sizeof(MeshRange) +
-         (p.free_tris.capacity() + p.free_verts.capacity()) * 4 +
-         (p.tri_bits.capacity() + p.vert_bits.capacity()) * 8 +
-         p.hidden.size() * (sizeof(std::uint32_t) + 12 + 16) + p.hidden.bucket_count() * 8;
+    b +=
+        p.mesh.vertices.capacity() * sizeof(MeshVertex) +
+        p.mesh.indices.capacity() * sizeof(std::uint32_t) +
+        (p.mesh.dirty_vertices.capacity() + p.mesh.dirty_triangles.capacity()) * sizeof(MeshRange) +
+        (p.free_tris.capacity() + p.free_verts.capacity()) * 4 +
+        (p.tri_bits.capacity() + p.vert_bits.capacity()) * 8 +
+        p.hidden.size() * (sizeof(std::uint32_t) + 12 + 16) + p.hidden.bucket_count() * 8;
   }
   return b;
 }
