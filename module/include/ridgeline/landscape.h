@@ -137,6 +137,12 @@ class Landscape {
       return records_[stored_index(i, j)].bound;
     return diamond_slow(i, j);
   }
+  /// The address of what diamond() and shading() read for vertex (i, j) when it is stored
+  /// (a hint for prefetching; some valid address otherwise).
+  const void* record_address(std::int64_t i, std::int64_t j) const noexcept {
+    const bool in = detail_ == 0 && i >= 0 && j >= 0 && i < stored_w_ && j < stored_h_;
+    return records_.data() + (in ? stored_index(i, j) : 0);
+  }
   /// Shading data of finest-lattice vertex (i, j), inside the landscape (padding included).
   /// Stored once per sample without procedural detail (in the bounds' 28-byte record), computed
   /// otherwise.

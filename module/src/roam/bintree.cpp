@@ -1,6 +1,11 @@
 // Bintree operations of a RoamView: diamond split with forced splits (Duchaineau et al. 1997,
 // section 4; Turner 2000 for the neighbour links) and diamond merge, each keeping the front (the
 // diamonds that may change next) and the patch buffers (what the engine draws) in step.
+//
+// These run ~1,000 times per update on a moving camera, so they do no more than they must:
+// a triangle's corners follow from its diamond's centre and canonical half hypotenuse in a few
+// additions (diamond.h, canonical_half()), a triangle's patch from its apex and centre in two
+// shifts, and a new vertex takes its height and bounds from the front entry that split.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -15,27 +20,26 @@ namespace ridgeline {
 using namespace roam;
 
 RoamView::Impl::Impl(const Landscape& l)
-    : land(l), K(l.patch_log2()), cache(l.terrain().detail_cache()) {}
+    : land(l),
+      K(l.patch_log2()),
+      cache(l.terrain().detail_cache()),
+      last_i(l.last_i()),
+      last_j(l.last_j()),
+      px_count(l.patches_x()),
+      sx(float(l.spacing_x())),
+      sz(float(l.spacing_z())) {
+  // Padding exists only in the last row or column of patches (landscape.h).
+  const std::int64_t P = l.patch_cells();
+  may_pad = std::int64_t(l.patches_x()) * P > last_i || std::int64_t(l.patches_z()) * P > last_j;
+}
 
 // ---- geometry -----------------------------------------------------------------------------------
 
-LatticeTriangle RoamView::Impl::diamond_triangle(std::int64_t i, std::int64_t j,
-                                                 std::uint32_t side) const {
-  const Diamond d = diamond_at(i, j, K);
-  std::int64_t h0x, h0z, h1x, h1z;
-  d.hypotenuse(h0x, h0z, h1x, h1z);
-  // The apexes lie a half hypotenuse from the centre, perpendicular to it.
-  const std::int64_t dx = h1x - i, dz = h1z - j;
-  std::int64_t ax = i - dz, az = j + dx;
-  if (apex_side(ax, az, i, j) != side) ax = i + dz, az = j - dx;
-  // (apex, left, right) counter-clockwise seen from above (landscape.h's convention).
-  const std::int64_t cross = (h0z - az) * (h1x - ax) - (h0x - ax) * (h1z - az);
-  if (cross > 0) return {ax, az, h0x, h0z, h1x, h1z};
-  return {ax, az, h1x, h1z, h0x, h0z};
-}
-
-std::uint32_t RoamView::Impl::side_of(const LatticeTriangle& t) const {
-  return apex_side(t.ax, t.az, (t.lx + t.rx) / 2, (t.lz + t.rz) / 2);
+LatticeTriangle RoamView::Impl::diamond_triangle(std::int64_t i, std::int64_t j, std::int64_t hu,
+                                                 std::int64_t hw, std::uint32_t side) noexcept {
+  // sigma = +1 for side 1: A = c + sigma p, L = c + sigma h, R = c - sigma h, p = (-hw, hu).
+  const std::int64_t su = side ? hu : -hu, sw = side ? hw : -hw;
+  return {i - sw, j + su, i + su, j + sw, i - su, j - sw};
 }
 
 LatticeTriangle RoamView::Impl::leaf_triangle(std::uint32_t n) const {
@@ -44,26 +48,17 @@ LatticeTriangle RoamView::Impl::leaf_triangle(std::uint32_t n) const {
     // A half-cell triangle of the finest lattice: no diamond of its own (it never splits); its
     // parent's diamond is always mergeable, so the parent has an entry.
     const Node& p = nodes[x.parent];
-    const std::uint32_t pe = p.entry();
-    return Landscape::child_triangle(diamond_triangle(front.ci(pe), front.cj(pe), p.side()),
-                                     int(n - p.a));
+    return Landscape::child_triangle(entry_triangle(p.entry(), p.side()), int(n - p.a));
   }
-  const std::uint32_t e = x.entry();
-  return diamond_triangle(front.ci(e), front.cj(e), x.side());
+  return entry_triangle(x.entry(), x.side());
 }
 
 std::uint32_t RoamView::Impl::patch_of(const LatticeTriangle& t) const {
-  // The centroid's patch (coordinates are never negative; a constant divisor and a shift).
-  const std::int64_t px =
-      std::min<std::int64_t>(((t.ax + t.lx + t.rx) / 3) >> K, land.patches_x() - 1);
-  const std::int64_t pz =
-      std::min<std::int64_t>(((t.az + t.lz + t.rz) / 3) >> K, land.patches_z() - 1);
-  return std::uint32_t(px + pz * land.patches_x());
-}
-
-bool RoamView::Impl::padding(const LatticeTriangle& t) const {
-  return std::min({t.ax, t.lx, t.rx}) >= land.last_i() ||
-         std::min({t.az, t.lz, t.rz}) >= land.last_j();
+  // The midpoint of the median from the apex to the hypotenuse's midpoint is inside the
+  // triangle, hence strictly inside its patch: floor((A + M) / 2P) per axis.
+  const std::int64_t px = (2 * t.ax + t.lx + t.rx) >> (K + 2);
+  const std::int64_t pz = (2 * t.az + t.lz + t.rz) >> (K + 2);
+  return std::uint32_t(px + pz * std::int64_t(px_count));
 }
 
 // ---- front entries
@@ -86,7 +81,7 @@ void RoamView::Impl::entry_data(std::int64_t i, std::int64_t j, float& y, float&
         // detail's bound so that it holds every height the vertex may have.
         provisional = true;
         y = land.base_lattice_height(i, j);
-        if (r < 3.0e38f) r += land.detail_offset_bound(i, j);
+        if (r < Front::kBorderRadius) r += land.detail_offset_bound(i, j);
         return;
       }
     }
@@ -94,30 +89,27 @@ void RoamView::Impl::entry_data(std::int64_t i, std::int64_t j, float& y, float&
   y = land.lattice_height(i, j);
 }
 
-std::uint32_t RoamView::Impl::add_entry(std::int64_t i, std::int64_t j, std::uint32_t n,
-                                        std::uint32_t partner, bool split) {
+std::uint32_t RoamView::Impl::add_entry(std::int64_t i, std::int64_t j, std::int64_t hu,
+                                        std::int64_t hw, std::uint32_t n, std::uint32_t partner,
+                                        bool split) {
   float y, mu, r;
   bool prov;
   entry_data(i, j, y, mu, r, prov);
   const std::uint32_t t = std::uint32_t(std::min(ctz64(i), ctz64(j)));
-  const std::uint32_t e = front.add(std::int32_t(i), std::int32_t(j), t, y, mu, r, n, split, prov);
+  // The centre's metres as the front's test computed them from lattice indices: float(i) * sx.
+  const std::uint32_t e =
+      front.add(std::int32_t(i), std::int32_t(j), std::int32_t(hu), std::int32_t(hw), t,
+                float(i) * sx, y, float(j) * sz, mu, r, n, partner, split, prov);
   nodes[n].set_entry(e);
   if (partner != kNone) nodes[partner].set_entry(e);
   return e;
 }
 
-std::array<std::uint32_t, 2> RoamView::Impl::entry_nodes(std::uint32_t e) const {
-  const std::uint32_t n = front.node(e);
-  const std::uint32_t b = nodes[n].base;
-  if (b != kNone && nodes[b].base == n) return {n, b};  // partners share a diamond
-  return {n, kNone};
-}
-
 void RoamView::Impl::remove_entry(std::uint32_t e) {
   const std::uint32_t moved = front.remove(e);
   if (moved == e) return;
-  for (std::uint32_t n : entry_nodes(e))
-    if (n != kNone) nodes[n].set_entry(e);
+  nodes[front.node(e)].set_entry(e);
+  if (front.node2(e) != kNone) nodes[front.node2(e)].set_entry(e);
 }
 
 void RoamView::Impl::refresh_entry(std::uint32_t e) {
@@ -126,6 +118,14 @@ void RoamView::Impl::refresh_entry(std::uint32_t e) {
   entry_data(front.ci(e), front.cj(e), y, mu, r, prov);
   front.set_data(e, y, mu, r);
   front.set_provisional(e, prov);
+}
+
+std::uint8_t RoamView::Impl::test_new(std::uint32_t e) {
+  ++st.priority_updates;
+  float p;
+  const std::uint8_t t = front.test_one(e, cam, &p);
+  if (t == kInView) fresh_worst = std::max(fresh_worst, p);
+  return t;
 }
 
 // ---- links
@@ -166,15 +166,28 @@ std::uint32_t RoamView::Impl::split_cost(std::uint32_t n) const {
   }
 }
 
-void RoamView::Impl::attach_leaf(std::uint32_t n, const LatticeTriangle& t) {
-  if (((t.lx + t.rx) | (t.lz + t.rz)) & 1) return;  // finest: no diamond (leaf_triangle())
-  const std::uint32_t b = nodes[n].base;
-  nodes[n].set_side(side_of(t));
+// A new leaf `n` with triangle t = (A, L, R): its diamond is centred at the midpoint of L-R.
+// It shares its partner's entry when the neighbour across its hypotenuse is a leaf of the same
+// diamond; otherwise the diamond joins the front, is tested at once, and goes to `queue` when
+// active.
+void RoamView::Impl::attach_leaf(std::uint32_t n, const LatticeTriangle& t,
+                                 std::vector<std::uint32_t>* queue) {
+  const std::int64_t sx2 = t.lx + t.rx, sz2 = t.lz + t.rz;
+  if ((sx2 | sz2) & 1) return;  // finest: no diamond (leaf_triangle())
+  const std::int64_t ci = sx2 >> 1, cj = sz2 >> 1;
+  Node& x = nodes[n];
+  x.set_side(apex_side(t.ax, t.az, ci, cj));
+  const std::uint32_t b = x.base;
   if (b != kNone && nodes[b].leaf() && nodes[b].base == n) {
-    nodes[n].set_entry(nodes[b].entry());  // the partner's diamond: one entry for both
+    const std::uint32_t e = nodes[b].entry();  // the partner's diamond: one entry for both
+    x.set_entry(e);
+    front.set_nodes(e, b, n);
     return;
   }
-  add_entry((t.lx + t.rx) / 2, (t.lz + t.rz) / 2, n, kNone, false);
+  std::int64_t hu = t.lx - ci, hw = t.lz - cj;
+  canonical_half(hu, hw);
+  const std::uint32_t e = add_entry(ci, cj, hu, hw, n, kNone, false);
+  if ((test_new(e) & kActive) && queue != nullptr) queue->push_back(n);
 }
 
 // ---- detail tiles
@@ -206,6 +219,29 @@ bool RoamView::Impl::chain_ready(std::uint32_t n) {
 // ---- split
 // ----------------------------------------------------------------------------------------
 
+// Splits triangle p (its triangle t, in `patch`, whose new vertex has slot v there) into its two
+// children: c0 = (M, A, L) takes p's triangle slot, c1 = (M, R, A) a new one. Returns c0.
+std::uint32_t RoamView::Impl::split_triangle(std::uint32_t p, const LatticeTriangle& t,
+                                             std::uint32_t patch, std::uint32_t v) {
+  const std::uint32_t c = nodes.alloc_pair();
+  Node& x = nodes[p];
+  const std::array<std::uint32_t, 3> k = out.corners(patch, x.slot());  // (A, L, R)
+  bool pad0 = false, pad1 = false;
+  if (may_pad) {
+    const LatticeTriangle c0 = Landscape::child_triangle(t, 0),
+                          c1 = Landscape::child_triangle(t, 1);
+    pad0 = padding(c0), pad1 = padding(c1);
+  }
+  out.set_triangle(patch, x.slot(), {v, k[0], k[1]}, pad0);
+  const std::uint32_t s1 = out.add_triangle(patch, {v, k[2], k[0]}, pad1);
+  Node& n0 = nodes[c];
+  Node& n1 = nodes[c + 1];
+  n0.parent = n1.parent = p;
+  n0.set_slot(x.slot());
+  n1.set_slot(s1);
+  return c;
+}
+
 bool RoamView::Impl::split(std::uint32_t n, bool forced, std::vector<std::uint32_t>* queue) {
   // Make the base neighbour a diamond partner first (forced splits): it is coarser, and its
   // split gives n a partner sharing n's hypotenuse.
@@ -223,61 +259,48 @@ bool RoamView::Impl::split(std::uint32_t n, bool forced, std::vector<std::uint32
   else
     ++st.splits;
   const std::uint32_t T = n, B = nodes[n].base;
-  const LatticeTriangle tT = leaf_triangle(T);
-  const std::int64_t mx = (tT.lx + tT.rx) / 2, mz = (tT.lz + tT.rz) / 2;
+  const std::int64_t ci = front.ci(e), cj = front.cj(e), hu = front.hu(e), hw = front.hw(e);
+  const std::uint32_t sideT = nodes[T].side();
+  const LatticeTriangle tT = diamond_triangle(ci, cj, hu, hw, sideT);
   const std::uint32_t pT = patch_of(tT);
-  // The new vertex's bounds: the entry holds them in the screen metric (refreshed above when
-  // they were provisional).
-  DiamondBound vb;
-  const DiamondBound* known = nullptr;
-  if (!cam.world) {
-    vb.morph = front.mu(e);
-    vb.radius = front.radius(e);
-    known = &vb;
-  }
-  const std::uint32_t vT = out.add_vertex(pT, mx, mz, known);
+  // The new vertex: height and bounds from the entry; in the tolerance mode the entry holds the
+  // error bound, so the output looks its bounds up. An entry still provisional after the
+  // refresh above waited on a tile this update's snapshot does not hold yet (a synchronous
+  // cache made it resident during the request): its true height comes from the surface.
+  const float vy = front.provisional(e) ? land.lattice_height(ci, cj) : front.y(e);
+  const float vmu = front.mu(e), vr = front.radius(e);
+  auto add_vertex = [&](std::uint32_t patch) {
+    return cam.world ? out.add_vertex(patch, ci, cj) : out.add_vertex(patch, ci, cj, vy, vmu, vr);
+  };
+  const std::uint32_t vT = add_vertex(pT);
   LatticeTriangle tB{};
   std::uint32_t pB = pT, vB = vT;
   if (B != kNone) {
-    // The partner is T turned half a turn about the midpoint: (A', R, L), A' = 2M - A.
-    tB = {2 * mx - tT.ax, 2 * mz - tT.az, tT.rx, tT.rz, tT.lx, tT.lz};
+    tB = diamond_triangle(ci, cj, hu, hw, sideT ^ 1u);
     pB = patch_of(tB);
-    if (pB != pT) vB = out.add_vertex(pB, mx, mz, known);
+    if (pB != pT) vB = add_vertex(pB);
   }
-  // Children: c0 = (M, A, L) takes the parent's triangle slot, c1 = (M, R, A) a new one.
-  auto make = [&](std::uint32_t p, const LatticeTriangle& t, std::uint32_t patch, std::uint32_t v,
-                  LatticeTriangle ct[2]) {
-    const std::uint32_t c = nodes.alloc_pair();
-    const std::array<std::uint32_t, 3> k = out.corners(patch, nodes[p].tri);  // (A, L, R)
-    ct[0] = Landscape::child_triangle(t, 0);
-    ct[1] = Landscape::child_triangle(t, 1);
-    out.set_triangle(patch, nodes[p].tri, {v, k[0], k[1]}, padding(ct[0]));
-    const std::uint32_t s1 = out.add_triangle(patch, {v, k[2], k[0]}, padding(ct[1]));
-    nodes[c].parent = nodes[c + 1].parent = p;
-    nodes[c].tri = nodes[p].tri;
-    nodes[c + 1].tri = s1;
-    return c;
-  };
-  LatticeTriangle ctT[2], ctB[2];
-  const std::uint32_t cT = make(T, tT, pT, vT, ctT);
-  const std::uint32_t cB = B != kNone ? make(B, tB, pB, vB, ctB) : kNone;
+  const std::uint32_t cT = split_triangle(T, tT, pT, vT);
+  const std::uint32_t cB = B != kNone ? split_triangle(B, tB, pB, vB) : kNone;
   // Links: each child's base is the parent's outer neighbour on that side; across the split
   // hypotenuse the children border the partner's children.
   auto link = [&](std::uint32_t p, std::uint32_t c, std::uint32_t right_of_c0,
                   std::uint32_t left_of_c1, std::uint32_t vslot) {
     Node& x = nodes[p];
     const std::uint32_t left = x.a, right = x.b;
-    nodes[c].base = left;
-    nodes[c].a = c + 1;
-    nodes[c].b = right_of_c0;
-    nodes[c + 1].base = right;
-    nodes[c + 1].a = left_of_c1;
-    nodes[c + 1].b = c;
+    Node& n0 = nodes[c];
+    Node& n1 = nodes[c + 1];
+    n0.base = left;
+    n0.a = c + 1;
+    n0.b = right_of_c0;
+    n1.base = right;
+    n1.a = left_of_c1;
+    n1.b = c;
     replace_link(left, p, c);
     replace_link(right, p, c + 1);
     x.a = c;
     x.b = vslot;
-    x.tri = kInterior;
+    x.set_interior();
   };
   link(T, cT, cB != kNone ? cB + 1 : kNone, cB, vT);
   if (B != kNone) link(B, cB, cT + 1, cT, vB);
@@ -288,24 +311,16 @@ bool RoamView::Impl::split(std::uint32_t n, bool forced, std::vector<std::uint32
   for (std::uint32_t p : {nodes[T].parent, B != kNone ? nodes[B].parent : kNone}) {
     if (p == kNone || nodes[p].entry() == kNoEntry) continue;
     const std::uint32_t pe = nodes[p].entry();
-    const auto pn = entry_nodes(pe);
+    const std::uint32_t q0 = front.node(pe), q1 = front.node2(pe);
     remove_entry(pe);
-    for (std::uint32_t q : pn)
-      if (q != kNone) nodes[q].set_entry(kNoEntry);
+    nodes[q0].set_entry(kNoEntry);
+    if (q1 != kNone) nodes[q1].set_entry(kNoEntry);
   }
-  const std::uint32_t kids[4] = {cT, cT + 1, cB, cB + 1};
-  const LatticeTriangle* kt[4] = {&ctT[0], &ctT[1], &ctB[0], &ctB[1]};
-  for (int k = 0; k < (B != kNone ? 4 : 2); ++k) {
-    const std::uint32_t c = kids[k];
-    const std::uint32_t before = front.size();
-    attach_leaf(c, *kt[k]);
-    if (front.size() != before) {  // a new diamond: test it now
-      const std::uint32_t ce = nodes[c].entry();
-      ++st.priority_updates;
-      const std::uint8_t t = front.test_one(ce, cam);
-      if (t == kInView) fresh_worst = std::max(fresh_worst, front.priority(ce, cam));
-      if ((t & kActive) && queue != nullptr) queue->push_back(c);
-    }
+  attach_leaf(cT, Landscape::child_triangle(tT, 0), queue);
+  attach_leaf(cT + 1, Landscape::child_triangle(tT, 1), queue);
+  if (B != kNone) {
+    attach_leaf(cB, Landscape::child_triangle(tB, 0), queue);
+    attach_leaf(cB + 1, Landscape::child_triangle(tB, 1), queue);
   }
   return true;
 }
@@ -316,38 +331,39 @@ bool RoamView::Impl::split(std::uint32_t n, bool forced, std::vector<std::uint32
 void RoamView::Impl::merge(std::uint32_t n, std::vector<std::uint32_t>* queue) {
   ++st.merges;
   const std::uint32_t T = n, B = nodes[n].base;
+  const std::uint32_t e = nodes[T].entry();
+  const std::int64_t ci = front.ci(e), cj = front.cj(e), hu = front.hu(e), hw = front.hw(e);
   // A child's diamond is shared with the neighbour across its hypotenuse, or the child's alone.
   auto detach = [&](std::uint32_t c) {
     const std::uint32_t ce = nodes[c].entry();
     if (ce == kNoEntry) return;  // finest
     const std::uint32_t b = nodes[c].base;
     const bool shared = b != kNone && nodes[b].leaf() && nodes[b].base == c;
-    if (!shared) {
+    if (!shared)
       remove_entry(ce);
-    } else if (front.node(ce) == c) {
-      front.set_node(ce, b);
-    }
+    else
+      front.set_nodes(ce, b, kNone);  // the partner's alone now
   };
   std::uint32_t vM = kNone, pM = kNone;
+  LatticeTriangle tT{};
   auto collapse = [&](std::uint32_t p) {
     Node& x = nodes[p];
     const std::uint32_t c0 = x.a, c1 = c0 + 1, vslot = x.b;
     const std::uint32_t left = nodes[c0].base, right = nodes[c1].base;
-    // Geometry and corners first: the children's entries go below.
-    const LatticeTriangle t0 = leaf_triangle(c0);  // (M, A, L); the parent is (A, L, 2M - L)
-    const LatticeTriangle whole{t0.lx, t0.lz, t0.rx, t0.rz, 2 * t0.ax - t0.rx, 2 * t0.az - t0.rz};
-    const std::uint32_t patch = patch_of(t0);
-    const std::array<std::uint32_t, 3> k0 = out.corners(patch, nodes[c0].tri);
-    const std::array<std::uint32_t, 3> k1 = out.corners(patch, nodes[c1].tri);
+    const LatticeTriangle whole = diamond_triangle(ci, cj, hu, hw, x.side());
+    if (p == T) tT = whole;
+    const std::uint32_t patch = patch_of(whole);
+    const std::array<std::uint32_t, 3> k0 = out.corners(patch, nodes[c0].slot());  // (M, A, L)
+    const std::array<std::uint32_t, 3> k1 = out.corners(patch, nodes[c1].slot());  // (M, R, A)
     detach(c0);
     detach(c1);
     replace_link(left, c0, p);
     replace_link(right, c1, p);
-    out.set_triangle(patch, nodes[c0].tri, {k0[1], k0[2], k1[1]}, padding(whole));
-    out.remove_triangle(patch, nodes[c1].tri);
+    out.set_triangle(patch, nodes[c0].slot(), {k0[1], k0[2], k1[1]}, may_pad && padding(whole));
+    out.remove_triangle(patch, nodes[c1].slot());
     if (!(vslot == vM && patch == pM)) out.remove_vertex(patch, vslot);
     vM = vslot, pM = patch;
-    x.tri = nodes[c0].tri;
+    x.set_slot(nodes[c0].slot());
     x.a = left;
     x.b = right;
     nodes.free_pair(c0);
@@ -357,17 +373,24 @@ void RoamView::Impl::merge(std::uint32_t n, std::vector<std::uint32_t>* queue) {
   triangles -= B != kNone ? 2 : 1;
   // Removing the children's entries may have moved this diamond's: read it again.
   front.set_split(nodes[T].entry(), false);
-  // Parents whose children are now all leaves become mergeable.
-  for (std::uint32_t p : {nodes[T].parent, B != kNone ? nodes[B].parent : kNone}) {
+  // Parents whose children are now all leaves become mergeable: their diamond is centred at
+  // the apex of their children.
+  for (std::uint32_t k = 0; k < 2; ++k) {
+    const std::uint32_t c = k == 0 ? T : B;
+    if (c == kNone) continue;
+    const std::uint32_t p = nodes[c].parent;
     if (p == kNone || nodes[p].entry() != kNoEntry || !mergeable(p)) continue;
+    const LatticeTriangle t = k == 0 ? tT : diamond_triangle(ci, cj, hu, hw, nodes[B].side());
+    // c is (M, A_p, L_p) when it is child 0 of p, (M, R_p, A_p) when child 1; p's half
+    // hypotenuse runs from M to L_p (child 0) or R_p (child 1), and A_p sets p's side.
+    const bool first = nodes[p].a == c;
+    [[maybe_unused]] const std::int64_t ax = first ? t.lx : t.rx, az = first ? t.lz : t.rz;  // A_p
+    std::int64_t phu = first ? t.rx - t.ax : t.lx - t.ax, phw = first ? t.rz - t.az : t.lz - t.az;
+    canonical_half(phu, phw);
     const std::uint32_t pb = nodes[p].base;
-    // The parent's diamond is centred at its hypotenuse midpoint: its children's apex.
-    const LatticeTriangle ct = leaf_triangle(p == nodes[T].parent ? T : B);
-    const std::uint32_t pe = add_entry(ct.ax, ct.az, p, pb, true);
-    ++st.priority_updates;
-    const std::uint8_t t = front.test_one(pe, cam);
-    if (t == kInView) fresh_worst = std::max(fresh_worst, front.priority(pe, cam));
-    if (!(t & kActive) && queue != nullptr) queue->push_back(p);
+    RIDGELINE_ASSERT(nodes[p].side() == apex_side(ax, az, t.ax, t.az));
+    const std::uint32_t pe = add_entry(t.ax, t.az, phu, phw, p, pb, true);
+    if (!(test_new(pe) & kActive) && queue != nullptr) queue->push_back(p);
   }
 }
 
@@ -393,13 +416,15 @@ void RoamView::Impl::reset() {
       // root 1: apex (0, P), left edge z = P (towards +z), right edge x = 0 (towards -x)
       r1.a = z + 1 < pz ? 2 * (p + px) : kNone;
       r1.b = x > 0 ? 2 * (p - 1) : kNone;
-      r0.tri = 0;
-      r1.tri = 1;
+      r0.set_slot(0);
+      r1.set_slot(1);
       const std::int64_t ci = std::int64_t(x) * P + P / 2, cj = std::int64_t(z) * P + P / 2;
-      const LatticeTriangle t0 = land.triangle(2 * p, 1), t1 = land.triangle(2 * p + 1, 1);
-      add_entry(ci, cj, 2 * p, 2 * p + 1, false);
-      r0.set_side(side_of(t0));
-      r1.set_side(side_of(t1));
+      const LatticeTriangle t0 = land.triangle(2 * p, 1);
+      std::int64_t hu, hw;
+      half_hypotenuse(ci, cj, K, hu, hw);
+      add_entry(ci, cj, hu, hw, 2 * p, 2 * p + 1, false);
+      r0.set_side(apex_side(t0.ax, t0.az, ci, cj));
+      r1.set_side(r0.side() ^ 1u);
     }
   }
   triangles = land.root_count();

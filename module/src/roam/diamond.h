@@ -117,3 +117,28 @@ inline Diamond diamond_at(std::int64_t i, std::int64_t j, int K) noexcept {
 }
 
 }  // namespace ridgeline::roam
+
+namespace ridgeline::roam {
+
+/// A diamond's half hypotenuse (hu, hw) in its canonical orientation: the vector from the centre
+/// to one end of the shared hypotenuse, chosen so that its turn by 90 degrees, p = (-hw, hu),
+/// points at the apex of side 1 (apex_side()). Then the triangle of side s is, with sigma = +1
+/// for side 1 and -1 for side 0,
+///   apex A = c + sigma p,  left L = c + sigma h,  right R = c - sigma h
+/// (counter-clockwise seen from above, (apex, left, right) as in landscape.h), and its children
+/// are (M, A, L) and (M, R, A) with M = c.
+inline void canonical_half(std::int64_t& hu, std::int64_t& hw) noexcept {
+  if (hw > 0 || (hw == 0 && hu < 0)) hu = -hu, hw = -hw;
+}
+
+/// The canonical half hypotenuse of the diamond centred at (i, j) (not a patch corner).
+inline void half_hypotenuse(std::int64_t i, std::int64_t j, int K, std::int64_t& hu,
+                            std::int64_t& hw) noexcept {
+  const Diamond d = diamond_at(i, j, K);
+  std::int64_t x0, z0, x1, z1;
+  d.hypotenuse(x0, z0, x1, z1);
+  hu = x1 - i, hw = z1 - j;
+  canonical_half(hu, hw);
+}
+
+}  // namespace ridgeline::roam

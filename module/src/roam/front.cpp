@@ -1,91 +1,151 @@
-// The front's test, vectorised (compiled with -O3 -ffp-contract=off -fno-math-errno: the
-// vector and scalar paths make the same IEEE operations in the same order, so a diamond tested
-// alone gets the same answer as in the pass). The test is Lindstrom & Pascucci's (SOAR, 2001):
-// active when (kappa mu + r)^2 > d^2, with nested bounds and spheres, plus view culling of the
-// sphere against the side planes and the far distance.
+// The front's test, vectorised (compiled with -ffp-contract=off -fno-math-errno: the vector and
+// scalar paths make the same IEEE operations in the same order, so a diamond tested alone gets
+// the same answer as in the pass). The test is Lindstrom & Pascucci's (SOAR, 2001): active when
+// (kappa mu + r)^2 > d^2, with nested bounds and spheres, plus view culling of the sphere against
+// the side planes and the far distance.
 #include "roam/front.h"
 
 #include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstring>
-#include <glm/geometric.hpp>
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#define RIDGELINE_FRONT_AVX2 1
+#endif
 
 namespace ridgeline::roam {
 
 namespace {
 
-// One entry's test. Branch free, so the pass vectorises; `p` receives the priority (projected
-// bound, pixels) with the distance to the sphere clamped to the near plane.
-inline std::uint32_t screen_test(std::int32_t i, std::int32_t j, float y, float mu, float r,
-                                 const FrontCamera& c, float& p) noexcept {
-  const float dx = float(i) * c.sx - c.ex, dy = y - c.ey, dz = float(j) * c.sz - c.ez;
+// One entry's test; `p` receives the priority (projected bound, pixels) with the distance to the
+// sphere clamped to the near plane. Every operation here is mirrored, in the same order, by the
+// eight-lane pass below.
+inline std::uint32_t screen_test(float x, float y, float z, float mu, float r, const FrontCamera& c,
+                                 float* p) noexcept {
+  const float dx = x - c.ex, dy = y - c.ey, dz = z - c.ez;
   const float d2 = dx * dx + dy * dy + dz * dz;
   // A diamond without error never splits, even with the eye inside its sphere; one over the
-  // data's border always does (radius FLT_MAX).
-  const std::uint32_t may = (mu > 0.0f) | (r >= 3.0e38f);
-  r += c.margin;
+  // data's border always does.
+  const std::uint32_t may = std::uint32_t(mu > 0.0f) | std::uint32_t(r >= Front::kBorderRadius);
+  r = r + c.margin;
   const float m = c.kappa * mu + r;
-  const std::uint32_t act = (m * m > d2) & may;  // 0 * inf (zero bound, threshold 0) is NaN
+  const std::uint32_t act = std::uint32_t(m * m > d2) & may;  // 0 * inf (bound 0, threshold 0)
   const float s0 = c.planes[0][0] * dx + c.planes[0][1] * dy + c.planes[0][2] * dz;
   const float s1 = c.planes[1][0] * dx + c.planes[1][1] * dy + c.planes[1][2] * dz;
   const float s2 = c.planes[2][0] * dx + c.planes[2][1] * dy + c.planes[2][2] * dz;
   const float s3 = c.planes[3][0] * dx + c.planes[3][1] * dy + c.planes[3][2] * dz;
   const float nr = -r, fr = c.far_m + r;
-  const std::uint32_t in = (s0 >= nr) & (s1 >= nr) & (s2 >= nr) & (s3 >= nr) & (d2 <= fr * fr);
-  float den = std::sqrt(d2) - r;
-  den = den > c.near_m ? den : c.near_m;
-  p = mu * c.scale / den;
+  const std::uint32_t in = std::uint32_t(s0 >= nr) & std::uint32_t(s1 >= nr) &
+                           std::uint32_t(s2 >= nr) & std::uint32_t(s3 >= nr) &
+                           std::uint32_t(d2 <= fr * fr);
+  if (p != nullptr) {
+    float den = std::sqrt(d2) - r;
+    den = den > c.near_m ? den : c.near_m;
+    *p = mu * c.scale / den;
+  }
   return (act & in) | (in << 1);
 }
 
-inline std::uint32_t world_test(float mu, float r, const FrontCamera& c, float& p) noexcept {
-  p = mu;
-  const std::uint32_t act = (mu > c.threshold) | (r >= 3.0e38f);  // the data border is forced
+inline std::uint32_t world_test(float mu, float r, const FrontCamera& c, float* p) noexcept {
+  if (p != nullptr) *p = mu;
+  const std::uint32_t act =
+      std::uint32_t(mu > c.threshold) | std::uint32_t(r >= Front::kBorderRadius);
   return act | kInView;
 }
 
-// The new state word of a lane from its old one and the test's result.
-inline std::uint32_t with_result(std::uint32_t state, std::uint32_t t) noexcept {
-  const std::uint32_t changed = ((t & kActive) ^ (state & Front::kSplit)) << 2;
-  return (state & ~(0xffu << Front::kResultShift)) | ((t | changed) << Front::kResultShift);
-}
-
-#if defined(__x86_64__) && !defined(__clang__)
-#define RIDGELINE_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define RIDGELINE_CLONES
-#endif
-
-// The pass, one block of four lanes at a time: the results, and the largest priority of an entry
-// in view whose test fails (what stays unsplit once the changes are made), as the bits of a
-// non-negative float (integer order: the reduction vectorises). Lanes past the last entry hold
-// zeros and test inactive, out of view.
-RIDGELINE_CLONES
-std::uint32_t screen_pass(Front::Block* __restrict blocks, std::size_t nblocks,
-                          const FrontCamera& c, std::uint8_t* __restrict changed) {
-  const FrontCamera cc = c;  // a local copy: no aliasing with the blocks
-  std::uint32_t worst = 0;
-  for (std::size_t b = 0; b < nblocks; ++b) {
-    const std::int32_t* __restrict bi = blocks[b].i;
-    const std::int32_t* __restrict bj = blocks[b].j;
-    const float* __restrict y = blocks[b].y;
-    const float* __restrict mu = blocks[b].mu;
-    const float* __restrict r = blocks[b].r;
-    std::uint32_t* __restrict st = blocks[b].state;
+// The pass without vector instructions: the scalar test lane by lane.
+float screen_pass_scalar(const Front::Hot* hot, Front::Masks* masks, std::size_t nb,
+                         const FrontCamera& c) {
+  float worst = 0.0f;
+  for (std::size_t b = 0; b < nb; ++b) {
+    const Front::Hot& h = hot[b];
+    std::uint32_t act = 0, view = 0;
     for (std::uint32_t l = 0; l < Front::kLanes; ++l) {
-      float pk;
-      const std::uint32_t t = screen_test(bi[l], bj[l], y[l], mu[l], r[l], cc, pk);
-      st[l] = with_result(st[l], t);
-      // In view and the test failed: keep the priority's bits (a mask, so that it vectorises).
-      const std::uint32_t q = std::bit_cast<std::uint32_t>(pk) & -std::uint32_t(t == kInView);
-      worst = q > worst ? q : worst;
+      float p;
+      const std::uint32_t t = screen_test(h.x[l], h.y[l], h.z[l], h.mu[l], h.r[l], c, &p);
+      act |= (t & 1u) << l;
+      view |= ((t >> 1) & 1u) << l;
+      if (t == kInView && ((masks[b].valid >> l) & 1u) && p > worst) worst = p;
     }
-    // Whether any lane of the block changed: the view's scan skips the others.
-    changed[b] = std::uint8_t(((st[0] | st[1] | st[2] | st[3]) >> (Front::kResultShift + 2)) & 1);
+    masks[b].active = std::uint8_t(act & masks[b].valid);
+    masks[b].view = std::uint8_t(view & masks[b].valid);
   }
   return worst;
 }
+
+#ifdef RIDGELINE_FRONT_AVX2
+// Eight lanes at a time, the same operations as screen_test() in the same order (no fused
+// multiply-adds). Writes only the masks.
+__attribute__((target("avx2"))) float screen_pass_avx2(const Front::Hot* hot, Front::Masks* masks,
+                                                       std::size_t nb, const FrontCamera& c) {
+  const __m256 ex = _mm256_set1_ps(c.ex), ey = _mm256_set1_ps(c.ey), ez = _mm256_set1_ps(c.ez);
+  const __m256 kappa = _mm256_set1_ps(c.kappa), margin = _mm256_set1_ps(c.margin);
+  const __m256 zero = _mm256_setzero_ps(), border = _mm256_set1_ps(Front::kBorderRadius);
+  const __m256 far = _mm256_set1_ps(c.far_m), near = _mm256_set1_ps(c.near_m);
+  const __m256 scale = _mm256_set1_ps(c.scale);
+  __m256 pl[4][3];
+  for (int k = 0; k < 4; ++k)
+    for (int a = 0; a < 3; ++a) pl[k][a] = _mm256_set1_ps(c.planes[k][a]);
+  // The largest priority of a failing lane in view: mu K / max(d - r, near). Computing it for
+  // every lane costs a square root and a division; instead a lane is a candidate only when
+  // (mu K / w + r)^2 > d^2 (w the largest so far), which every lane whose priority exceeds w
+  // passes (for d - r > near directly, and for d - r <= near because then mu K / w > near,
+  // so mu K / w + r > d). Only blocks with a candidate compute priorities; w climbs to its
+  // final value within the first blocks, so that is rare.
+  float w = 0.0f;
+  __m256 kw = _mm256_set1_ps(INFINITY);  // K / w, generous by 2^-20
+  for (std::size_t b = 0; b < nb; ++b) {
+    const Front::Hot& h = hot[b];
+    const __m256 dx = _mm256_sub_ps(_mm256_load_ps(h.x), ex);
+    const __m256 dy = _mm256_sub_ps(_mm256_load_ps(h.y), ey);
+    const __m256 dz = _mm256_sub_ps(_mm256_load_ps(h.z), ez);
+    const __m256 d2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)),
+                                    _mm256_mul_ps(dz, dz));
+    const __m256 mu = _mm256_load_ps(h.mu);
+    __m256 r = _mm256_load_ps(h.r);
+    const __m256 may =
+        _mm256_or_ps(_mm256_cmp_ps(mu, zero, _CMP_GT_OQ), _mm256_cmp_ps(r, border, _CMP_GE_OQ));
+    r = _mm256_add_ps(r, margin);
+    const __m256 m = _mm256_add_ps(_mm256_mul_ps(kappa, mu), r);
+    const __m256 act = _mm256_and_ps(_mm256_cmp_ps(_mm256_mul_ps(m, m), d2, _CMP_GT_OQ), may);
+    const __m256 nr = _mm256_sub_ps(zero, r);
+    const __m256 fr = _mm256_add_ps(far, r);
+    __m256 in = _mm256_cmp_ps(d2, _mm256_mul_ps(fr, fr), _CMP_LE_OQ);
+    for (int k = 0; k < 4; ++k) {
+      const __m256 s =
+          _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(pl[k][0], dx), _mm256_mul_ps(pl[k][1], dy)),
+                        _mm256_mul_ps(pl[k][2], dz));
+      in = _mm256_and_ps(in, _mm256_cmp_ps(s, nr, _CMP_GE_OQ));
+    }
+    const std::uint32_t valid = masks[b].valid;
+    const auto act_bits = std::uint32_t(_mm256_movemask_ps(_mm256_and_ps(act, in))) & valid;
+    const auto view_bits = std::uint32_t(_mm256_movemask_ps(in)) & valid;
+    masks[b].active = std::uint8_t(act_bits);
+    masks[b].view = std::uint8_t(view_bits);
+    const std::uint32_t q = view_bits & ~act_bits;  // in view, the test failed
+    if (q == 0) continue;
+    const __m256 a = _mm256_add_ps(_mm256_mul_ps(mu, kw), r);
+    if ((std::uint32_t(_mm256_movemask_ps(_mm256_cmp_ps(_mm256_mul_ps(a, a), d2, _CMP_GT_OQ))) &
+         q) == 0)
+      continue;
+    __m256 den = _mm256_sub_ps(_mm256_sqrt_ps(d2), r);
+    den = _mm256_max_ps(den, near);  // den > near ? den : near, as the scalar test
+    alignas(32) float p[8];
+    _mm256_store_ps(p, _mm256_div_ps(_mm256_mul_ps(mu, scale), den));
+    for (std::uint32_t l = 0; l < Front::kLanes; ++l)
+      if (((q >> l) & 1) && p[l] > w) w = p[l];
+    kw = _mm256_set1_ps(w > 0.0f ? c.scale / w * (1.0f + 0x1p-20f) : INFINITY);
+  }
+  return w;
+}
+
+bool have_avx2() {
+  static const bool yes = __builtin_cpu_supports("avx2");
+  return yes;
+}
+#endif
 
 }  // namespace
 
@@ -120,101 +180,136 @@ FrontCamera FrontCamera::world_metres(double threshold_m) {
   return c;
 }
 
-std::uint32_t Front::add(std::int32_t i, std::int32_t j, std::uint32_t t, float y, float mu,
-                         float r, std::uint32_t node, bool split, bool provisional) {
+namespace {
+// The four masks of a block as one word: byte 0 split, 1 active, 2 view, 3 valid (Masks).
+inline std::uint32_t word(const Front::Masks& m) noexcept {
+  std::uint32_t w;
+  std::memcpy(&w, &m, 4);
+  return w;
+}
+inline void set_word(Front::Masks& m, std::uint32_t w) noexcept {
+  std::memcpy(&m, &w, 4);
+}
+constexpr std::uint32_t kLaneBits = 0x01010101u;  // lane 0's bit in each of the four masks
+}  // namespace
+
+std::uint32_t Front::add(std::int32_t i, std::int32_t j, std::int32_t hu, std::int32_t hw,
+                         std::uint32_t t, float x, float y, float z, float mu, float r,
+                         std::uint32_t node, std::uint32_t node2, bool split, bool provisional) {
   const std::uint32_t e = n_++;
-  if ((e & 3) == 0 && (e >> 2) >= blocks_.size()) {
+  const std::uint32_t l = e & 7;
+  if (l == 0 && (e >> 3) >= hot_.size()) {
     // Grow by a quarter, not double: the front is most of a view's memory after the nodes.
-    if (blocks_.size() == blocks_.capacity())
-      blocks_.reserve(std::max<std::size_t>(256, blocks_.size() + blocks_.size() / 4));
-    blocks_.emplace_back();
+    if (hot_.size() == hot_.capacity()) {
+      const std::size_t cap = std::max<std::size_t>(128, hot_.size() + hot_.size() / 4);
+      hot_.reserve(cap);
+      cold_.reserve(cap * kLanes);
+      masks_.reserve(cap);
+    }
+    hot_.emplace_back();
+    masks_.emplace_back();
   }
-  Block& k = blk(e);
-  const std::uint32_t l = e & 3;
-  k.i[l] = i, k.j[l] = j, k.y[l] = y, k.mu[l] = mu, k.r[l] = r, k.node[l] = node;
-  k.state[l] = (t << kLevelShift) | (split ? kSplit : 0u) | (provisional ? kProvisional : 0u);
+  Hot& h = hot_[e >> 3];
+  h.x[l] = x, h.y[l] = y, h.z[l] = z, h.mu[l] = mu, h.r[l] = r;
+  cold_.push_back({i, j, hu, hw, node, node2, (t << 8) | (provisional ? 1u : 0u)});
+  // valid, not active nor in view yet, split as given.
+  Masks& m = masks_[e >> 3];
+  const std::uint32_t w = word(m) & ~(kLaneBits << l);
+  set_word(m, w | ((0x01000000u | std::uint32_t(split)) << l));
   return e;
 }
 
-void Front::set_data(std::uint32_t e, float y, float mu, float r) noexcept {
-  Block& k = blk(e);
-  const std::uint32_t l = e & 3;
-  k.y[l] = y, k.mu[l] = mu, k.r[l] = r;
-}
-
-std::uint32_t Front::remove(std::uint32_t e) {
+std::uint32_t Front::remove(std::uint32_t e) noexcept {
   const std::uint32_t last = --n_;
-  Block& d = blk(e);
-  Block& s = blk(last);
-  const std::uint32_t a = e & 3, b = last & 3;
+  const std::uint32_t a = e & 7, b = last & 7;
+  Masks& ms = masks_[last >> 3];
+  Hot& sh = hot_[last >> 3];
   if (e != last) {
-    d.i[a] = s.i[b], d.j[a] = s.j[b], d.y[a] = s.y[b], d.mu[a] = s.mu[b], d.r[a] = s.r[b];
-    d.state[a] = s.state[b], d.node[a] = s.node[b];
+    Hot& dh = hot_[e >> 3];
+    dh.x[a] = sh.x[b], dh.y[a] = sh.y[b], dh.z[a] = sh.z[b], dh.mu[a] = sh.mu[b], dh.r[a] = sh.r[b];
+    cold_[e] = cold_[last];
+    Masks& md = masks_[e >> 3];
+    const std::uint32_t moved = (word(ms) >> b) & kLaneBits;
+    set_word(md, (word(md) & ~(kLaneBits << a)) | (moved << a));
   }
-  // The freed lane tests inactive and out of view (zero bound and radius, far from the eye is
-  // not needed: a zero sphere at the origin with a zero bound never passes; changed never set).
-  s.i[b] = s.j[b] = 0;
-  s.y[b] = s.mu[b] = s.r[b] = 0.0f;
-  s.state[b] = s.node[b] = 0;
+  // The freed lane: zero bound and radius (never active), outside every mask.
+  sh.x[b] = sh.y[b] = sh.z[b] = sh.mu[b] = sh.r[b] = 0.0f;
+  set_word(ms, word(ms) & ~(kLaneBits << b));
+  cold_.pop_back();
+  if (b == 0) {
+    hot_.pop_back();
+    masks_.pop_back();
+  }
   return last;
 }
 
+void Front::clear() noexcept {
+  n_ = 0;
+  hot_.clear();
+  cold_.clear();
+  masks_.clear();
+}
+
+void Front::set_result(std::uint32_t e, std::uint32_t bits) noexcept {
+  Masks& m = masks_[e >> 3];
+  const std::uint32_t l = e & 7;
+  // bits: kActive (1) -> byte 1, kInView (2) -> byte 2.
+  const std::uint32_t set = ((bits & kActive) << 8 | (bits & kInView) << 15) << l;
+  set_word(m, (word(m) & ~(0x00010100u << l)) | set);
+}
+
 float Front::evaluate(const FrontCamera& c) {
-  const std::size_t nb = (n_ + kLanes - 1) / kLanes;
+  const std::size_t nb = blocks();
   if (c.world) {
     float worst = 0;
     for (std::uint32_t e = 0; e < n_; ++e) {
-      Block& k = blk(e);
-      const std::uint32_t l = e & 3;
       float p;
-      const std::uint32_t t = world_test(k.mu[l], k.r[l], c, p);
-      k.state[l] = with_result(k.state[l], t);
+      const std::uint32_t t = world_test(mu(e), radius(e), c, &p);
+      set_result(e, t);
       if (!(t & kActive)) worst = std::max(worst, p);
     }
-    changed_.assign(blocks_.size(), 1);
     return worst;
   }
-  changed_.resize(blocks_.size());
-  const float worst = std::bit_cast<float>(screen_pass(blocks_.data(), nb, c, changed_.data()));
-  // A lane past the last entry (zeros: a sphere of radius 0 at the lattice origin, bound 0)
-  // never tests active or changed, but tests in view when the origin is: keep it all zeros.
-  for (std::uint32_t e = n_; e < nb * kLanes; ++e) blk(e).state[e & 3] = 0;
-  return worst;
+#ifdef RIDGELINE_FRONT_AVX2
+  if (have_avx2()) return screen_pass_avx2(hot_.data(), masks_.data(), nb, c);
+#endif
+  return screen_pass_scalar(hot_.data(), masks_.data(), nb, c);
 }
 
-std::uint8_t Front::test_one(std::uint32_t e, const FrontCamera& c) noexcept {
-  Block& k = blk(e);
-  const std::uint32_t l = e & 3;
-  float p;
-  const std::uint32_t t = c.world ? world_test(k.mu[l], k.r[l], c, p)
-                                  : screen_test(k.i[l], k.j[l], k.y[l], k.mu[l], k.r[l], c, p);
-  k.state[l] = with_result(k.state[l], t);
+std::uint8_t Front::test_one(std::uint32_t e, const FrontCamera& c, float* priority) noexcept {
+  const Hot& h = hot(e);
+  const std::uint32_t l = e & 7;
+  const std::uint32_t t = c.world
+                              ? world_test(h.mu[l], h.r[l], c, priority)
+                              : screen_test(h.x[l], h.y[l], h.z[l], h.mu[l], h.r[l], c, priority);
+  set_result(e, t);
   return std::uint8_t(t);
 }
 
 float Front::priority(std::uint32_t e, const FrontCamera& c) const noexcept {
-  const Block& k = blk(e);
-  const std::uint32_t l = e & 3;
-  float p;
+  const Hot& h = hot(e);
+  const std::uint32_t l = e & 7;
+  float p = 0;
   if (c.world)
-    (void)world_test(k.mu[l], k.r[l], c, p);
+    (void)world_test(h.mu[l], h.r[l], c, &p);
   else
-    (void)screen_test(k.i[l], k.j[l], k.y[l], k.mu[l], k.r[l], c, p);
+    (void)screen_test(h.x[l], h.y[l], h.z[l], h.mu[l], h.r[l], c, &p);
   return p;
 }
 
 float Front::max_unsplit_priority(const FrontCamera& c) const noexcept {
   float m = 0.0f;
   for (std::uint32_t e = 0; e < n_; ++e) {
-    const std::uint32_t s = st(e), f = s & 0xffu, r = (s >> kResultShift) & 0xffu;
-    if ((f & kSplit) || !(r & kInView) || ((r & kActive) && (f & kProvisional))) continue;
+    const std::uint8_t r = result(e);
+    if (split(e) || !(r & kInView) || ((r & kActive) && provisional(e))) continue;
     m = std::max(m, priority(e, c));
   }
   return m;
 }
 
 std::size_t Front::memory_bytes() const noexcept {
-  return blocks_.capacity() * sizeof(Block) + changed_.capacity();
+  return hot_.capacity() * sizeof(Hot) + cold_.capacity() * sizeof(Cold) +
+         masks_.capacity() * sizeof(Masks);
 }
 
 }  // namespace ridgeline::roam

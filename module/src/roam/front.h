@@ -1,5 +1,5 @@
 // The split and merge front of a RoamView: every diamond that could change in the next update,
-// in blocks of four lanes that one vectorised pass tests each update.
+// in blocks of eight lanes that one vectorised pass tests each update.
 //
 // The front holds each unsplit diamond with at least one triangle in the mesh (a split
 // candidate) and each split diamond whose four children are unsplit (a merge candidate). Every
@@ -7,16 +7,20 @@
 // diamond is active when its projected bound exceeds the threshold and its sphere meets the
 // frustum. Only entries whose activity disagrees with their state are split or merged, so no
 // priority is kept between frames and nothing expires: the cost of frame coherence is one pass
-// over ~0.85 entries per triangle (about a nanosecond each) plus the changes.
+// over ~0.85 entries per triangle (well under a nanosecond each) plus the changes.
 //
-// Layout: blocks of four entries, each field four consecutive 32-bit values (structure of arrays
-// inside a block, array of blocks; 128 bytes, two cache lines per block). The pass reads whole
-// vectors; adding, removing or testing one entry touches two cache lines, not one per field.
+// Layout: what the pass reads (the centre's position, the bound and the radius) is in blocks of
+// eight entries, five rows of eight floats; what only the changes read (lattice indices,
+// geometry, nodes, flags) is one 32-byte record per entry; and the pass writes nothing per entry:
+// its results are two bytes per block (which lanes are active, which in view), beside a byte of
+// which lanes are split. So a pass streams 20 bytes per entry and writes 2 bytes per eight, and
+// a change reads one cache line for an entry's cold data.
 #pragma once
 
 #include <cstdint>
 #include <vector>
 
+#include "memory_hints.h"
 #include "ridgeline/camera.h"
 
 namespace ridgeline::roam {
@@ -48,99 +52,132 @@ struct FrontCamera {
   static FrontCamera world_metres(double threshold_m);
 };
 
-/// Result of the test of one entry: active, in view, and whether the test disagrees with the
-/// entry's split state.
-inline constexpr std::uint8_t kActive = 1, kInView = 2, kChanged = 4;
+/// Result of the test of one entry: active, in view.
+inline constexpr std::uint8_t kActive = 1, kInView = 2;
 
 class Front {
  public:
-  static constexpr std::uint32_t kLanes = 4;
-  /// Per entry flags: kSplit (a merge candidate), kProvisional (a detail vertex whose height is
-  /// not known yet, its tile not resident: its sphere is widened to hold every height it may
-  /// take).
-  static constexpr std::uint8_t kSplit = 1, kProvisional = 2;
-  /// State word of a lane: flags in bits 0-7, the last test's result in bits 8-15, the
-  /// diamond's log2 size (Diamond::t) in bits 16-23.
-  static constexpr int kResultShift = 8, kLevelShift = 16;
+  static constexpr std::uint32_t kLanes = 8;
+  /// Bound of a diamond over the data's border: always active (FrontCamera's test).
+  static constexpr float kBorderRadius = 3.0e38f;
+
+  struct alignas(64) Hot {  // what the pass reads
+    float x[kLanes], y[kLanes], z[kLanes], mu[kLanes], r[kLanes];
+  };
+  struct alignas(32) Cold {  // what the changes read, one entry per half cache line
+    std::int32_t i, j;       // centre, finest-lattice indices
+    std::int32_t hu, hw;     // half hypotenuse, canonical (diamond.h, canonical_half())
+    std::uint32_t node, node2;
+    std::uint32_t flags;  // bit 0: provisional; bits 8..: log2 of the diamond's size
+  };
+  /// Per block: which lanes are split (kept by set_split()), and the last test's active and
+  /// in-view lanes (bit l = lane l).
+  struct Masks {
+    std::uint8_t split = 0, active = 0, view = 0, valid = 0;
+  };
+  static_assert(sizeof(Masks) == 4);
 
   std::uint32_t size() const noexcept { return n_; }
-  bool split(std::uint32_t e) const noexcept { return (st(e) & kSplit) != 0; }
-  void set_split(std::uint32_t e, bool s) noexcept { set_flag(e, kSplit, s); }
-  bool provisional(std::uint32_t e) const noexcept { return (st(e) & kProvisional) != 0; }
-  void set_provisional(std::uint32_t e, bool p) noexcept { set_flag(e, kProvisional, p); }
-  /// One node of the diamond (a leaf, or an interior node when split).
-  std::uint32_t node(std::uint32_t e) const noexcept { return blk(e).node[e & 3]; }
-  void set_node(std::uint32_t e, std::uint32_t n) noexcept { blk(e).node[e & 3] = n; }
-  /// The diamond's centre (finest-lattice indices) and log2 of its size.
-  std::int32_t ci(std::uint32_t e) const noexcept { return blk(e).i[e & 3]; }
-  std::int32_t cj(std::uint32_t e) const noexcept { return blk(e).j[e & 3]; }
-  std::uint32_t t(std::uint32_t e) const noexcept { return (st(e) >> kLevelShift) & 0xffu; }
-  float y(std::uint32_t e) const noexcept { return blk(e).y[e & 3]; }
-  float mu(std::uint32_t e) const noexcept { return blk(e).mu[e & 3]; }
-  float radius(std::uint32_t e) const noexcept { return blk(e).r[e & 3]; }
-  /// Result (kActive, kInView, kChanged) of the last evaluate() or test_one().
+  std::uint32_t blocks() const noexcept { return (n_ + kLanes - 1) / kLanes; }
+  bool split(std::uint32_t e) const noexcept { return (mask(e).split >> (e & 7)) & 1; }
+  void set_split(std::uint32_t e, bool s) noexcept {
+    std::uint8_t& m = masks_[e >> 3].split;
+    m = s ? std::uint8_t(m | (1u << (e & 7))) : std::uint8_t(m & ~(1u << (e & 7)));
+  }
+  /// A detail vertex whose height is not known yet (its tile not resident): its sphere is
+  /// widened to hold every height it may take.
+  bool provisional(std::uint32_t e) const noexcept { return (cold(e).flags & 1u) != 0; }
+  void set_provisional(std::uint32_t e, bool p) noexcept {
+    std::uint32_t& f = cold(e).flags;
+    f = p ? (f | 1u) : (f & ~1u);
+  }
+  /// The nodes of the diamond (leaves, or interior nodes when split): node() always, node2()
+  /// the partner across the shared hypotenuse when it is in the mesh (kNone otherwise).
+  std::uint32_t node(std::uint32_t e) const noexcept { return cold(e).node; }
+  std::uint32_t node2(std::uint32_t e) const noexcept { return cold(e).node2; }
+  void set_nodes(std::uint32_t e, std::uint32_t n, std::uint32_t n2) noexcept {
+    cold(e).node = n, cold(e).node2 = n2;
+  }
+  /// The diamond's centre (finest-lattice indices), its half hypotenuse (geometry.h) and log2
+  /// of its size (Diamond::t).
+  std::int32_t ci(std::uint32_t e) const noexcept { return cold(e).i; }
+  std::int32_t cj(std::uint32_t e) const noexcept { return cold(e).j; }
+  std::int32_t hu(std::uint32_t e) const noexcept { return cold(e).hu; }
+  std::int32_t hw(std::uint32_t e) const noexcept { return cold(e).hw; }
+  std::uint32_t t(std::uint32_t e) const noexcept { return cold(e).flags >> 8; }
+  float y(std::uint32_t e) const noexcept { return hot(e).y[e & 7]; }
+  float mu(std::uint32_t e) const noexcept { return hot(e).mu[e & 7]; }
+  float radius(std::uint32_t e) const noexcept { return hot(e).r[e & 7]; }
+  /// kActive, kInView of the last evaluate() or test_one().
   std::uint8_t result(std::uint32_t e) const noexcept {
-    return std::uint8_t(st(e) >> kResultShift);
+    const Masks& m = mask(e);
+    const unsigned l = e & 7;
+    return std::uint8_t(((m.active >> l) & 1) | (((m.view >> l) & 1) << 1));
   }
   /// Priority: the projected bound (pixels; metres with kWorldMetres), distances clamped to the
   /// near plane. Computed, not stored.
   float priority(std::uint32_t e, const FrontCamera& c) const noexcept;
 
-  /// Appends an entry; returns its index.
-  std::uint32_t add(std::int32_t i, std::int32_t j, std::uint32_t t, float y, float mu, float r,
-                    std::uint32_t node, bool split, bool provisional);
+  /// Appends an entry; returns its index. (x, z) is the centre in metres (i * sx, j * sz as
+  /// floats), y its height.
+  std::uint32_t add(std::int32_t i, std::int32_t j, std::int32_t hu, std::int32_t hw,
+                    std::uint32_t t, float x, float y, float z, float mu, float r,
+                    std::uint32_t node, std::uint32_t node2, bool split, bool provisional);
   /// Rewrites an entry's data (after an edit or a tile's arrival).
-  void set_data(std::uint32_t e, float y, float mu, float r) noexcept;
+  void set_data(std::uint32_t e, float y, float mu, float r) noexcept {
+    Hot& h = hot(e);
+    h.y[e & 7] = y, h.mu[e & 7] = mu, h.r[e & 7] = r;
+  }
   /// Removes entry `e` by moving the last entry into its place; returns the old index of the
   /// moved entry (== e when `e` was the last), whose nodes the caller re-points.
-  std::uint32_t remove(std::uint32_t e);
-  /// Empties the front; keeps the memory. (Lanes past size() must read as zeros: the pass tests
-  /// whole blocks.)
-  void clear() noexcept {
-    n_ = 0;
-    blocks_.clear();
-  }
+  std::uint32_t remove(std::uint32_t e) noexcept;
+  /// Empties the front; keeps the memory.
+  void clear() noexcept;
 
-  /// Tests every entry for `c`: result() of each. Returns the largest priority of an entry in
+  /// Tests every entry for `c` (result() of each). Returns the largest priority of an entry in
   /// view whose test fails (0 when none).
   float evaluate(const FrontCamera& c);
   /// Tests one entry (a new one, or one whose data changed) the same way, bit for bit; returns
-  /// kActive | kInView bits.
-  std::uint8_t test_one(std::uint32_t e, const FrontCamera& c) noexcept;
+  /// kActive | kInView bits. `priority`, when given, receives its priority.
+  std::uint8_t test_one(std::uint32_t e, const FrontCamera& c, float* priority = nullptr) noexcept;
   /// Largest priority of an entry in view that is left unsplit, not counting those that wait
   /// for a detail tile (active and provisional).
   float max_unsplit_priority(const FrontCamera& c) const noexcept;
 
-  /// Hints the caches to fetch entry e (both lines of its block).
-  void prefetch(std::uint32_t e) const noexcept {
-    if (e < n_) __builtin_prefetch(&blocks_[e >> 2]), __builtin_prefetch(&blocks_[e >> 2].state);
+  /// Lanes of block b whose last test disagrees with their state (active and unsplit, or split
+  /// and inactive).
+  std::uint32_t changed(std::uint32_t b) const noexcept {
+    const Masks& m = masks_[b];
+    return std::uint32_t((m.active ^ m.split) & m.valid);
   }
-  /// Whether a lane of block b may have changed in the last evaluate() (a quick skip for scans).
-  bool block_changed(std::uint32_t b) const noexcept { return changed_[b] != 0; }
-  /// The state words of block b (lanes past size() are 0), for scanning.
-  const std::uint32_t* block_state(std::uint32_t b) const noexcept { return blocks_[b].state; }
+  /// Hints the caches to fetch what a change reads of entry e: its cold record, and with
+  /// `all` its hot lanes (three lines) and masks too.
+  void prefetch(std::uint32_t e, bool all = false) const noexcept {
+    e = e < n_ ? e : 0;
+    detail::prefetch(cold_.data() + e);
+    if (!all) return;
+    const char* h = reinterpret_cast<const char*>(hot_.data() + (e >> 3));
+    detail::prefetch(h);
+    detail::prefetch(h + 64);
+    detail::prefetch(h + 128);
+    detail::prefetch(masks_.data() + (e >> 3));
+  }
 
   /// Bytes held (capacity).
   std::size_t memory_bytes() const noexcept;
 
-  struct alignas(64) Block {
-    std::int32_t i[kLanes], j[kLanes];
-    float y[kLanes], mu[kLanes], r[kLanes];
-    std::uint32_t state[kLanes], node[kLanes], spare[kLanes];
-  };
-  static_assert(sizeof(Block) == 128);
-
  private:
-  const Block& blk(std::uint32_t e) const noexcept { return blocks_[e >> 2]; }
-  Block& blk(std::uint32_t e) noexcept { return blocks_[e >> 2]; }
-  std::uint32_t st(std::uint32_t e) const noexcept { return blk(e).state[e & 3]; }
-  void set_flag(std::uint32_t e, std::uint8_t bit, bool on) noexcept {
-    std::uint32_t& f = blk(e).state[e & 3];
-    f = on ? (f | bit) : (f & ~std::uint32_t(bit));
-  }
+  const Hot& hot(std::uint32_t e) const noexcept { return hot_[e >> 3]; }
+  Hot& hot(std::uint32_t e) noexcept { return hot_[e >> 3]; }
+  const Cold& cold(std::uint32_t e) const noexcept { return cold_[e]; }
+  Cold& cold(std::uint32_t e) noexcept { return cold_[e]; }
+  const Masks& mask(std::uint32_t e) const noexcept { return masks_[e >> 3]; }
+  void set_result(std::uint32_t e, std::uint32_t bits) noexcept;
+
   std::uint32_t n_ = 0;
-  std::vector<Block> blocks_;
-  std::vector<std::uint8_t> changed_;  // per block, from the last evaluate()
+  std::vector<Hot> hot_;
+  std::vector<Cold> cold_;
+  std::vector<Masks> masks_;
 };
 
 }  // namespace ridgeline::roam

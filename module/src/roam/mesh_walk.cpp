@@ -122,7 +122,7 @@ std::string RoamView::Impl::check() const {
     }
     // Its output triangle: the corners' lattice positions are the triangle's.
     const std::uint32_t patch = m.patch_of(t);
-    const auto& k = m.out.corners(patch, nd.tri);
+    const auto& k = m.out.corners(patch, nd.slot());
     const std::int64_t want[3][2] = {{t.ax, t.az}, {t.lx, t.lz}, {t.rx, t.rz}};
     for (int q = 0; q < 3; ++q) {
       const auto pos = m.out.coord(patch, k[q]);
@@ -160,10 +160,16 @@ std::string RoamView::Impl::check() const {
         err = fmt("leaf %u and its base neighbour %u differ by more than one level", n, nd.base);
     }
   });
-  // Lanes past the last entry are zeros (the pass tests whole blocks).
-  for (std::uint32_t e = m.front.size(); e % roam::Front::kLanes != 0 && err.empty(); ++e)
-    if (m.front.block_state(e / roam::Front::kLanes)[e % roam::Front::kLanes] != 0)
-      err = fmt("front lane %u past the last entry is not empty", e);
+  // Every entry's geometry is its diamond's: level and canonical half hypotenuse.
+  for (std::uint32_t e = 0; e < m.front.size() && err.empty(); ++e) {
+    std::int64_t hu, hw;
+    half_hypotenuse(m.front.ci(e), m.front.cj(e), m.K, hu, hw);
+    const auto t = std::uint32_t(std::min(ctz64(m.front.ci(e)), ctz64(m.front.cj(e))));
+    if (hu != m.front.hu(e) || hw != m.front.hw(e) || t != m.front.t(e))
+      err = fmt("front entry %u (%d, %d): half hypotenuse (%d, %d) level %u, want (%lld, %lld) %u",
+                e, m.front.ci(e), m.front.cj(e), m.front.hu(e), m.front.hw(e), m.front.t(e),
+                static_cast<long long>(hu), static_cast<long long>(hw), t);
+  }
   // Every front entry points back at a node of its diamond that is in the trees.
   for (std::uint32_t e = 0; e < m.front.size() && err.empty(); ++e) {
     const std::uint32_t n = m.front.node(e);
@@ -171,6 +177,12 @@ std::string RoamView::Impl::check() const {
         m.nodes[n].leaf() == m.front.split(e))
       err = fmt("front entry %u (%d, %d) points at node %u, which is not a %s of its diamond", e,
                 m.front.ci(e), m.front.cj(e), n, m.front.split(e) ? "split node" : "leaf");
+    // Its second node is the first's partner across the shared hypotenuse, when there is one.
+    const std::uint32_t b = err.empty() ? m.nodes[n].base : kNone;
+    const std::uint32_t partner = b != kNone && m.nodes[b].base == n ? b : kNone;
+    if (err.empty() && m.front.node2(e) != partner)
+      err = fmt("front entry %u (%d, %d): second node %u, the partner is %u", e, m.front.ci(e),
+                m.front.cj(e), m.front.node2(e), partner);
   }
   if (err.empty() && leaves != m.triangles)
     err = fmt("leaf count %u differs from the triangle counter %u", leaves, m.triangles);

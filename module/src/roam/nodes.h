@@ -7,35 +7,42 @@
 #include <type_traits>
 #include <vector>
 
+#include "memory_hints.h"
+
 namespace ridgeline::roam {
 
 inline constexpr std::uint32_t kNone = 0xffffffffu;
-/// Node::tri of an interior node.
-inline constexpr std::uint32_t kInterior = 0xffffffffu;
-/// Node::front's low 31 bits when the node's diamond has no front entry.
-inline constexpr std::uint32_t kNoEntry = 0x7fffffffu;
+/// Node::slot() of an interior node.
+inline constexpr std::uint32_t kInterior = 0x7fffffffu;
+/// Node::entry() when the node's diamond has no front entry.
+inline constexpr std::uint32_t kNoEntry = 0xffffffffu;
 
 /// One bintree triangle. A leaf and an interior node use the two middle words differently:
-///   leaf:     a = left neighbour, b = right neighbour, tri = triangle slot in its patch's buffers
+///   leaf:     a = left neighbour, b = right neighbour, slot() = triangle slot in its patch's
+///             buffers
 ///   interior: a = first child (the pair a, a + 1), b = vertex slot of its hypotenuse midpoint in
-///             its patch's buffers, tri = kInterior
-/// `front` holds the index of its diamond's front entry (kNoEntry: none; a leaf always has one,
-/// an interior node when its diamond is mergeable) and, in bit 31, which of the diamond's two
-/// apexes is this triangle's (Diamond::apexes() order), so a node's geometry follows from the
-/// entry's centre without being stored. Geometry, root and heap index are never stored: they
-/// follow from the entry (leaves) or from a walk from the roots.
+///             its patch's buffers, slot() = kInterior
+/// `front` is the index of its diamond's front entry (kNoEntry: none; a leaf always has one, an
+/// interior node when its diamond is mergeable): a whole word, so that re-pointing a node at a
+/// moved entry is a plain store, no read. side() says which of the diamond's two apexes is this
+/// triangle's (Diamond::apexes() order), so a node's geometry follows from the entry's centre
+/// without being stored. Geometry, root and heap index are never stored: they follow from the
+/// entry (leaves) or from a walk from the roots.
 struct Node {
   std::uint32_t parent = kNone;
   std::uint32_t base = kNone;  ///< neighbour across the hypotenuse (kNone on the border)
   std::uint32_t a = kNone, b = kNone;
   std::uint32_t front = kNoEntry;
-  std::uint32_t tri = kInterior;
+  std::uint32_t tri = kInterior;  ///< slot (bits 0-30) and side (bit 31)
 
-  bool leaf() const noexcept { return tri != kInterior; }
-  std::uint32_t entry() const noexcept { return front & kNoEntry; }
-  std::uint32_t side() const noexcept { return front >> 31; }
-  void set_entry(std::uint32_t e) noexcept { front = (front & 0x80000000u) | e; }
-  void set_side(std::uint32_t s) noexcept { front = (front & kNoEntry) | (s << 31); }
+  bool leaf() const noexcept { return (tri & kInterior) != kInterior; }
+  std::uint32_t slot() const noexcept { return tri & kInterior; }
+  void set_slot(std::uint32_t s) noexcept { tri = (tri & ~kInterior) | s; }
+  void set_interior() noexcept { tri |= kInterior; }
+  std::uint32_t entry() const noexcept { return front; }
+  void set_entry(std::uint32_t e) noexcept { front = e; }
+  std::uint32_t side() const noexcept { return tri >> 31; }
+  void set_side(std::uint32_t s) noexcept { tri = (tri & kInterior) | (s << 31); }
 };
 static_assert(sizeof(Node) == 24, "docs/roam.md quotes the node size");
 static_assert(std::is_trivially_destructible_v<Node>);
@@ -50,15 +57,21 @@ class NodePool {
   const Node& operator[](std::uint32_t i) const noexcept {
     return chunks_[i >> kShift].get()[i & kMask];
   }
+  /// Hints the caches to fetch node i (node 0 for kNone or any other index out of range).
+  void prefetch(std::uint32_t i) const noexcept {
+    i = i < size_ ? i : 0;
+    detail::prefetch(&chunks_[i >> kShift].get()[i & kMask]);
+  }
   /// Nodes handed out so far (live or free).
   std::uint32_t size() const noexcept { return size_; }
 
-  /// The first of two new sibling nodes, default-constructed.
+  /// The first of two new sibling nodes, default-constructed. Freed pairs are handed out first,
+  /// the last freed first: their lines are the likeliest to be in the caches.
   std::uint32_t alloc_pair() {
     std::uint32_t c;
-    if (!free_.empty()) {
-      c = free_.back();
-      free_.pop_back();
+    if (free_ != kNone) {
+      c = free_;
+      free_ = (*this)[c].parent;  // a free pair's first node links to the next free pair
     } else {
       c = size_;
       if (((size_ + 1) >> kShift) >= chunks_.size())
@@ -69,19 +82,21 @@ class NodePool {
     ::new (&(*this)[c + 1]) Node{};
     return c;
   }
-  void free_pair(std::uint32_t first) { free_.push_back(first); }
+  void free_pair(std::uint32_t first) {
+    (*this)[first].parent = free_;
+    free_ = first;
+  }
 
   /// Forgets every node; the first `count` (an even number) are handed out again,
   /// default-constructed. Chunks are kept, so a rebuild faults in no new pages.
   void reset(std::uint32_t count) {
-    free_.clear();
+    free_ = kNone;
     size_ = 0;
     while (size_ < count) (void)alloc_pair();
   }
 
   std::size_t memory_bytes() const noexcept {
-    return chunks_.size() * (sizeof(Node) << kShift) + chunks_.capacity() * sizeof(chunks_[0]) +
-           free_.capacity() * sizeof(std::uint32_t);
+    return chunks_.size() * (sizeof(Node) << kShift) + chunks_.capacity() * sizeof(chunks_[0]);
   }
 
  private:
@@ -91,7 +106,7 @@ class NodePool {
     void operator()(Node* p) const noexcept { ::operator delete(p); }
   };
   std::vector<std::unique_ptr<Node, FreeChunk>> chunks_;
-  std::vector<std::uint32_t> free_;
+  std::uint32_t free_ = kNone;  // first node of the last freed pair (a list through `parent`)
   std::uint32_t size_ = 0;
 };
 

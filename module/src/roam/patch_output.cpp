@@ -30,7 +30,7 @@ void PatchOutput::reset(const Landscape& land) {
     pt.mesh.triangles = 0;
     ++pt.mesh.version;
     pt.free_tris.clear();
-    pt.free_verts.clear();
+    pt.free_verts = kNoSlot;
     pt.tri_bits.clear();
     pt.vert_bits.clear();
     pt.hidden.clear();
@@ -48,7 +48,7 @@ void PatchOutput::reset(const Landscape& land) {
 }
 
 void PatchOutput::write_vertex(std::uint32_t patch, std::uint32_t slot, std::int64_t i,
-                               std::int64_t j, const DiamondBound* bound) {
+                               std::int64_t j, const Known* known) {
   const Landscape& l = *land_;
   Patch& p = patches_[patch];
   const std::int64_t P = l.patch_cells();
@@ -58,19 +58,22 @@ void PatchOutput::write_vertex(std::uint32_t patch, std::uint32_t slot, std::int
   MeshVertex v;
   v.x = static_cast<float>(double(i - i0) * l.spacing_x());
   v.z = static_cast<float>(double(j - j0) * l.spacing_z());
-  v.y = l.lattice_height(i, j);
   v.nx = sh.normal.x, v.ny = sh.normal.y, v.nz = sh.normal.z;
   v.morph_dy = sh.morph_dy;
-  if (bound != nullptr) {
-    v.morph_bound = bound->morph;
-    v.morph_radius = bound->radius;
-  } else if (diamond_at(i, j, l.patch_log2()).corner) {
-    v.morph_bound = FLT_MAX;
-    v.morph_radius = 0.0f;
+  if (known != nullptr) {
+    v.y = known->y;
+    v.morph_bound = known->morph;
+    v.morph_radius = known->radius;
   } else {
-    const DiamondBound b = l.diamond(i, j);
-    v.morph_bound = b.morph;
-    v.morph_radius = b.radius;
+    v.y = l.lattice_height(i, j);
+    if (diamond_at(i, j, l.patch_log2()).corner) {
+      v.morph_bound = FLT_MAX;
+      v.morph_radius = 0.0f;
+    } else {
+      const DiamondBound b = l.diamond(i, j);
+      v.morph_bound = b.morph;
+      v.morph_radius = b.radius;
+    }
   }
   v.material = sh.material;
   p.mesh.vertices[slot] = v;
@@ -162,8 +165,7 @@ std::size_t PatchOutput::memory_bytes() const {
         p.mesh.vertices.capacity() * sizeof(MeshVertex) +
         p.mesh.indices.capacity() * sizeof(std::uint32_t) +
         (p.mesh.dirty_vertices.capacity() + p.mesh.dirty_triangles.capacity()) * sizeof(MeshRange) +
-        (p.free_tris.capacity() + p.free_verts.capacity()) * 4 +
-        (p.tri_bits.capacity() + p.vert_bits.capacity()) * 8 +
+        p.free_tris.capacity() * 4 + (p.tri_bits.capacity() + p.vert_bits.capacity()) * 8 +
         p.hidden.size() * (sizeof(std::uint32_t) + 12 + 16) + p.hidden.bucket_count() * 8;
   }
   return b;

@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <unordered_map>
 #include <vector>
 
@@ -22,26 +23,29 @@ class PatchOutput {
   /// Every patch back to its two root triangles over its four corner vertices.
   void reset(const Landscape& land);
 
-  /// A vertex slot for finest-lattice vertex (i, j) in `patch`, its data written. `bound`, when
-  /// given, is the vertex's diamond bound (saves looking it up).
-  std::uint32_t add_vertex(std::uint32_t patch, std::int64_t i, std::int64_t j,
-                           const DiamondBound* bound = nullptr) {
-    Patch& p = patches_[patch];
-    std::uint32_t slot;
-    if (!p.free_verts.empty()) {
-      slot = p.free_verts.back();
-      p.free_verts.pop_back();
-    } else {
-      slot = grow_vertices(p);
-    }
-    write_vertex(patch, slot, i, j, bound);
-    touch(patch);
-    return slot;
+  /// The data of a new vertex that the caller already has: its height and its diamond's morph
+  /// bound and radius.
+  struct Known {
+    float y, morph, radius;
+  };
+  /// A vertex slot for finest-lattice vertex (i, j) in `patch`, its data written (looked up).
+  std::uint32_t add_vertex(std::uint32_t patch, std::int64_t i, std::int64_t j) {
+    return add_vertex_impl(patch, i, j, nullptr);
+  }
+  /// The same, with the height and bounds given (a split has them in its front entry).
+  std::uint32_t add_vertex(std::uint32_t patch, std::int64_t i, std::int64_t j, float y,
+                           float morph, float radius) {
+    const Known k{y, morph, radius};
+    return add_vertex_impl(patch, i, j, &k);
   }
   void remove_vertex(std::uint32_t patch, std::uint32_t slot) {
     Patch& p = patches_[patch];
-    p.mesh.vertices[slot].material = kFreeVertex;  // no upload: no index refers to it any more
-    p.free_verts.push_back(slot);
+    // No upload: no index refers to it any more. A free slot links to the next free one in its
+    // x (read by nothing else), so that taking a free slot touches only the slot.
+    MeshVertex& v = p.mesh.vertices[slot];
+    v.material = kFreeVertex;
+    std::memcpy(&v.x, &p.free_verts, sizeof(std::uint32_t));
+    p.free_verts = slot;
   }
   /// Rewrites a live vertex's data from the landscape (after an edit or a tile's arrival).
   void refresh_vertex(std::uint32_t patch, std::uint32_t slot);
@@ -120,9 +124,11 @@ class PatchOutput {
 
  private:
   static constexpr std::uint32_t kFreeVertex = 0xffffffffu;  // MeshVertex::material of a free slot
+  static constexpr std::uint32_t kNoSlot = 0xffffffffu;
   struct Patch {
     PatchMesh mesh;
-    std::vector<std::uint32_t> free_tris, free_verts;
+    std::vector<std::uint32_t> free_tris;
+    std::uint32_t free_verts = kNoSlot;  // the last freed vertex slot (a list through x)
     std::vector<std::uint64_t> tri_bits, vert_bits;  // slots changed since the last take
     // Corners of the triangles over the padding (their indices are degenerate).
     std::unordered_map<std::uint32_t, std::array<std::uint32_t, 3>> hidden;
@@ -155,8 +161,22 @@ class PatchOutput {
     mark(p.tri_bits, slot, 3 * sizeof(std::uint32_t));
     touch(std::uint32_t(&p - patches_.data()));
   }
+  std::uint32_t add_vertex_impl(std::uint32_t patch, std::int64_t i, std::int64_t j,
+                                const Known* known) {
+    Patch& p = patches_[patch];
+    std::uint32_t slot;
+    if (p.free_verts != kNoSlot) {
+      slot = p.free_verts;
+      std::memcpy(&p.free_verts, &p.mesh.vertices[slot].x, sizeof(std::uint32_t));
+    } else {
+      slot = grow_vertices(p);
+    }
+    write_vertex(patch, slot, i, j, known);
+    touch(patch);
+    return slot;
+  }
   void write_vertex(std::uint32_t patch, std::uint32_t slot, std::int64_t i, std::int64_t j,
-                    const DiamondBound* bound);
+                    const Known* known);
   std::uint32_t grow_vertices(Patch& p);
   std::uint32_t grow_triangles(Patch& p);
 

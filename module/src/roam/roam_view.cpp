@@ -241,18 +241,60 @@ bool RoamView::Impl::merge_candidate(std::uint32_t n) const {
 void RoamView::Impl::collect() {
   to_merge.clear();
   to_split.clear();
-  const std::uint32_t n = front.size();
-  // Few entries change per update: skip the blocks the pass found unchanged.
-  constexpr std::uint32_t kChangedBit = std::uint32_t(kChanged) << Front::kResultShift;
-  for (std::uint32_t b = 0; b * Front::kLanes < n; ++b) {
-    if (!front.block_changed(b)) continue;
-    const std::uint32_t* words = front.block_state(b);
-    for (std::uint32_t l = 0; l < Front::kLanes && b * Front::kLanes + l < n; ++l)
-      if (words[l] & kChangedBit) {
-        const std::uint32_t e = b * Front::kLanes + l;
-        (front.split(e) ? to_merge : to_split).push_back(front.node(e));
-      }
+  // Few entries change per update: the blocks' masks say which.
+  const std::uint32_t nb = front.blocks();
+  for (std::uint32_t b = 0; b < nb; ++b) {
+    for (std::uint32_t c = front.changed(b); c != 0; c &= c - 1) {
+      const std::uint32_t e = b * Front::kLanes + std::uint32_t(__builtin_ctz(c));
+      (front.split(e) ? to_merge : to_split).push_back(front.node(e));
+    }
   }
+}
+
+// The changes are memory walks (node, entry, neighbours, the landscape's records, the patch
+// buffers) that depend on each other within one change but not across changes. So the next
+// changes' data is fetched in stages while this one runs: a node 32 changes ahead, what the node
+// points at 16 ahead, what its entry points at 8 ahead; the misses overlap instead of stalling
+// one change at a time.
+void RoamView::Impl::prefetch_change(const std::vector<std::uint32_t>& list, bool split) const {
+  auto prefetch_record = [&](std::int64_t i, std::int64_t j) {
+    detail::prefetch(land.record_address(i, j));
+  };
+  constexpr std::size_t D1 = 32, D2 = 16, D3 = 8;  // measured: 16/8/4 was ~10 % slower
+  const std::size_t n = list.size();
+  if (n > D1) nodes.prefetch(list[n - D1 - 1]);
+  if (n > D2) {
+    const Node& x = nodes[list[n - D2 - 1]];
+    front.prefetch(x.entry(), true);
+    nodes.prefetch(x.base);
+    nodes.prefetch(x.parent);
+    nodes.prefetch(x.a);
+    if (split) nodes.prefetch(x.b);
+  }
+  if (n <= D3) return;
+  const Node& x = nodes[list[n - D3 - 1]];
+  const std::uint32_t e = x.entry();
+  if (e >= front.size()) return;
+  const std::int64_t i = front.ci(e), j = front.cj(e), hu = front.hu(e), hw = front.hw(e);
+  if (!split) {
+    // A merge removes its children's entries and may make a parent mergeable: the parents are
+    // centred at the two apexes c +- p.
+    front.prefetch(nodes[x.a].entry(), true);
+    front.prefetch(nodes[x.a + 1].entry(), true);
+    prefetch_record(i - hw, j + hu);
+    prefetch_record(i + hw, j - hu);
+    return;
+  }
+  // A split removes its parents' entries (when mergeable), writes its vertex (its record) and
+  // adds its children's diamonds (centres c +- (p +- h) / 2, p = (-hw, hu)).
+  if (x.parent != kNone) front.prefetch(nodes[x.parent].entry(), true);
+  prefetch_record(i, j);
+  if (((hu - hw) | (hu + hw)) & 1) return;  // finest: no child diamonds
+  const std::int64_t au = (hu - hw) / 2, aw = (hu + hw) / 2, bu = (hu + hw) / 2, bw = (hw - hu) / 2;
+  prefetch_record(i + au, j + aw);
+  prefetch_record(i - au, j - aw);
+  prefetch_record(i + bu, j + bw);
+  prefetch_record(i - bu, j - bw);
 }
 
 void RoamView::Impl::converge_all() {
@@ -265,11 +307,7 @@ void RoamView::Impl::converge_all() {
 #endif
   std::vector<std::uint32_t>& list = m.to_merge;
   while (!list.empty()) {
-    if (list.size() > 8) {
-      __builtin_prefetch(&m.nodes[list[list.size() - 8]]);
-      const Node& ahead = m.nodes[list[list.size() - 4]];
-      if (!ahead.leaf() && ahead.a < m.nodes.size()) __builtin_prefetch(&m.nodes[ahead.a]);
-    }
+    m.prefetch_change(list, false);
     const std::uint32_t n = list.back();
     list.pop_back();
     if (m.merge_candidate(n)) m.merge(n, &list);
@@ -282,13 +320,7 @@ void RoamView::Impl::converge_all() {
   }
   std::vector<std::uint32_t>& work = m.to_split;
   while (!work.empty()) {
-    // Software prefetch: the changes are independent memory walks; fetching the next ones'
-    // nodes and entries while this one runs overlaps their cache misses.
-    if (work.size() > 8) {
-      __builtin_prefetch(&m.nodes[work[work.size() - 8]]);
-      const Node& ahead = m.nodes[work[work.size() - 4]];
-      if (ahead.leaf()) m.front.prefetch(ahead.entry());
-    }
+    m.prefetch_change(work, true);
     const std::uint32_t n = work.back();
     work.pop_back();
     if (m.split_candidate(n) && !m.split(n, false, &work)) ++m.st.pending_splits;

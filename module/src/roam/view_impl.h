@@ -9,6 +9,7 @@
 //   mesh_walk.cpp   walks from the roots: leaves, hash, measurement, invariants
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cstdint>
@@ -57,33 +58,46 @@ struct RoamView::Impl {
   // Under a triangle cap: the threshold the last update ended at (0: none yet).
   double cap_threshold = 0;
 
-  // ---- geometry of a node (from its front entry, or its parent's) ---------------------------
+  // Constants of the landscape the hot paths read.
+  const std::int64_t last_i, last_j;  // the last sampled lattice index per axis
+  const std::uint32_t px_count;       // patches along x
+  const float sx, sz;    // metres per finest-lattice step, as the front's test has them
+  bool may_pad = false;  // some patch extends past the samples
 
-  /// The lattice triangle of a leaf (from its entry's centre and its side bit).
+  // ---- geometry (diamond.h: a triangle from its diamond's centre, half hypotenuse and side) --
+
+  static LatticeTriangle diamond_triangle(std::int64_t i, std::int64_t j, std::int64_t hu,
+                                          std::int64_t hw, std::uint32_t side) noexcept;
+  /// The triangle of side `side` of entry e's diamond.
+  LatticeTriangle entry_triangle(std::uint32_t e, std::uint32_t side) const noexcept {
+    return diamond_triangle(front.ci(e), front.cj(e), front.hu(e), front.hw(e), side);
+  }
+  /// The lattice triangle of a leaf (from its entry, or its parent's for the finest level).
   LatticeTriangle leaf_triangle(std::uint32_t n) const;
-  /// The triangle of the node whose diamond is centred at (i, j), on apex side `side`, ordered
-  /// (apex, left, right) counter-clockwise from above.
-  LatticeTriangle diamond_triangle(std::int64_t i, std::int64_t j, std::uint32_t side) const;
-  /// Which apex of the diamond of triangle `t` (its hypotenuse midpoint) is t's.
-  std::uint32_t side_of(const LatticeTriangle& t) const;
   /// The patch holding a triangle.
   std::uint32_t patch_of(const LatticeTriangle& t) const;
-  bool padding(const LatticeTriangle& t) const;
+  /// True when every corner of t lies on or past the last sampled row or column: t is over the
+  /// padding (not drawn).
+  bool padding(const LatticeTriangle& t) const noexcept {
+    return std::min(std::min(t.ax, t.lx), t.rx) >= last_i ||
+           std::min(std::min(t.az, t.lz), t.rz) >= last_j;
+  }
 
   // ---- front ---------------------------------------------------------------------------------
 
-  /// Adds the entry of the diamond centred at (i, j) for node `n` (split or not) and points the
-  /// diamond's nodes at it; returns it. The node's partner, when given, is pointed at it too.
-  std::uint32_t add_entry(std::int64_t i, std::int64_t j, std::uint32_t n, std::uint32_t partner,
-                          bool split);
+  /// Adds the entry of the diamond centred at (i, j) with canonical half hypotenuse (hu, hw)
+  /// for node `n` (split or not) and points the diamond's nodes at it; returns it. The node's
+  /// partner, when given, is pointed at it too.
+  std::uint32_t add_entry(std::int64_t i, std::int64_t j, std::int64_t hu, std::int64_t hw,
+                          std::uint32_t n, std::uint32_t partner, bool split);
   /// Removes an entry; re-points the nodes of the entry moved into its place.
   void remove_entry(std::uint32_t e);
-  /// The nodes of an entry's diamond: its node and its partner (kNone when alone).
-  std::array<std::uint32_t, 2> entry_nodes(std::uint32_t e) const;
   /// Recomputes an entry's bounds and position from the landscape.
   void refresh_entry(std::uint32_t e);
   void entry_data(std::int64_t i, std::int64_t j, float& y, float& mu, float& r,
                   bool& provisional) const;
+  /// Tests a new entry now (counted, and its priority kept for the remaining error).
+  std::uint8_t test_new(std::uint32_t e);
 
   // ---- bintree ---------------------------------------------------------------------------------
 
@@ -101,8 +115,12 @@ struct RoamView::Impl {
   /// True when the vertices a split of n (and its forced chain) creates have their detail.
   bool chain_ready(std::uint32_t n);
   void replace_link(std::uint32_t n, std::uint32_t from, std::uint32_t to);
-  /// A leaf's entry: joins its partner's, or a new one.
-  void attach_leaf(std::uint32_t n, const LatticeTriangle& t);
+  /// Splits triangle p (t, in `patch`; its new vertex's slot v) into a child pair; returns the
+  /// first child.
+  std::uint32_t split_triangle(std::uint32_t p, const LatticeTriangle& t, std::uint32_t patch,
+                               std::uint32_t v);
+  /// A new leaf's entry: joins its partner's, or a new one (tested; to `queue` when active).
+  void attach_leaf(std::uint32_t n, const LatticeTriangle& t, std::vector<std::uint32_t>* queue);
   void reset();
   bool split_candidate(std::uint32_t n) const;
   bool merge_candidate(std::uint32_t n) const;
@@ -114,6 +132,8 @@ struct RoamView::Impl {
   /// The front's entries whose test disagrees with their state, into to_merge and to_split.
   void collect();
   void converge_all();
+  /// Fetches what the next changes of a worklist (its back is next) will read.
+  void prefetch_change(const std::vector<std::uint32_t>& list, bool split) const;
   /// Returns the largest priority in view left unsplit.
   float converge_budgeted(double threshold, std::uint32_t cap);
   /// Under a triangle cap alone: converges at the smallest threshold (>= `threshold`) found
