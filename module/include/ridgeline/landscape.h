@@ -80,6 +80,10 @@ struct VertexShading {
 /// Threading: every method may run concurrently with every other, except that sync() after an
 /// edit must not overlap other readers of this landscape (views calling it concurrently
 /// serialise on an internal lock). Edits to the terrain need exclusive access (terrain.h).
+namespace roam {
+struct LandscapeAccess;  // the tessellator's inline reads of the records (module/src/roam)
+}
+
 class Landscape {
  public:
   static Result<std::shared_ptr<const Landscape>> create(std::shared_ptr<const Terrain> terrain,
@@ -132,25 +136,11 @@ class Landscape {
   /// Bounds of the diamond centred at finest-lattice vertex (i, j), which must be a diamond
   /// centre inside the landscape (0 <= i <= patches_x() * patch_cells(), same for j; not a patch
   /// corner: asserted, zeros returned past the assert).
-  DiamondBound diamond(std::int64_t i, std::int64_t j) const noexcept {
-    if (detail_ == 0 && i >= 0 && j >= 0 && i < stored_w_ && j < stored_h_)
-      return records_[stored_index(i, j)].bound;
-    return diamond_slow(i, j);
-  }
-  /// The address of what diamond() and shading() read for vertex (i, j) when it is stored
-  /// (a hint for prefetching; some valid address otherwise).
-  const void* record_address(std::int64_t i, std::int64_t j) const noexcept {
-    const bool in = detail_ == 0 && i >= 0 && j >= 0 && i < stored_w_ && j < stored_h_;
-    return records_.data() + (in ? stored_index(i, j) : 0);
-  }
+  DiamondBound diamond(std::int64_t i, std::int64_t j) const noexcept;
   /// Shading data of finest-lattice vertex (i, j), inside the landscape (padding included).
   /// Stored once per sample without procedural detail (in the bounds' 28-byte record), computed
   /// otherwise.
-  VertexShading shading(std::int64_t i, std::int64_t j) const noexcept {
-    if (detail_ == 0 && i >= 0 && j >= 0 && i < stored_w_ && j < stored_h_)
-      return unpack(records_[stored_index(i, j)]);
-    return compute_shading(i, j);
-  }
+  VertexShading shading(std::int64_t i, std::int64_t j) const noexcept;
   /// For vertices below the stored resolution: the bound of |detail| over the diamond's reach,
   /// metres (what a sphere about a vertex whose detail is not known yet must add). 0 for stored
   /// vertices or without detail.
@@ -166,13 +156,7 @@ class Landscape {
 
   /// Height of finest-lattice vertex (i, j) relative to the heightfield's offset (base + detail +
   /// edits), with the padding rule (indices clamped into the footprint).
-  float lattice_height(std::int64_t i, std::int64_t j) const noexcept {
-    if (detail_ != 0) return static_cast<float>(terrain_->fine_local_height(i, j));
-    // The copy kept beside the bounds (one cache line for everything about a vertex).
-    if (i >= 0 && j >= 0 && i < stored_w_ && j < stored_h_)
-      return records_[stored_index(i, j)].height;
-    return terrain_->heightfield().local_clamped(i, j);
-  }
+  float lattice_height(std::int64_t i, std::int64_t j) const noexcept;
   /// Height relative to the offset of the stored surface (no detail) at finest-lattice vertex
   /// (i, j): what a vertex's height is known to be within detail_offset_bound() of before its
   /// detail tile is resident.
@@ -219,6 +203,7 @@ class Landscape {
   double build_ms() const noexcept { return build_ms_; }
 
  private:
+  friend struct roam::LandscapeAccess;
   Landscape() = default;
   struct Impl;
   // Exact error against the stored lattice of a triangle in stored-lattice coordinates.

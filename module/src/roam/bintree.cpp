@@ -13,6 +13,7 @@
 
 #include "ridgeline/detail.h"
 #include "ridgeline/log.h"
+#include "roam/landscape_access.h"
 #include "roam/view_impl.h"
 
 namespace ridgeline {
@@ -48,7 +49,7 @@ LatticeTriangle RoamView::Impl::leaf_triangle(std::uint32_t n) const {
     // A half-cell triangle of the finest lattice: no diamond of its own (it never splits); its
     // parent's diamond is always mergeable, so the parent has an entry.
     const Node& p = nodes[x.parent];
-    return Landscape::child_triangle(entry_triangle(p.entry(), p.side()), int(n - p.a));
+    return Landscape::child_triangle(entry_triangle(p.entry(), p.side()), int(n - p.a()));
   }
   return entry_triangle(x.entry(), x.side());
 }
@@ -66,10 +67,16 @@ std::uint32_t RoamView::Impl::patch_of(const LatticeTriangle& t) const {
 
 void RoamView::Impl::entry_data(std::int64_t i, std::int64_t j, float& y, float& mu, float& r,
                                 bool& provisional) const {
-  const DiamondBound b = land.diamond(i, j);
+  provisional = false;
+  DiamondBound b;
+  if (LandscapeAccess::bound_and_height(land, i, j, b, y)) {  // stored: one record, one read
+    mu = cam.world ? b.error : b.morph;
+    r = b.radius;
+    return;
+  }
+  b = LandscapeAccess::diamond(land, i, j);
   mu = cam.world ? b.error : b.morph;
   r = b.radius;
-  provisional = false;
   if (snapshot != nullptr) {
     const int L = int(land.detail_levels());
     const int tz = std::min({ctz64(i), ctz64(j), L});
@@ -86,7 +93,7 @@ void RoamView::Impl::entry_data(std::int64_t i, std::int64_t j, float& y, float&
       }
     }
   }
-  y = land.lattice_height(i, j);
+  y = LandscapeAccess::height(land, i, j);
 }
 
 std::uint32_t RoamView::Impl::add_entry(std::int64_t i, std::int64_t j, std::int64_t hu,
@@ -99,7 +106,7 @@ std::uint32_t RoamView::Impl::add_entry(std::int64_t i, std::int64_t j, std::int
   // The centre's metres as the front's test computed them from lattice indices: float(i) * sx.
   const std::uint32_t e =
       front.add(std::int32_t(i), std::int32_t(j), std::int32_t(hu), std::int32_t(hw), t,
-                float(i) * sx, y, float(j) * sz, mu, r, n, partner, split, prov);
+                float(i) * sx, y, float(j) * sz, mu, r, n, split, prov);
   nodes[n].set_entry(e);
   if (partner != kNone) nodes[partner].set_entry(e);
   return e;
@@ -108,8 +115,10 @@ std::uint32_t RoamView::Impl::add_entry(std::int64_t i, std::int64_t j, std::int
 void RoamView::Impl::remove_entry(std::uint32_t e) {
   const std::uint32_t moved = front.remove(e);
   if (moved == e) return;
-  nodes[front.node(e)].set_entry(e);
-  if (front.node2(e) != kNone) nodes[front.node2(e)].set_entry(e);
+  // The moved entry's nodes: its node, and the partner its base link names.
+  const std::uint32_t n = front.node(e), w = nodes[n].base();
+  nodes[n].set_entry(e);
+  if (w != kNone && back(w) == 0) nodes[to(w)].set_entry(e);
 }
 
 void RoamView::Impl::refresh_entry(std::uint32_t e) {
@@ -131,38 +140,30 @@ std::uint8_t RoamView::Impl::test_new(std::uint32_t e) {
 // ---- links
 // ----------------------------------------------------------------------------------------
 
-void RoamView::Impl::replace_link(std::uint32_t n, std::uint32_t from, std::uint32_t to) {
-  if (n == kNone) return;
-  Node& x = nodes[n];
-  if (x.base == from)
-    x.base = to;
-  else if (x.a == from)
-    x.a = to;
-  else if (x.b == from)
-    x.b = to;
-  else
-    RIDGELINE_ASSERT(false && "neighbour link not found");
+void RoamView::Impl::relink(std::uint32_t w, std::uint32_t word) {
+  if (w != kNone) nodes[to(w)].link[back(w)] = word;
 }
 
 bool RoamView::Impl::children_leaves(std::uint32_t n) const {
   const Node& x = nodes[n];
-  return !x.leaf() && nodes[x.a].leaf() && nodes[x.a + 1].leaf();
+  return !x.leaf() && nodes[x.a()].leaf() && nodes[x.a() + 1].leaf();
 }
 
 bool RoamView::Impl::mergeable(std::uint32_t n) const {
   if (!children_leaves(n)) return false;
-  const std::uint32_t b = nodes[n].base;
-  return b == kNone || (nodes[b].base == n && children_leaves(b));
+  // The base link says whether the neighbour is a partner (it links back with its own base).
+  const std::uint32_t w = nodes[n].base();
+  return w == kNone || (back(w) == 0 && children_leaves(to(w)));
 }
 
 std::uint32_t RoamView::Impl::split_cost(std::uint32_t n) const {
   std::uint32_t cost = 0;
   for (std::uint32_t x = n;;) {
-    const std::uint32_t b = nodes[x].base;
-    if (b == kNone) return cost + 1;
-    if (nodes[b].base == x) return cost + 2;
+    const std::uint32_t w = nodes[x].base();
+    if (w == kNone) return cost + 1;
+    if (back(w) == 0) return cost + 2;  // a partner
     cost += 2;
-    x = b;
+    x = to(w);
   }
 }
 
@@ -177,11 +178,11 @@ void RoamView::Impl::attach_leaf(std::uint32_t n, const LatticeTriangle& t,
   const std::int64_t ci = sx2 >> 1, cj = sz2 >> 1;
   Node& x = nodes[n];
   x.set_side(apex_side(t.ax, t.az, ci, cj));
-  const std::uint32_t b = x.base;
-  if (b != kNone && nodes[b].leaf() && nodes[b].base == n) {
+  const std::uint32_t w = x.base();
+  if (w != kNone && back(w) == 0) {  // a partner (a leaf: leaves link only leaves)
+    const std::uint32_t b = to(w);
     const std::uint32_t e = nodes[b].entry();  // the partner's diamond: one entry for both
     x.set_entry(e);
-    front.set_nodes(e, b, n);
     return;
   }
   std::int64_t hu = t.lx - ci, hw = t.lz - cj;
@@ -209,9 +210,9 @@ bool RoamView::Impl::chain_ready(std::uint32_t n) {
       if (snapshot == nullptr || snapshot->find(key) == nullptr)
         ready = cache->request(key) && ready;
     }
-    const std::uint32_t b = nodes[x].base;
-    if (b == kNone || nodes[b].base == x) break;
-    x = b;
+    const std::uint32_t w = nodes[x].base();
+    if (w == kNone || back(w) == 0) break;
+    x = to(w);
   }
   return ready;
 }
@@ -245,8 +246,8 @@ std::uint32_t RoamView::Impl::split_triangle(std::uint32_t p, const LatticeTrian
 bool RoamView::Impl::split(std::uint32_t n, bool forced, std::vector<std::uint32_t>* queue) {
   // Make the base neighbour a diamond partner first (forced splits): it is coarser, and its
   // split gives n a partner sharing n's hypotenuse.
-  while (nodes[n].base != kNone && nodes[nodes[n].base].base != n)
-    if (!split(nodes[n].base, true, queue)) return false;
+  for (std::uint32_t w = nodes[n].base(); w != kNone && back(w) != 0; w = nodes[n].base())
+    if (!split(to(w), true, queue)) return false;
   const std::uint32_t e = nodes[n].entry();
   if (front.provisional(e)) {
     // The new vertex's detail tile is not resident: request it and wait (the split is tested
@@ -258,7 +259,7 @@ bool RoamView::Impl::split(std::uint32_t n, bool forced, std::vector<std::uint32
     ++st.forced_splits;
   else
     ++st.splits;
-  const std::uint32_t T = n, B = nodes[n].base;
+  const std::uint32_t T = n, B = to(nodes[n].base());
   const std::int64_t ci = front.ci(e), cj = front.cj(e), hu = front.hu(e), hw = front.hw(e);
   const std::uint32_t sideT = nodes[T].side();
   const LatticeTriangle tT = diamond_triangle(ci, cj, hu, hw, sideT);
@@ -267,7 +268,7 @@ bool RoamView::Impl::split(std::uint32_t n, bool forced, std::vector<std::uint32
   // error bound, so the output looks its bounds up. An entry still provisional after the
   // refresh above waited on a tile this update's snapshot does not hold yet (a synchronous
   // cache made it resident during the request): its true height comes from the surface.
-  const float vy = front.provisional(e) ? land.lattice_height(ci, cj) : front.y(e);
+  const float vy = front.provisional(e) ? LandscapeAccess::height(land, ci, cj) : front.y(e);
   const float vmu = front.mu(e), vr = front.radius(e);
   auto add_vertex = [&](std::uint32_t patch) {
     return cam.world ? out.add_vertex(patch, ci, cj) : out.add_vertex(patch, ci, cj, vy, vmu, vr);
@@ -283,27 +284,28 @@ bool RoamView::Impl::split(std::uint32_t n, bool forced, std::vector<std::uint32
   const std::uint32_t cT = split_triangle(T, tT, pT, vT);
   const std::uint32_t cB = B != kNone ? split_triangle(B, tB, pB, vB) : kNone;
   // Links: each child's base is the parent's outer neighbour on that side; across the split
-  // hypotenuse the children border the partner's children.
-  auto link = [&](std::uint32_t p, std::uint32_t c, std::uint32_t right_of_c0,
-                  std::uint32_t left_of_c1, std::uint32_t vslot) {
+  // hypotenuse the children border the partner's children (c0.b is the partner's c1, whose a
+  // links back; c1.a is the partner's c0, whose b links back). Every link a store: the link
+  // words say which link of each neighbour points back.
+  auto link = [&](std::uint32_t p, std::uint32_t c, std::uint32_t pc) {
     Node& x = nodes[p];
-    const std::uint32_t left = x.a, right = x.b;
+    const std::uint32_t left = x.a(), right = x.b();
     Node& n0 = nodes[c];
     Node& n1 = nodes[c + 1];
-    n0.base = left;
-    n0.a = c + 1;
-    n0.b = right_of_c0;
-    n1.base = right;
-    n1.a = left_of_c1;
-    n1.b = c;
-    replace_link(left, p, c);
-    replace_link(right, p, c + 1);
-    x.a = c;
-    x.b = vslot;
+    n0.base() = left;
+    n0.a() = link_word(c + 1, 2);
+    n0.b() = pc != kNone ? link_word(pc + 1, 1) : kNone;
+    n1.base() = right;
+    n1.a() = pc != kNone ? link_word(pc, 2) : kNone;
+    n1.b() = link_word(c, 1);
+    relink(left, link_word(c, 0));
+    relink(right, link_word(c + 1, 0));
+    x.a() = c;
+    x.b() = p == T ? vT : vB;
     x.set_interior();
   };
-  link(T, cT, cB != kNone ? cB + 1 : kNone, cB, vT);
-  if (B != kNone) link(B, cB, cT + 1, cT, vB);
+  link(T, cT, cB);
+  if (B != kNone) link(B, cB, cT);
   triangles += B != kNone ? 2 : 1;
   // Front: the diamond is now split and mergeable; its parents' diamonds no longer are; the
   // children's diamonds join the front.
@@ -311,10 +313,11 @@ bool RoamView::Impl::split(std::uint32_t n, bool forced, std::vector<std::uint32
   for (std::uint32_t p : {nodes[T].parent, B != kNone ? nodes[B].parent : kNone}) {
     if (p == kNone || nodes[p].entry() == kNoEntry) continue;
     const std::uint32_t pe = nodes[p].entry();
-    const std::uint32_t q0 = front.node(pe), q1 = front.node2(pe);
+    // The parent diamond's nodes: p and its partner (its base link's, when a partner).
+    const std::uint32_t w = nodes[p].base();
     remove_entry(pe);
-    nodes[q0].set_entry(kNoEntry);
-    if (q1 != kNone) nodes[q1].set_entry(kNoEntry);
+    nodes[p].set_entry(kNoEntry);
+    if (w != kNone && back(w) == 0) nodes[to(w)].set_entry(kNoEntry);
   }
   attach_leaf(cT, Landscape::child_triangle(tT, 0), queue);
   attach_leaf(cT + 1, Landscape::child_triangle(tT, 1), queue);
@@ -330,26 +333,25 @@ bool RoamView::Impl::split(std::uint32_t n, bool forced, std::vector<std::uint32
 
 void RoamView::Impl::merge(std::uint32_t n, std::vector<std::uint32_t>* queue) {
   ++st.merges;
-  const std::uint32_t T = n, B = nodes[n].base;
+  const std::uint32_t T = n, B = to(nodes[n].base());
   const std::uint32_t e = nodes[T].entry();
   const std::int64_t ci = front.ci(e), cj = front.cj(e), hu = front.hu(e), hw = front.hw(e);
   // A child's diamond is shared with the neighbour across its hypotenuse, or the child's alone.
   auto detach = [&](std::uint32_t c) {
     const std::uint32_t ce = nodes[c].entry();
     if (ce == kNoEntry) return;  // finest
-    const std::uint32_t b = nodes[c].base;
-    const bool shared = b != kNone && nodes[b].leaf() && nodes[b].base == c;
-    if (!shared)
+    const std::uint32_t w = nodes[c].base();
+    if (w == kNone || back(w) != 0)
       remove_entry(ce);
     else
-      front.set_nodes(ce, b, kNone);  // the partner's alone now
+      front.set_node(ce, to(w));  // shared with a partner: the partner's alone now
   };
   std::uint32_t vM = kNone, pM = kNone;
   LatticeTriangle tT{};
   auto collapse = [&](std::uint32_t p) {
     Node& x = nodes[p];
-    const std::uint32_t c0 = x.a, c1 = c0 + 1, vslot = x.b;
-    const std::uint32_t left = nodes[c0].base, right = nodes[c1].base;
+    const std::uint32_t c0 = x.a(), c1 = c0 + 1, vslot = x.b();
+    const std::uint32_t left = nodes[c0].base(), right = nodes[c1].base();
     const LatticeTriangle whole = diamond_triangle(ci, cj, hu, hw, x.side());
     if (p == T) tT = whole;
     const std::uint32_t patch = patch_of(whole);
@@ -357,15 +359,15 @@ void RoamView::Impl::merge(std::uint32_t n, std::vector<std::uint32_t>* queue) {
     const std::array<std::uint32_t, 3> k1 = out.corners(patch, nodes[c1].slot());  // (M, R, A)
     detach(c0);
     detach(c1);
-    replace_link(left, c0, p);
-    replace_link(right, c1, p);
+    relink(left, link_word(p, 1));
+    relink(right, link_word(p, 2));
     out.set_triangle(patch, nodes[c0].slot(), {k0[1], k0[2], k1[1]}, may_pad && padding(whole));
     out.remove_triangle(patch, nodes[c1].slot());
     if (!(vslot == vM && patch == pM)) out.remove_vertex(patch, vslot);
     vM = vslot, pM = patch;
     x.set_slot(nodes[c0].slot());
-    x.a = left;
-    x.b = right;
+    x.a() = left;
+    x.b() = right;
     nodes.free_pair(c0);
   };
   collapse(T);
@@ -383,11 +385,11 @@ void RoamView::Impl::merge(std::uint32_t n, std::vector<std::uint32_t>* queue) {
     const LatticeTriangle t = k == 0 ? tT : diamond_triangle(ci, cj, hu, hw, nodes[B].side());
     // c is (M, A_p, L_p) when it is child 0 of p, (M, R_p, A_p) when child 1; p's half
     // hypotenuse runs from M to L_p (child 0) or R_p (child 1), and A_p sets p's side.
-    const bool first = nodes[p].a == c;
+    const bool first = nodes[p].a() == c;
     [[maybe_unused]] const std::int64_t ax = first ? t.lx : t.rx, az = first ? t.lz : t.rz;  // A_p
     std::int64_t phu = first ? t.rx - t.ax : t.lx - t.ax, phw = first ? t.rz - t.az : t.lz - t.az;
     canonical_half(phu, phw);
-    const std::uint32_t pb = nodes[p].base;
+    const std::uint32_t pb = to(nodes[p].base());
     RIDGELINE_ASSERT(nodes[p].side() == apex_side(ax, az, t.ax, t.az));
     const std::uint32_t pe = add_entry(t.ax, t.az, phu, phw, p, pb, true);
     if (!(test_new(pe) & kActive) && queue != nullptr) queue->push_back(p);
@@ -408,14 +410,14 @@ void RoamView::Impl::reset() {
       const std::uint32_t p = x + z * px;
       Node& r0 = nodes[2 * p];
       Node& r1 = nodes[2 * p + 1];
-      r0.base = 2 * p + 1;
-      r1.base = 2 * p;
+      r0.base() = link_word(2 * p + 1, 0);
+      r1.base() = link_word(2 * p, 0);
       // root 0: apex (P, 0), left edge z = 0 (towards -z), right edge x = P (towards +x)
-      r0.a = z > 0 ? 2 * (p - px) + 1 : kNone;
-      r0.b = x + 1 < px ? 2 * (p + 1) + 1 : kNone;
+      r0.a() = z > 0 ? link_word(2 * (p - px) + 1, 1) : kNone;
+      r0.b() = x + 1 < px ? link_word(2 * (p + 1) + 1, 2) : kNone;
       // root 1: apex (0, P), left edge z = P (towards +z), right edge x = 0 (towards -x)
-      r1.a = z + 1 < pz ? 2 * (p + px) : kNone;
-      r1.b = x > 0 ? 2 * (p - 1) : kNone;
+      r1.a() = z + 1 < pz ? link_word(2 * (p + px), 1) : kNone;
+      r1.b() = x > 0 ? link_word(2 * (p - 1), 2) : kNone;
       r0.set_slot(0);
       r1.set_slot(1);
       const std::int64_t ci = std::int64_t(x) * P + P / 2, cj = std::int64_t(z) * P + P / 2;

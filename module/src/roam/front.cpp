@@ -56,21 +56,22 @@ inline std::uint32_t world_test(float mu, float r, const FrontCamera& c, float* 
 }
 
 // The pass without vector instructions: the scalar test lane by lane.
-float screen_pass_scalar(const Front::Hot* hot, Front::Masks* masks, std::size_t nb,
+float screen_pass_scalar(Front::Hot* hot, const std::uint32_t* list, std::size_t nb,
                          const FrontCamera& c) {
   float worst = 0.0f;
-  for (std::size_t b = 0; b < nb; ++b) {
-    const Front::Hot& h = hot[b];
+  for (std::size_t k = 0; k < nb; ++k) {
+    const std::size_t b = list != nullptr ? list[k] : k;
+    Front::Hot& h = hot[b];
     std::uint32_t act = 0, view = 0;
     for (std::uint32_t l = 0; l < Front::kLanes; ++l) {
       float p;
       const std::uint32_t t = screen_test(h.x[l], h.y[l], h.z[l], h.mu[l], h.r[l], c, &p);
       act |= (t & 1u) << l;
       view |= ((t >> 1) & 1u) << l;
-      if (t == kInView && ((masks[b].valid >> l) & 1u) && p > worst) worst = p;
+      if (t == kInView && ((hot[b].m.valid >> l) & 1u) && p > worst) worst = p;
     }
-    masks[b].active = std::uint8_t(act & masks[b].valid);
-    masks[b].view = std::uint8_t(view & masks[b].valid);
+    hot[b].m.active = std::uint8_t(act & hot[b].m.valid);
+    hot[b].m.view = std::uint8_t(view & hot[b].m.valid);
   }
   return worst;
 }
@@ -78,7 +79,8 @@ float screen_pass_scalar(const Front::Hot* hot, Front::Masks* masks, std::size_t
 #ifdef RIDGELINE_FRONT_AVX2
 // Eight lanes at a time, the same operations as screen_test() in the same order (no fused
 // multiply-adds). Writes only the masks.
-__attribute__((target("avx2"))) float screen_pass_avx2(const Front::Hot* hot, Front::Masks* masks,
+// The blocks are list[0 .. nb) or, without a list, 0 .. nb.
+__attribute__((target("avx2"))) float screen_pass_avx2(Front::Hot* hot, const std::uint32_t* list,
                                                        std::size_t nb, const FrontCamera& c) {
   const __m256 ex = _mm256_set1_ps(c.ex), ey = _mm256_set1_ps(c.ey), ez = _mm256_set1_ps(c.ez);
   const __m256 kappa = _mm256_set1_ps(c.kappa), margin = _mm256_set1_ps(c.margin);
@@ -96,8 +98,9 @@ __attribute__((target("avx2"))) float screen_pass_avx2(const Front::Hot* hot, Fr
   // final value within the first blocks, so that is rare.
   float w = 0.0f;
   __m256 kw = _mm256_set1_ps(INFINITY);  // K / w, generous by 2^-20
-  for (std::size_t b = 0; b < nb; ++b) {
-    const Front::Hot& h = hot[b];
+  for (std::size_t k = 0; k < nb; ++k) {
+    const std::size_t b = list != nullptr ? list[k] : k;
+    Front::Hot& h = hot[b];
     const __m256 dx = _mm256_sub_ps(_mm256_load_ps(h.x), ex);
     const __m256 dy = _mm256_sub_ps(_mm256_load_ps(h.y), ey);
     const __m256 dz = _mm256_sub_ps(_mm256_load_ps(h.z), ez);
@@ -119,11 +122,11 @@ __attribute__((target("avx2"))) float screen_pass_avx2(const Front::Hot* hot, Fr
                         _mm256_mul_ps(pl[k][2], dz));
       in = _mm256_and_ps(in, _mm256_cmp_ps(s, nr, _CMP_GE_OQ));
     }
-    const std::uint32_t valid = masks[b].valid;
+    const std::uint32_t valid = hot[b].m.valid;
     const auto act_bits = std::uint32_t(_mm256_movemask_ps(_mm256_and_ps(act, in))) & valid;
     const auto view_bits = std::uint32_t(_mm256_movemask_ps(in)) & valid;
-    masks[b].active = std::uint8_t(act_bits);
-    masks[b].view = std::uint8_t(view_bits);
+    hot[b].m.active = std::uint8_t(act_bits);
+    hot[b].m.view = std::uint8_t(view_bits);
     const std::uint32_t q = view_bits & ~act_bits;  // in view, the test failed
     if (q == 0) continue;
     const __m256 a = _mm256_add_ps(_mm256_mul_ps(mu, kw), r);
@@ -195,7 +198,7 @@ constexpr std::uint32_t kLaneBits = 0x01010101u;  // lane 0's bit in each of the
 
 std::uint32_t Front::add(std::int32_t i, std::int32_t j, std::int32_t hu, std::int32_t hw,
                          std::uint32_t t, float x, float y, float z, float mu, float r,
-                         std::uint32_t node, std::uint32_t node2, bool split, bool provisional) {
+                         std::uint32_t node, bool split, bool provisional) {
   const std::uint32_t e = n_++;
   const std::uint32_t l = e & 7;
   if (l == 0 && (e >> 3) >= hot_.size()) {
@@ -204,42 +207,36 @@ std::uint32_t Front::add(std::int32_t i, std::int32_t j, std::int32_t hu, std::i
       const std::size_t cap = std::max<std::size_t>(128, hot_.size() + hot_.size() / 4);
       hot_.reserve(cap);
       cold_.reserve(cap * kLanes);
-      masks_.reserve(cap);
     }
     hot_.emplace_back();
-    masks_.emplace_back();
   }
   Hot& h = hot_[e >> 3];
   h.x[l] = x, h.y[l] = y, h.z[l] = z, h.mu[l] = mu, h.r[l] = r;
-  cold_.push_back({i, j, hu, hw, node, node2, (t << 8) | (provisional ? 1u : 0u)});
+  // The half hypotenuse's kind: (s, 0), (0, -s), (-s, -s), (s, -s) (canonical: diamond.h).
+  const std::uint32_t kind = hw == 0 ? 0u : hu == 0 ? 1u : hu < 0 ? 2u : 3u;
+  cold_.push_back({i, j, node, (t << 8) | (kind << 1) | (provisional ? 1u : 0u)});
   // valid, not active nor in view yet, split as given.
-  Masks& m = masks_[e >> 3];
-  const std::uint32_t w = word(m) & ~(kLaneBits << l);
-  set_word(m, w | ((0x01000000u | std::uint32_t(split)) << l));
+  const std::uint32_t w = word(h.m) & ~(kLaneBits << l);
+  set_word(h.m, w | ((0x01000000u | std::uint32_t(split)) << l));
   return e;
 }
 
 std::uint32_t Front::remove(std::uint32_t e) noexcept {
   const std::uint32_t last = --n_;
   const std::uint32_t a = e & 7, b = last & 7;
-  Masks& ms = masks_[last >> 3];
   Hot& sh = hot_[last >> 3];
   if (e != last) {
     Hot& dh = hot_[e >> 3];
     dh.x[a] = sh.x[b], dh.y[a] = sh.y[b], dh.z[a] = sh.z[b], dh.mu[a] = sh.mu[b], dh.r[a] = sh.r[b];
     cold_[e] = cold_[last];
-    Masks& md = masks_[e >> 3];
-    const std::uint32_t moved = (word(ms) >> b) & kLaneBits;
-    set_word(md, (word(md) & ~(kLaneBits << a)) | (moved << a));
+    const std::uint32_t moved = (word(sh.m) >> b) & kLaneBits;
+    set_word(dh.m, (word(dh.m) & ~(kLaneBits << a)) | (moved << a));
   }
   // The freed lane: zero bound and radius (never active), outside every mask.
   sh.x[b] = sh.y[b] = sh.z[b] = sh.mu[b] = sh.r[b] = 0.0f;
-  set_word(ms, word(ms) & ~(kLaneBits << b));
+  set_word(sh.m, word(sh.m) & ~(kLaneBits << b));
   cold_.pop_back();
-  if (b == 0) {
-    hot_.pop_back();
-    masks_.pop_back();
-  }
+  if (b == 0) hot_.pop_back();
   return last;
 }
 
@@ -247,11 +244,10 @@ void Front::clear() noexcept {
   n_ = 0;
   hot_.clear();
   cold_.clear();
-  masks_.clear();
 }
 
 void Front::set_result(std::uint32_t e, std::uint32_t bits) noexcept {
-  Masks& m = masks_[e >> 3];
+  Masks& m = hot_[e >> 3].m;
   const std::uint32_t l = e & 7;
   // bits: kActive (1) -> byte 1, kInView (2) -> byte 2.
   const std::uint32_t set = ((bits & kActive) << 8 | (bits & kInView) << 15) << l;
@@ -271,13 +267,13 @@ float Front::evaluate(const FrontCamera& c) {
     return worst;
   }
 #ifdef RIDGELINE_FRONT_AVX2
-  if (have_avx2()) return screen_pass_avx2(hot_.data(), masks_.data(), nb, c);
+  if (have_avx2()) return screen_pass_avx2(hot_.data(), nullptr, nb, c);
 #endif
-  return screen_pass_scalar(hot_.data(), masks_.data(), nb, c);
+  return screen_pass_scalar(hot_.data(), nullptr, nb, c);
 }
 
 std::uint8_t Front::test_one(std::uint32_t e, const FrontCamera& c, float* priority) noexcept {
-  const Hot& h = hot(e);
+  const Hot& h = hot_[e >> 3];
   const std::uint32_t l = e & 7;
   const std::uint32_t t = c.world
                               ? world_test(h.mu[l], h.r[l], c, priority)
@@ -287,7 +283,7 @@ std::uint8_t Front::test_one(std::uint32_t e, const FrontCamera& c, float* prior
 }
 
 float Front::priority(std::uint32_t e, const FrontCamera& c) const noexcept {
-  const Hot& h = hot(e);
+  const Hot& h = hot_[e >> 3];
   const std::uint32_t l = e & 7;
   float p = 0;
   if (c.world)
@@ -308,8 +304,7 @@ float Front::max_unsplit_priority(const FrontCamera& c) const noexcept {
 }
 
 std::size_t Front::memory_bytes() const noexcept {
-  return hot_.capacity() * sizeof(Hot) + cold_.capacity() * sizeof(Cold) +
-         masks_.capacity() * sizeof(Masks);
+  return hot_.capacity() * sizeof(Hot) + cold_.capacity() * sizeof(Cold);
 }
 
 }  // namespace ridgeline::roam

@@ -10,11 +10,11 @@
 // over ~0.85 entries per triangle (well under a nanosecond each) plus the changes.
 //
 // Layout: what the pass reads (the centre's position, the bound and the radius) is in blocks of
-// eight entries, five rows of eight floats; what only the changes read (lattice indices,
-// geometry, nodes, flags) is one 32-byte record per entry; and the pass writes nothing per entry:
-// its results are two bytes per block (which lanes are active, which in view), beside a byte of
-// which lanes are split. So a pass streams 20 bytes per entry and writes 2 bytes per eight, and
-// a change reads one cache line for an entry's cold data.
+// eight entries, five rows of eight floats, with the block's masks in the padding; what only
+// the changes read (lattice indices, geometry, node, flags) is one 16-byte record per entry.
+// The pass writes nothing per entry: its results are two bytes per block (which lanes are
+// active, which in view), beside a byte of which lanes are split. So a pass streams 20 bytes per
+// entry, and an entry costs 40 bytes in all.
 #pragma once
 
 #include <cstdint>
@@ -61,53 +61,60 @@ class Front {
   /// Bound of a diamond over the data's border: always active (FrontCamera's test).
   static constexpr float kBorderRadius = 3.0e38f;
 
-  struct alignas(64) Hot {  // what the pass reads
-    float x[kLanes], y[kLanes], z[kLanes], mu[kLanes], r[kLanes];
-  };
-  struct alignas(32) Cold {  // what the changes read, one entry per half cache line
-    std::int32_t i, j;       // centre, finest-lattice indices
-    std::int32_t hu, hw;     // half hypotenuse, canonical (diamond.h, canonical_half())
-    std::uint32_t node, node2;
-    std::uint32_t flags;  // bit 0: provisional; bits 8..: log2 of the diamond's size
-  };
   /// Per block: which lanes are split (kept by set_split()), and the last test's active and
-  /// in-view lanes (bit l = lane l).
+  /// in-view lanes (bit l = lane l), and which lanes hold entries.
   struct Masks {
     std::uint8_t split = 0, active = 0, view = 0, valid = 0;
   };
   static_assert(sizeof(Masks) == 4);
+  /// What the pass reads (rows of eight lanes), and the block's masks in the padding of the
+  /// third line.
+  struct alignas(64) Hot {
+    float x[kLanes], y[kLanes], z[kLanes], mu[kLanes], r[kLanes];
+    Masks m;
+  };
+  static_assert(sizeof(Hot) == 192);
+  /// What only the changes read of one entry: a quarter of a cache line.
+  struct alignas(16) Cold {
+    std::int32_t i, j;  // centre, finest-lattice indices
+    std::uint32_t node;
+    std::uint32_t code;  // bit 0 provisional; bits 1-2 half hypotenuse kind; bits 8..: log2 size
+  };
+  static_assert(sizeof(Cold) == 16);
 
   std::uint32_t size() const noexcept { return n_; }
   std::uint32_t blocks() const noexcept { return (n_ + kLanes - 1) / kLanes; }
   bool split(std::uint32_t e) const noexcept { return (mask(e).split >> (e & 7)) & 1; }
   void set_split(std::uint32_t e, bool s) noexcept {
-    std::uint8_t& m = masks_[e >> 3].split;
+    std::uint8_t& m = hot_[e >> 3].m.split;
     m = s ? std::uint8_t(m | (1u << (e & 7))) : std::uint8_t(m & ~(1u << (e & 7)));
   }
   /// A detail vertex whose height is not known yet (its tile not resident): its sphere is
   /// widened to hold every height it may take.
-  bool provisional(std::uint32_t e) const noexcept { return (cold(e).flags & 1u) != 0; }
+  bool provisional(std::uint32_t e) const noexcept { return (cold(e).code & 1u) != 0; }
   void set_provisional(std::uint32_t e, bool p) noexcept {
-    std::uint32_t& f = cold(e).flags;
+    std::uint32_t& f = cold(e).code;
     f = p ? (f | 1u) : (f & ~1u);
   }
-  /// The nodes of the diamond (leaves, or interior nodes when split): node() always, node2()
-  /// the partner across the shared hypotenuse when it is in the mesh (kNone otherwise).
+  /// One node of the diamond (a leaf, or an interior node when split); the other one, when it
+  /// is in the mesh, is the partner its base link names.
   std::uint32_t node(std::uint32_t e) const noexcept { return cold(e).node; }
-  std::uint32_t node2(std::uint32_t e) const noexcept { return cold(e).node2; }
-  void set_nodes(std::uint32_t e, std::uint32_t n, std::uint32_t n2) noexcept {
-    cold(e).node = n, cold(e).node2 = n2;
-  }
-  /// The diamond's centre (finest-lattice indices), its half hypotenuse (geometry.h) and log2
-  /// of its size (Diamond::t).
+  void set_node(std::uint32_t e, std::uint32_t n) noexcept { cold(e).node = n; }
+  /// The diamond's centre (finest-lattice indices), its canonical half hypotenuse (diamond.h)
+  /// and log2 of its size (Diamond::t).
   std::int32_t ci(std::uint32_t e) const noexcept { return cold(e).i; }
   std::int32_t cj(std::uint32_t e) const noexcept { return cold(e).j; }
-  std::int32_t hu(std::uint32_t e) const noexcept { return cold(e).hu; }
-  std::int32_t hw(std::uint32_t e) const noexcept { return cold(e).hw; }
-  std::uint32_t t(std::uint32_t e) const noexcept { return cold(e).flags >> 8; }
-  float y(std::uint32_t e) const noexcept { return hot(e).y[e & 7]; }
-  float mu(std::uint32_t e) const noexcept { return hot(e).mu[e & 7]; }
-  float radius(std::uint32_t e) const noexcept { return hot(e).r[e & 7]; }
+  std::uint32_t t(std::uint32_t e) const noexcept { return cold(e).code >> 8; }
+  std::int32_t hu(std::uint32_t e) const noexcept {
+    static constexpr std::int32_t kU[4] = {1, 0, -1, 1};
+    return kU[(cold(e).code >> 1) & 3] << t(e);
+  }
+  std::int32_t hw(std::uint32_t e) const noexcept {
+    return ((cold(e).code >> 1) & 3) == 0 ? 0 : -(std::int32_t{1} << t(e));
+  }
+  float y(std::uint32_t e) const noexcept { return hot_[e >> 3].y[e & 7]; }
+  float mu(std::uint32_t e) const noexcept { return hot_[e >> 3].mu[e & 7]; }
+  float radius(std::uint32_t e) const noexcept { return hot_[e >> 3].r[e & 7]; }
   /// kActive, kInView of the last evaluate() or test_one().
   std::uint8_t result(std::uint32_t e) const noexcept {
     const Masks& m = mask(e);
@@ -118,14 +125,15 @@ class Front {
   /// near plane. Computed, not stored.
   float priority(std::uint32_t e, const FrontCamera& c) const noexcept;
 
-  /// Appends an entry; returns its index. (x, z) is the centre in metres (i * sx, j * sz as
-  /// floats), y its height.
+  /// Appends an entry; returns its index. (hu, hw) is the canonical half hypotenuse, t = log2
+  /// of the diamond's size; (x, z) the centre in metres (i * sx, j * sz as floats), y its
+  /// height.
   std::uint32_t add(std::int32_t i, std::int32_t j, std::int32_t hu, std::int32_t hw,
                     std::uint32_t t, float x, float y, float z, float mu, float r,
-                    std::uint32_t node, std::uint32_t node2, bool split, bool provisional);
+                    std::uint32_t node, bool split, bool provisional);
   /// Rewrites an entry's data (after an edit or a tile's arrival).
   void set_data(std::uint32_t e, float y, float mu, float r) noexcept {
-    Hot& h = hot(e);
+    Hot& h = hot_[e >> 3];
     h.y[e & 7] = y, h.mu[e & 7] = mu, h.r[e & 7] = r;
   }
   /// Removes entry `e` by moving the last entry into its place; returns the old index of the
@@ -147,37 +155,32 @@ class Front {
   /// Lanes of block b whose last test disagrees with their state (active and unsplit, or split
   /// and inactive).
   std::uint32_t changed(std::uint32_t b) const noexcept {
-    const Masks& m = masks_[b];
+    const Masks& m = hot_[b].m;
     return std::uint32_t((m.active ^ m.split) & m.valid);
   }
-  /// Hints the caches to fetch what a change reads of entry e: its cold record, and with
-  /// `all` its hot lanes (three lines) and masks too.
-  void prefetch(std::uint32_t e, bool all = false) const noexcept {
+  /// Hints the caches to fetch what a change of entry e reads: its cold record and its lane
+  /// of the block (three lines: height, bound, radius and the masks).
+  void prefetch(std::uint32_t e) const noexcept {
     e = e < n_ ? e : 0;
     detail::prefetch(cold_.data() + e);
-    if (!all) return;
     const char* h = reinterpret_cast<const char*>(hot_.data() + (e >> 3));
     detail::prefetch(h);
     detail::prefetch(h + 64);
     detail::prefetch(h + 128);
-    detail::prefetch(masks_.data() + (e >> 3));
   }
 
   /// Bytes held (capacity).
   std::size_t memory_bytes() const noexcept;
 
  private:
-  const Hot& hot(std::uint32_t e) const noexcept { return hot_[e >> 3]; }
-  Hot& hot(std::uint32_t e) noexcept { return hot_[e >> 3]; }
   const Cold& cold(std::uint32_t e) const noexcept { return cold_[e]; }
   Cold& cold(std::uint32_t e) noexcept { return cold_[e]; }
-  const Masks& mask(std::uint32_t e) const noexcept { return masks_[e >> 3]; }
+  const Masks& mask(std::uint32_t e) const noexcept { return hot_[e >> 3].m; }
   void set_result(std::uint32_t e, std::uint32_t bits) noexcept;
 
   std::uint32_t n_ = 0;
   std::vector<Hot> hot_;
   std::vector<Cold> cold_;
-  std::vector<Masks> masks_;
 };
 
 }  // namespace ridgeline::roam

@@ -35,6 +35,7 @@
 #include "ridgeline/log.h"
 #include "ridgeline/surface.h"
 #include "roam/diamond.h"
+#include "roam/landscape_access.h"
 
 namespace ridgeline {
 
@@ -408,6 +409,18 @@ DiamondBound Landscape::compute_stored(std::int64_t i, std::int64_t j) const noe
   }
   if (straddles) radius = FLT_MAX;
   return {round_up(err), round_up(morph), radius >= FLT_MAX ? FLT_MAX : round_up(radius)};
+}
+
+DiamondBound Landscape::diamond(std::int64_t i, std::int64_t j) const noexcept {
+  return roam::LandscapeAccess::diamond(*this, i, j);
+}
+
+VertexShading Landscape::shading(std::int64_t i, std::int64_t j) const noexcept {
+  return roam::LandscapeAccess::shading(*this, i, j);
+}
+
+float Landscape::lattice_height(std::int64_t i, std::int64_t j) const noexcept {
+  return roam::LandscapeAccess::height(*this, i, j);
 }
 
 DiamondBound Landscape::diamond_slow(std::int64_t i, std::int64_t j) const noexcept {

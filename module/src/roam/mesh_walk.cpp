@@ -31,8 +31,8 @@ void RoamView::Impl::walk(Fn&& fn) const {
       const Node& nd = nodes[it.n];
       fn(it.n, r, it.heap, it.t, nd.leaf());
       if (nd.leaf()) continue;
-      stack.push_back({nd.a + 1, 2 * it.heap + 1, Landscape::child_triangle(it.t, 1)});
-      stack.push_back({nd.a, 2 * it.heap, Landscape::child_triangle(it.t, 0)});
+      stack.push_back({nd.a() + 1, 2 * it.heap + 1, Landscape::child_triangle(it.t, 1)});
+      stack.push_back({nd.a(), 2 * it.heap, Landscape::child_triangle(it.t, 0)});
     }
   }
 }
@@ -134,30 +134,33 @@ std::string RoamView::Impl::check() const {
       }
     }
     drawn[patch] += m.padding(t) ? 0 : 1;
-    // Links: leaves that link back; levels differ by at most one.
-    for (std::uint32_t nb : {nd.base, nd.a, nd.b}) {
-      if (nb == kNone) continue;
-      const Node& o = m.nodes[nb];
-      if (!o.leaf()) {
+    // Links: leaves that link back, through the link their link word names; levels differ by
+    // at most one.
+    for (std::uint32_t k = 0; k < 3; ++k) {
+      const std::uint32_t w = nd.link[k];
+      if (w == kNone) continue;
+      const std::uint32_t nb = to(w);
+      if (nb >= m.nodes.size() || !m.nodes[nb].leaf()) {
         err = fmt("leaf %u (root %u heap %llu) links to internal node %u", n, root,
                   static_cast<unsigned long long>(heap), nb);
         return;
       }
-      if (o.base != n && o.a != n && o.b != n) {
-        err = fmt("leaf %u links to %u which does not link back", n, nb);
+      if (m.nodes[nb].link[back(w)] != link_word(n, k)) {
+        err = fmt("leaf %u links to %u (its link %u), which does not link back", n, nb, back(w));
         return;
       }
     }
-    if (nd.base != kNone) {
-      const Node& o = m.nodes[nd.base];
-      const LatticeTriangle ot = m.leaf_triangle(nd.base);
+    if (nd.base() != kNone) {
+      const Node& o = m.nodes[to(nd.base())];
+      const LatticeTriangle ot = m.leaf_triangle(to(nd.base()));
       auto len2 = [](const LatticeTriangle& x) {
         return (x.lx - x.rx) * (x.lx - x.rx) + (x.lz - x.rz) * (x.lz - x.rz);
       };
-      const bool partner = o.base == n;
+      const bool partner = to(o.base()) == n;
       // A partner shares the hypotenuse; a coarser base neighbour's is sqrt 2 longer.
       if (partner ? len2(ot) != len2(t) : len2(ot) != 2 * len2(t))
-        err = fmt("leaf %u and its base neighbour %u differ by more than one level", n, nd.base);
+        err = fmt("leaf %u and its base neighbour %u differ by more than one level", n,
+                  to(nd.base()));
     }
   });
   // Every entry's geometry is its diamond's: level and canonical half hypotenuse.
@@ -177,12 +180,6 @@ std::string RoamView::Impl::check() const {
         m.nodes[n].leaf() == m.front.split(e))
       err = fmt("front entry %u (%d, %d) points at node %u, which is not a %s of its diamond", e,
                 m.front.ci(e), m.front.cj(e), n, m.front.split(e) ? "split node" : "leaf");
-    // Its second node is the first's partner across the shared hypotenuse, when there is one.
-    const std::uint32_t b = err.empty() ? m.nodes[n].base : kNone;
-    const std::uint32_t partner = b != kNone && m.nodes[b].base == n ? b : kNone;
-    if (err.empty() && m.front.node2(e) != partner)
-      err = fmt("front entry %u (%d, %d): second node %u, the partner is %u", e, m.front.ci(e),
-                m.front.cj(e), m.front.node2(e), partner);
   }
   if (err.empty() && leaves != m.triangles)
     err = fmt("leaf count %u differs from the triangle counter %u", leaves, m.triangles);

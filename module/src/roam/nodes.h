@@ -12,16 +12,33 @@
 namespace ridgeline::roam {
 
 inline constexpr std::uint32_t kNone = 0xffffffffu;
+/// A link word: the neighbour's index in bits 0-29 and, in bits 30-31, which of the neighbour's
+/// links (0 base, 1 a, 2 b) points back, so that relinking a neighbour is a store, not a search.
+/// kNone (all ones) for no neighbour.
+inline constexpr std::uint32_t kIndexMask = 0x3fffffffu;
+inline constexpr std::uint32_t link_word(std::uint32_t node, std::uint32_t back) noexcept {
+  return node | (back << 30);
+}
+/// The node a link word points at (kNone for none).
+inline constexpr std::uint32_t to(std::uint32_t w) noexcept {
+  return w == kNone ? kNone : (w & kIndexMask);
+}
+/// Which link of that node points back.
+inline constexpr std::uint32_t back(std::uint32_t w) noexcept {
+  return w >> 30;
+}
+
 /// Node::slot() of an interior node.
 inline constexpr std::uint32_t kInterior = 0x7fffffffu;
 /// Node::entry() when the node's diamond has no front entry.
 inline constexpr std::uint32_t kNoEntry = 0xffffffffu;
 
-/// One bintree triangle. A leaf and an interior node use the two middle words differently:
-///   leaf:     a = left neighbour, b = right neighbour, slot() = triangle slot in its patch's
-///             buffers
+/// One bintree triangle. A leaf and an interior node use the links a and b differently:
+///   leaf:     a = left neighbour, b = right neighbour (link words), slot() = triangle slot in
+///             its patch's buffers
 ///   interior: a = first child (the pair a, a + 1), b = vertex slot of its hypotenuse midpoint in
 ///             its patch's buffers, slot() = kInterior
+/// base is a link word for both (a split diamond's two nodes keep linking each other).
 /// `front` is the index of its diamond's front entry (kNoEntry: none; a leaf always has one, an
 /// interior node when its diamond is mergeable): a whole word, so that re-pointing a node at a
 /// moved entry is a plain store, no read. side() says which of the diamond's two apexes is this
@@ -30,11 +47,18 @@ inline constexpr std::uint32_t kNoEntry = 0xffffffffu;
 /// entry (leaves) or from a walk from the roots.
 struct Node {
   std::uint32_t parent = kNone;
-  std::uint32_t base = kNone;  ///< neighbour across the hypotenuse (kNone on the border)
-  std::uint32_t a = kNone, b = kNone;
+  /// base (neighbour across the hypotenuse; kNone on the border), a, b: link words for a leaf
+  /// (link_word()), child and vertex slot for an interior node (plain numbers).
+  std::uint32_t link[3] = {kNone, kNone, kNone};
   std::uint32_t front = kNoEntry;
   std::uint32_t tri = kInterior;  ///< slot (bits 0-30) and side (bit 31)
 
+  std::uint32_t& base() noexcept { return link[0]; }
+  std::uint32_t& a() noexcept { return link[1]; }
+  std::uint32_t& b() noexcept { return link[2]; }
+  std::uint32_t base() const noexcept { return link[0]; }
+  std::uint32_t a() const noexcept { return link[1]; }
+  std::uint32_t b() const noexcept { return link[2]; }
   bool leaf() const noexcept { return (tri & kInterior) != kInterior; }
   std::uint32_t slot() const noexcept { return tri & kInterior; }
   void set_slot(std::uint32_t s) noexcept { tri = (tri & ~kInterior) | s; }
@@ -72,6 +96,7 @@ class NodePool {
     if (free_ != kNone) {
       c = free_;
       free_ = (*this)[c].parent;  // a free pair's first node links to the next free pair
+      prefetch(free_);            // the next allocation reads it
     } else {
       c = size_;
       if (((size_ + 1) >> kShift) >= chunks_.size())

@@ -7,6 +7,7 @@
 
 #include "ridgeline/surface.h"
 #include "roam/diamond.h"
+#include "roam/landscape_access.h"
 
 namespace ridgeline::roam {
 
@@ -15,6 +16,8 @@ void PatchOutput::reset(const Landscape& land) {
   const std::uint32_t np = land.patch_count();
   if (patches_.size() != np) patches_.assign(np, Patch{});
   dirty_list_.clear();
+  stale_.clear();
+  bytes_ = 0;
   const std::int64_t P = land.patch_cells();
   for (std::uint32_t p = 0; p < np; ++p) {
     Patch& pt = patches_[p];
@@ -37,6 +40,9 @@ void PatchOutput::reset(const Landscape& land) {
     pt.listed = false;
     pt.grew = true;
     pt.counted = false;
+    pt.bytes = 0;
+    pt.stale = true;
+    stale_.push_back(p);
     // Corners: slots 0 (0, 0), 1 (P, 0), 2 (0, P), 3 (P, P), never freed.
     for (int c = 0; c < 4; ++c) add_vertex(p, i0 + (c & 1) * P, j0 + (c >> 1) * P);
     // Root 0: apex (P, 0), left (0, 0), right (P, P); root 1: apex (0, P), left (P, P),
@@ -54,7 +60,7 @@ void PatchOutput::write_vertex(std::uint32_t patch, std::uint32_t slot, std::int
   const std::int64_t P = l.patch_cells();
   const std::int64_t i0 = std::int64_t(patch % l.patches_x()) * P;
   const std::int64_t j0 = std::int64_t(patch / l.patches_x()) * P;
-  const VertexShading sh = l.shading(i, j);
+  const VertexShading sh = LandscapeAccess::shading(l, i, j);
   MeshVertex v;
   v.x = static_cast<float>(double(i - i0) * l.spacing_x());
   v.z = static_cast<float>(double(j - j0) * l.spacing_z());
@@ -65,12 +71,12 @@ void PatchOutput::write_vertex(std::uint32_t patch, std::uint32_t slot, std::int
     v.morph_bound = known->morph;
     v.morph_radius = known->radius;
   } else {
-    v.y = l.lattice_height(i, j);
+    v.y = LandscapeAccess::height(l, i, j);
     if (diamond_at(i, j, l.patch_log2()).corner) {
       v.morph_bound = FLT_MAX;
       v.morph_radius = 0.0f;
     } else {
-      const DiamondBound b = l.diamond(i, j);
+      const DiamondBound b = LandscapeAccess::diamond(l, i, j);
       v.morph_bound = b.morph;
       v.morph_radius = b.radius;
     }
@@ -139,6 +145,8 @@ std::vector<std::uint32_t> PatchOutput::take_dirty() {
     }
     p.grew = false;
     p.counted = false;
+    p.stale = true;  // its dirty ranges' capacity may have changed
+    stale_.push_back(pi);
   }
   return out;
 }
@@ -158,17 +166,27 @@ std::uint64_t PatchOutput::take_upload_bytes() {
   return b;
 }
 
-std::size_t PatchOutput::memory_bytes() const {
-  std::size_t b = patches_.capacity() * sizeof(Patch) + dirty_list_.capacity() * 4;
-  for (const Patch& p : patches_) {
-    b +=
+std::size_t PatchOutput::memory_bytes() {
+  auto count = [&](std::uint32_t pi) {
+    Patch& p = patches_[pi];
+    bytes_ -= p.bytes;
+    p.bytes =
         p.mesh.vertices.capacity() * sizeof(MeshVertex) +
         p.mesh.indices.capacity() * sizeof(std::uint32_t) +
         (p.mesh.dirty_vertices.capacity() + p.mesh.dirty_triangles.capacity()) * sizeof(MeshRange) +
         p.free_tris.capacity() * 4 + (p.tri_bits.capacity() + p.vert_bits.capacity()) * 8 +
         p.hidden.size() * (sizeof(std::uint32_t) + 12 + 16) + p.hidden.bucket_count() * 8;
-  }
-  return b;
+    bytes_ += p.bytes;
+    p.stale = false;
+  };
+  // Only the patches changed since the last count (a full count walks every patch's vectors:
+  // cache misses on patches nobody touched).
+  for (std::uint32_t pi : dirty_list_) count(pi);
+  for (std::uint32_t pi : stale_)
+    if (patches_[pi].stale) count(pi);
+  stale_.clear();
+  return patches_.capacity() * sizeof(Patch) + (dirty_list_.capacity() + stale_.capacity()) * 4 +
+         bytes_;
 }
 
 }  // namespace ridgeline::roam

@@ -13,6 +13,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "memory_hints.h"
 #include "ridgeline/landscape.h"
 #include "ridgeline/roam_view.h"
 
@@ -120,7 +121,9 @@ class PatchOutput {
   /// Bytes changed since the last call to this function (dirty slots, whole resized buffers).
   std::uint64_t take_upload_bytes();
   std::uint32_t dirty_patch_count() const { return std::uint32_t(dirty_list_.size()); }
-  std::size_t memory_bytes() const;
+  /// Bytes held by the buffers and their bookkeeping (capacity). Kept up to date per patch:
+  /// only patches changed since the last call are counted again.
+  std::size_t memory_bytes();
 
  private:
   static constexpr std::uint32_t kFreeVertex = 0xffffffffu;  // MeshVertex::material of a free slot
@@ -132,7 +135,8 @@ class PatchOutput {
     std::vector<std::uint64_t> tri_bits, vert_bits;  // slots changed since the last take
     // Corners of the triangles over the padding (their indices are degenerate).
     std::unordered_map<std::uint32_t, std::array<std::uint32_t, 3>> hidden;
-    bool listed = false, grew = false, counted = false;
+    bool listed = false, grew = false, counted = false, stale = true;
+    std::size_t bytes = 0;  // this patch's share of memory_bytes(), when not stale
   };
   void touch(std::uint32_t patch) {
     Patch& p = patches_[patch];
@@ -168,6 +172,8 @@ class PatchOutput {
     if (p.free_verts != kNoSlot) {
       slot = p.free_verts;
       std::memcpy(&p.free_verts, &p.mesh.vertices[slot].x, sizeof(std::uint32_t));
+      // The next allocation in this patch reads the next free slot.
+      detail::prefetch(p.mesh.vertices.data() + (p.free_verts != kNoSlot ? p.free_verts : slot));
     } else {
       slot = grow_vertices(p);
     }
@@ -183,6 +189,8 @@ class PatchOutput {
   const Landscape* land_ = nullptr;
   std::vector<Patch> patches_;
   std::vector<std::uint32_t> dirty_list_;
+  std::vector<std::uint32_t> stale_;  // patches whose bytes changed outside the dirty list
+  std::size_t bytes_ = 0;             // sum of the patches' bytes (stale ones as last counted)
   std::uint64_t upload_bytes_ = 0;
 };
 

@@ -24,6 +24,7 @@
 #include "format.h"
 #include "ridgeline/detail.h"
 #include "ridgeline/log.h"
+#include "roam/landscape_access.h"
 #include "roam/view_impl.h"
 
 namespace ridgeline {
@@ -258,36 +259,45 @@ void RoamView::Impl::collect() {
 // one change at a time.
 void RoamView::Impl::prefetch_change(const std::vector<std::uint32_t>& list, bool split) const {
   auto prefetch_record = [&](std::int64_t i, std::int64_t j) {
-    detail::prefetch(land.record_address(i, j));
+    detail::prefetch(LandscapeAccess::address(land, i, j));
   };
   constexpr std::size_t D1 = 32, D2 = 16, D3 = 8;  // measured: 16/8/4 was ~10 % slower
   const std::size_t n = list.size();
   if (n > D1) nodes.prefetch(list[n - D1 - 1]);
   if (n > D2) {
     const Node& x = nodes[list[n - D2 - 1]];
-    front.prefetch(x.entry(), true);
-    nodes.prefetch(x.base);
+    front.prefetch(x.entry());
+    nodes.prefetch(to(x.base()));
     nodes.prefetch(x.parent);
-    nodes.prefetch(x.a);
-    if (split) nodes.prefetch(x.b);
+    nodes.prefetch(split ? to(x.a()) : x.a());  // a leaf's neighbour, an interior node's children
+    if (split) nodes.prefetch(to(x.b()));
   }
   if (n <= D3) return;
   const Node& x = nodes[list[n - D3 - 1]];
   const std::uint32_t e = x.entry();
-  if (e >= front.size()) return;
+  if (e >= front.size() || x.leaf() != split) return;  // no longer a candidate
   const std::int64_t i = front.ci(e), j = front.cj(e), hu = front.hu(e), hw = front.hw(e);
   if (!split) {
-    // A merge removes its children's entries and may make a parent mergeable: the parents are
-    // centred at the two apexes c +- p.
-    front.prefetch(nodes[x.a].entry(), true);
-    front.prefetch(nodes[x.a + 1].entry(), true);
+    // A merge removes its children's entries and may make a parent mergeable (its partner's
+    // children are read, its record too: the parents are centred at the two apexes c +- p).
+    front.prefetch(nodes[x.a()].entry());
+    front.prefetch(nodes[x.a() + 1].entry());
+    if (x.parent != kNone) nodes.prefetch(to(nodes[x.parent].base()));
     prefetch_record(i - hw, j + hu);
     prefetch_record(i + hw, j - hu);
     return;
   }
   // A split removes its parents' entries (when mergeable), writes its vertex (its record) and
-  // adds its children's diamonds (centres c +- (p +- h) / 2, p = (-hw, hu)).
-  if (x.parent != kNone) front.prefetch(nodes[x.parent].entry(), true);
+  // adds its children's diamonds (centres c +- (p +- h) / 2, p = (-hw, hu)). A base neighbour
+  // that is not its partner is split first (a forced split): its entry and parent next.
+  if (x.parent != kNone) front.prefetch(nodes[x.parent].entry());
+  if (x.base() != kNone && back(x.base()) != 0) {
+    const Node& f = nodes[to(x.base())];
+    front.prefetch(f.entry());
+    nodes.prefetch(f.parent);
+    nodes.prefetch(to(f.a()));
+    nodes.prefetch(to(f.b()));
+  }
   prefetch_record(i, j);
   if (((hu - hw) | (hu + hw)) & 1) return;  // finest: no child diamonds
   const std::int64_t au = (hu - hw) / 2, aw = (hu + hw) / 2, bu = (hu + hw) / 2, bw = (hw - hu) / 2;
@@ -412,7 +422,8 @@ float RoamView::Impl::converge_budgeted(double threshold, std::uint32_t cap) {
     // The merged diamond may split again later (a trade back); its parents may merge next.
     fresh.push_back(n);
     for (std::uint32_t p :
-         {m.nodes[n].parent, m.nodes[n].base != kNone ? m.nodes[m.nodes[n].base].parent : kNone})
+         {m.nodes[n].parent,
+          m.nodes[n].base() != kNone ? m.nodes[to(m.nodes[n].base())].parent : kNone})
       if (p != kNone) fresh.push_back(p);
     push_fresh();
   };
@@ -447,7 +458,7 @@ float RoamView::Impl::converge_budgeted(double threshold, std::uint32_t cap) {
       if (cap != 0 && m.triangles + m.split_cost(n) > cap) {
         // Trade a lower-priority diamond for this split, unless it is the leaf's own parent.
         if (g && gp < sp && g->second != m.nodes[n].parent &&
-            m.nodes[g->second].base != m.nodes[n].parent) {
+            to(m.nodes[g->second].base()) != m.nodes[n].parent) {
           do_merge();
           continue;
         }
@@ -468,9 +479,10 @@ float RoamView::Impl::converge_budgeted(double threshold, std::uint32_t cap) {
       else {
         // The split diamond is mergeable now; its children may split next.
         fresh.push_back(n);
-        for (std::uint32_t k = 0; k < 2; ++k) fresh.push_back(m.nodes[n].a + k);
-        if (m.nodes[n].base != kNone)
-          for (std::uint32_t k = 0; k < 2; ++k) fresh.push_back(m.nodes[m.nodes[n].base].a + k);
+        for (std::uint32_t k = 0; k < 2; ++k) fresh.push_back(m.nodes[n].a() + k);
+        if (m.nodes[n].base() != kNone)
+          for (std::uint32_t k = 0; k < 2; ++k)
+            fresh.push_back(m.nodes[to(m.nodes[n].base())].a() + k);
       }
       push_fresh();
       continue;

@@ -114,7 +114,9 @@ struct RoamView::Impl {
   std::uint32_t split_cost(std::uint32_t n) const;
   /// True when the vertices a split of n (and its forced chain) creates have their detail.
   bool chain_ready(std::uint32_t n);
-  void replace_link(std::uint32_t n, std::uint32_t from, std::uint32_t to);
+  /// Points the link of the neighbour that link word w names (the link that pointed back) at
+  /// link word `word`; nothing for kNone.
+  void relink(std::uint32_t w, std::uint32_t word);
   /// Splits triangle p (t, in `patch`; its new vertex's slot v) into a child pair; returns the
   /// first child.
   std::uint32_t split_triangle(std::uint32_t p, const LatticeTriangle& t, std::uint32_t patch,
