@@ -207,6 +207,13 @@ Status BudgetController::set_target_ms(double target_ms) {
   return {};
 }
 
+Status BudgetController::set_deadband(double deadband) {
+  if (!std::isfinite(deadband) || deadband < 0 || deadband >= 0.5)
+    return Error{"budget controller: deadband " + num(deadband) + "; need 0 <= deadband < 0.5"};
+  desc_.deadband = deadband;
+  return {};
+}
+
 Status BudgetController::set_range(double lo, double hi) {
   if (Status s = check_range(lo, hi); !s) return s;
   const double t = state_.threshold, s = state_.render_scale;

@@ -68,6 +68,35 @@ TEST(BudgetController, SettlesInsideTheBandOnSteadyLoadWithoutOscillating) {
   }
 }
 
+TEST(BudgetController, ANarrowerBandSettlesCloserToTheTargetFromBelow) {
+  // Frames too fast (3 px: 25 ms): the controller lowers the threshold until the smoothed time
+  // enters the band and stops there, near its lower edge: 33 x 0.92 = 30.4 ms with the default
+  // band, 33 x 0.96 = 31.7 ms with 0.04 (a little past it: the average lags), without a
+  // reversal either way. The narrower band ends closer to the target.
+  double gap[2] = {};
+  for (int k = 0; k < 2; ++k) {
+    const double band = k == 0 ? 0.08 : 0.04;
+    BudgetController c = make({.deadband = band});
+    ASSERT_TRUE(c.reset(3.0).ok());
+    run(c, 20, 0, [](double) { return 0.0; });
+    const double frame = plant_ms(c.threshold(), 0);
+    EXPECT_GE(frame, 33.0 * (1 - band) - 0.2) << "band " << band;
+    EXPECT_LE(frame, 33.0 * (1 + band)) << "band " << band;
+    EXPECT_EQ(c.state().reversals, 0u) << "band " << band;
+    gap[k] = 33.0 - frame;
+  }
+  EXPECT_LT(gap[1], 0.6 * gap[0]);
+  // The same with set_deadband() on a running controller.
+  BudgetController c = make();
+  ASSERT_TRUE(c.reset(3.0).ok());
+  run(c, 20, 0, [](double) { return 0.0; });
+  const double wide = c.threshold();
+  ASSERT_TRUE(c.set_deadband(0.04).ok());
+  run(c, 20, 20, [](double) { return 0.0; });
+  EXPECT_LT(c.threshold(), wide * 0.97);
+  EXPECT_EQ(c.state().reversals, 0u);
+}
+
 TEST(BudgetController, NoisySteadyLoadDoesNotReverseBackAndForth) {
   BudgetController c = make();
   run(c, 5, 0, [](double) { return 0.0; });
@@ -206,6 +235,11 @@ TEST(BudgetController, RefusesBadSettingsWithTheFieldNamed) {
   expect_error(d, "render_scale_from_px 40");
   BudgetController c = make();
   EXPECT_FALSE(c.set_target_ms(-3).ok());
+  EXPECT_FALSE(c.set_deadband(0.5).ok());
+  EXPECT_FALSE(c.set_deadband(std::nan("")).ok());
+  EXPECT_NE(c.set_deadband(-0.1).message().find("deadband -0.1"), std::string::npos);
+  ASSERT_TRUE(c.set_deadband(0.05).ok());
+  EXPECT_DOUBLE_EQ(c.desc().deadband, 0.05);
   EXPECT_FALSE(c.set_range(0, 1).ok());
   EXPECT_FALSE(c.reset(100).ok());
   EXPECT_FALSE(c.reset(2, 0.5).ok()) << "the render scale lever is off: scale 1 only";

@@ -115,6 +115,10 @@ class BudgetController {
 
   /// Changes the target (ms, finite, > 0); the rest of the state is kept.
   Status set_target_ms(double target_ms);
+  /// Changes the hysteresis band (a fraction of the target in [0, 0.5)); the rest of the state
+  /// is kept. A narrower band settles closer to the target (the controller stops wherever the
+  /// smoothed frame time enters the band), at the price of reacting to smaller swings.
+  Status set_deadband(double deadband);
   /// Changes the threshold range; the current threshold is clamped into it (that is the point),
   /// as is render_scale_from_px when it was set.
   Status set_range(double min_threshold, double max_threshold);
