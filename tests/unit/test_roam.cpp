@@ -15,6 +15,7 @@
 #include <tuple>
 
 #include "ridgeline/roam_view.h"
+#include "roam/diamond.h"
 #include "roam_test_util.h"
 
 using namespace ridgeline;
@@ -442,6 +443,76 @@ TEST(Roam, OutputBuffersMatchTheLeavesAndSeamsShareHeightBits) {
   EXPECT_LT(dirty.size(), l->patch_count());
 }
 
+// Hierarchical geomorphs (docs/roam.md, "Geomorphs"), checked on the output an engine draws:
+// every vertex whose diamond's ratio (what the split test compares with 1) is at least 1 has the
+// two ends of the edge it splits at t = 1, at their true heights, so the vertex starts on its
+// parent edge as drawn; and at t = 0 it is drawn at that edge's midpoint (its morph offset).
+// Along a flyover at several thresholds and morph windows.
+TEST(Roam, AVertexStartsOnItsParentEdgeAsDrawn) {
+  for (const double w : {0.5, 1.0}) {
+    auto hf = make_default_heightfield({.size = 257, .spacing = 2.0, .seed = 1337});
+    ASSERT_TRUE(hf);
+    auto l = Landscape::create(Terrain::create(std::move(hf).value()),
+                               {.patch_exponent = 5, .morph_window = w})
+                 .value();
+    for (const double tau : {1.0, 3.0}) {
+      auto v = RoamView::create(l, {.threshold = tau}).value();
+      std::size_t active = 0, ends = 0;
+      for (int k = 0; k < 12; ++k) {
+        const double a = 0.3 * k;
+        const glm::dvec3 eye(256 + 150 * std::cos(a), 140, 256 + 150 * std::sin(a));
+        const Camera cam = camera_at(eye, {256, 40, 256});
+        auto st = v->update(cam);
+        ASSERT_TRUE(st);
+        const double K = projection_scale(cam);
+        for (std::uint32_t p = 0; p < l->patch_count(); ++p) {
+          const PatchMesh& m = v->patch_mesh(p);
+          const glm::vec3 e(float(eye.x - m.origin_x), float(eye.y - m.origin_y),
+                            float(eye.z - m.origin_z));
+          // The drawn vertices by lattice position.
+          std::map<std::pair<std::int64_t, std::int64_t>, const MeshVertex*> at;
+          for (std::size_t t = 0; t + 2 < m.indices.size(); t += 3) {
+            if (m.indices[t] == m.indices[t + 1]) continue;
+            for (int q = 0; q < 3; ++q) {
+              const MeshVertex& mv = m.vertices[m.indices[t + q]];
+              at[{std::llround((m.origin_x + mv.x) / 2.0), std::llround((m.origin_z + mv.z) / 2.0)}] =
+                  &mv;
+            }
+          }
+          auto rho = [&](const MeshVertex& mv) {
+            const double dx = mv.x - e.x, dy = mv.y - e.y, dz = mv.z - e.z;
+            const double d = std::sqrt(dx * dx + dy * dy + dz * dz) - mv.morph_radius;
+            return mv.morph_bound * K / (st->morph_threshold * std::max(d, 1e-6));
+          };
+          for (const auto& [ij, mv] : at) {
+            if (mv->morph_bound >= 3e38f || mv->morph_radius >= 3e38f) continue;  // never morph
+            if (rho(*mv) < 1.0) continue;  // split for the frustum's sake, not its ratio
+            ++active;
+            std::int64_t hu, hw;
+            roam::half_hypotenuse(ij.first, ij.second, l->patch_log2(), hu, hw);
+            float ends_y = 0;
+            for (const int s : {-1, 1}) {
+              const auto it = at.find({ij.first + s * hu, ij.second + s * hw});
+              ASSERT_NE(it, at.end()) << "an end of the edge vertex (" << ij.first << ", "
+                                      << ij.second << ") splits is not drawn";
+              const MeshVertex& end = *it->second;
+              ends_y += end.y;
+              EXPECT_EQ(morph_factor(end, e, K, st->morph_threshold, l->morph_window()), 1.0f)
+                  << "vertex (" << ij.first << ", " << ij.second << ") at ratio " << rho(*mv)
+                  << ": an end of its edge is still morphing (ratio " << rho(end) << ")";
+              ++ends;
+            }
+            // At t = 0 the vertex sits on the edge between its ends' true heights.
+            EXPECT_NEAR(mv->y + mv->morph_dy, 0.5f * ends_y, 1e-4f * (1 + std::abs(mv->y)));
+          }
+        }
+      }
+      EXPECT_GT(active, 1000u) << "w " << w << " threshold " << tau;
+      EXPECT_EQ(ends, 2 * active);
+    }
+  }
+}
+
 // On a field whose size is not 2^k + 1 (and not square) the drawn mesh covers exactly the data:
 // no vertex beyond the last sample, and the drawn triangles' areas add up to the data's area, so
 // there is neither a gap nor an overhang; at a fine threshold and at the coarsest tolerance.
@@ -457,9 +528,14 @@ TEST(Roam, MeshEndsExactlyOnTheDataBorder) {
   auto terrain = Terrain::create(Heightfield::create(d, h).value());
   auto l = Landscape::create(terrain, {.patch_exponent = 4}).value();
   const double w = (d.width - 1) * 2.0, hz = (d.height - 1) * 2.0;
+  // At a fine threshold, at the coarsest tolerance, and under a triangle cap far below what the
+  // threshold asks for (the border's splits are forced: they go past the cap, as crack fixes do).
+  const std::uint32_t roots = l->root_count();
   for (const RoamSettings& s :
        {RoamSettings{.threshold = 1.0},
-        RoamSettings{.metric = ErrorMetric::kWorldMetres, .threshold = 1000.0}}) {
+        RoamSettings{.metric = ErrorMetric::kWorldMetres, .threshold = 1000.0},
+        RoamSettings{.threshold = 1.0, .max_triangles = roots},
+        RoamSettings{.threshold = 0.0, .max_triangles = roots + 40}}) {
     auto view = RoamView::create(l, s).value();
     ASSERT_TRUE(view->converge(camera_at({-20, 60, -30}, {80, 0, 60})));
     double area = 0;
@@ -477,8 +553,10 @@ TEST(Roam, MeshEndsExactlyOnTheDataBorder) {
                        double(v[1]->x - v[0]->x) * (v[2]->z - v[0]->z));
       }
     }
-    EXPECT_NEAR(area, w * hz, 1e-6 * w * hz) << "threshold " << s.threshold;
+    EXPECT_NEAR(area, w * hz, 1e-6 * w * hz)
+        << "threshold " << s.threshold << " cap " << s.max_triangles;
     EXPECT_EQ(check_crack_free(*view), "");
+    EXPECT_EQ(view->check_invariants(), "");
   }
 }
 
@@ -683,7 +761,6 @@ TEST(Roam, ZoomInAndOutStaysConvergedAndUnique) {
   }
 }
 
-#include "roam/diamond.h"
 
 // The diamond hierarchy (roam/diamond.h) in O(1) arithmetic agrees with the bintree walked from
 // the roots: every node's hypotenuse midpoint is a diamond whose hypotenuse is the node's and one

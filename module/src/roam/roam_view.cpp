@@ -364,8 +364,10 @@ float RoamView::Impl::converge_budgeted(double threshold, std::uint32_t cap) {
   } else {
     for (std::uint32_t e = 0; e < m.front.size(); ++e) {
       if (m.front.split(e)) {
-        // Under a cap every mergeable diamond may be traded.
-        merges.push_back({-merge_key(e), m.front.node(e)});
+        // Under a cap every mergeable diamond may be traded, except those that keep the mesh
+        // on the data's border (forced, like the splits that keep it crack-free).
+        if (m.front.radius(e) < Front::kBorderRadius)
+          merges.push_back({-merge_key(e), m.front.node(e)});
       } else if (m.front.result(e) & kActive) {
         splits.push_back({split_key(e), m.front.node(e)});
       }
@@ -383,7 +385,7 @@ float RoamView::Impl::converge_budgeted(double threshold, std::uint32_t cap) {
           splits.push_back({split_key(e), n});
           std::push_heap(splits.begin(), splits.end());
         }
-      } else if (m.front.split(e)) {
+      } else if (m.front.split(e) && (cap == 0 || m.front.radius(e) < Front::kBorderRadius)) {
         merges.push_back({-merge_key(e), n});
         std::push_heap(merges.begin(), merges.end());
       }
@@ -455,7 +457,9 @@ float RoamView::Impl::converge_budgeted(double threshold, std::uint32_t cap) {
     }
     if (s) {
       const std::uint32_t n = s->second;
-      if (cap != 0 && m.triangles + m.split_cost(n) > cap) {
+      // A split on the data's border is forced: it goes past the cap (docs/roam.md).
+      const bool border = m.front.radius(m.nodes[n].entry()) >= Front::kBorderRadius;
+      if (cap != 0 && !border && m.triangles + m.split_cost(n) > cap) {
         // Trade a lower-priority diamond for this split, unless it is the leaf's own parent.
         if (g && gp < sp && g->second != m.nodes[n].parent &&
             to(m.nodes[g->second].base()) != m.nodes[n].parent) {
@@ -496,7 +500,26 @@ float RoamView::Impl::converge_budgeted(double threshold, std::uint32_t cap) {
   // What stays unsplit in view: the splits left in the queue (active), and the tests that failed
   // (fresh_worst: this update's pass and every diamond tested since).
   const Item* s = top_split();
-  return std::max(m.fresh_worst, s ? s->first : 0.0f);
+  const float left = std::max(m.fresh_worst, s ? s->first : 0.0f);
+  // Under a cap, the splits that end the mesh on the data's border are forced, as crack fixes
+  // are: every one the cap held back is made now, past the cap (docs/roam.md).
+  if (cap != 0 && m.may_pad && !m.out_of_time()) m.split_border();
+  return left;
+}
+
+void RoamView::Impl::split_border() {
+  std::vector<std::uint32_t> work;
+  for (std::uint32_t e = 0; e < front.size(); ++e)
+    if (!front.split(e) && (front.result(e) & kActive) && front.radius(e) >= Front::kBorderRadius)
+      work.push_back(front.node(e));
+  while (!work.empty()) {
+    const std::uint32_t n = work.back();
+    work.pop_back();
+    // The children a split makes that are active go to `work`; only the border's are forced.
+    if (split_candidate(n) && front.radius(nodes[n].entry()) >= Front::kBorderRadius &&
+        !split(n, false, &work))
+      ++st.pending_splits;
+  }
 }
 
 roam::FrontCamera RoamView::Impl::front_camera(const Camera& camera, double px) const {

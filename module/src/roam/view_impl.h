@@ -138,6 +138,9 @@ struct RoamView::Impl {
   void prefetch_change(const std::vector<std::uint32_t>& list, bool split) const;
   /// Returns the largest priority in view left unsplit.
   float converge_budgeted(double threshold, std::uint32_t cap);
+  /// Splits every active diamond on the data's border still unsplit (and those its splits make),
+  /// whatever the triangle cap: the mesh ends on the border like it stays crack-free.
+  void split_border();
   /// Under a triangle cap alone: converges at the smallest threshold (>= `threshold`) found
   /// whose mesh fits the cap, starting from the last update's; returns that threshold.
   double converge_capped(const Camera& camera, double threshold, std::uint32_t cap);
