@@ -1,5 +1,9 @@
 #include "cli_util.h"
 
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
 #include <unistd.h>
 
 #include <charconv>
@@ -150,6 +154,13 @@ void install_log_sink() {
     std::fprintf(stderr, "ridge: %s: %.*s\n", tag, static_cast<int>(message.size()),
                  message.data());
   });
+}
+
+void keep_freed_memory() {
+#if defined(__GLIBC__)
+  (void)mallopt(M_MMAP_THRESHOLD, 1 << 30);
+  (void)mallopt(M_TRIM_THRESHOLD, 1 << 30);
+#endif
 }
 
 double thread_cpu_ns() {

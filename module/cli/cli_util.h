@@ -56,6 +56,12 @@ Status check_output_folder(const std::string& path, const std::string& what);
 /// CPU time of the calling thread, nanoseconds (CLOCK_THREAD_CPUTIME_ID): unlike wall time it
 /// does not count the time the thread waits for a core, which on a shared machine can dominate.
 double thread_cpu_ns();
+/// For benchmarks that time one piece of work per frame and measure it between frames: keeps
+/// the memory the measurement frees inside the process (glibc: no unmapping, no trimming).
+/// Otherwise a measurement that frees a large buffer unmaps it, which flushes the TLB, and the
+/// next timed frame pays for refilling it (here ~0.5 ms for a 50k-triangle view): a cost of
+/// the benchmark, not of the work timed. Applies to every mode alike.
+void keep_freed_memory();
 
 /// Installs a log sink that prints the library's info, warning and error messages to stderr.
 void install_log_sink();

@@ -220,6 +220,7 @@ Result<Json> run_hard_cases(const ReportArgs& a, const Options& o, std::string& 
 }
 
 int run_report(const ReportArgs& a) {
+  keep_freed_memory();
   if (!a.write_noise.empty()) {  // only the input files
     if (auto s = report::write_noise_field(a.write_noise); !s) return report_error(s.message());
     return 0;

@@ -236,6 +236,7 @@ double percentile(std::vector<double> v, double q) {
 }
 
 int run_bench_lod(const BenchLodArgs& a) {
+  keep_freed_memory();
   if (a.path.empty()) return report_error("give --path PATH.json");
   auto frames = io::load_camera_path(a.path);
   if (!frames) return report_error(frames.error().message);

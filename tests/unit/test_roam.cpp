@@ -475,8 +475,8 @@ TEST(Roam, AVertexStartsOnItsParentEdgeAsDrawn) {
             if (m.indices[t] == m.indices[t + 1]) continue;
             for (int q = 0; q < 3; ++q) {
               const MeshVertex& mv = m.vertices[m.indices[t + q]];
-              at[{std::llround((m.origin_x + mv.x) / 2.0), std::llround((m.origin_z + mv.z) / 2.0)}] =
-                  &mv;
+              at[{std::llround((m.origin_x + mv.x) / 2.0),
+                  std::llround((m.origin_z + mv.z) / 2.0)}] = &mv;
             }
           }
           auto rho = [&](const MeshVertex& mv) {
@@ -760,7 +760,6 @@ TEST(Roam, ZoomInAndOutStaysConvergedAndUnique) {
     EXPECT_EQ(view->mesh_hash(), fresh->mesh_hash()) << "fov " << fov;
   }
 }
-
 
 // The diamond hierarchy (roam/diamond.h) in O(1) arithmetic agrees with the bintree walked from
 // the roots: every node's hypotenuse midpoint is a diamond whose hypotenuse is the node's and one

@@ -56,22 +56,27 @@ inline std::uint32_t world_test(float mu, float r, const FrontCamera& c, float* 
 }
 
 // The pass without vector instructions: the scalar test lane by lane.
-float screen_pass_scalar(Front::Hot* hot, const std::uint32_t* list, std::size_t nb,
-                         const FrontCamera& c) {
+float screen_pass_scalar(Front::Hot* hot, std::size_t nb, const FrontCamera& c,
+                         std::vector<Front::Keyed>* changed) {
   float worst = 0.0f;
-  for (std::size_t k = 0; k < nb; ++k) {
-    const std::size_t b = list != nullptr ? list[k] : k;
+  for (std::size_t b = 0; b < nb; ++b) {
     Front::Hot& h = hot[b];
     std::uint32_t act = 0, view = 0;
+    float p[Front::kLanes];
     for (std::uint32_t l = 0; l < Front::kLanes; ++l) {
-      float p;
-      const std::uint32_t t = screen_test(h.x[l], h.y[l], h.z[l], h.mu[l], h.r[l], c, &p);
+      const std::uint32_t t = screen_test(h.x[l], h.y[l], h.z[l], h.mu[l], h.r[l], c, &p[l]);
       act |= (t & 1u) << l;
       view |= ((t >> 1) & 1u) << l;
-      if (t == kInView && ((hot[b].m.valid >> l) & 1u) && p > worst) worst = p;
+      if (t == kInView && ((h.m.valid >> l) & 1u) && p[l] > worst) worst = p[l];
     }
-    hot[b].m.active = std::uint8_t(act & hot[b].m.valid);
-    hot[b].m.view = std::uint8_t(view & hot[b].m.valid);
+    h.m.active = std::uint8_t(act & h.m.valid);
+    h.m.view = std::uint8_t(view & h.m.valid);
+    if (changed == nullptr) continue;
+    for (std::uint32_t d = std::uint32_t(h.m.active ^ h.m.split) & h.m.valid; d != 0; d &= d - 1) {
+      const std::uint32_t l = std::uint32_t(__builtin_ctz(d));
+      changed->push_back(
+          {(h.m.view >> l) & 1 ? p[l] : -1.0f, std::uint32_t(b) * Front::kLanes + l});
+    }
   }
   return worst;
 }
@@ -79,9 +84,9 @@ float screen_pass_scalar(Front::Hot* hot, const std::uint32_t* list, std::size_t
 #ifdef RIDGELINE_FRONT_AVX2
 // Eight lanes at a time, the same operations as screen_test() in the same order (no fused
 // multiply-adds). Writes only the masks.
-// The blocks are list[0 .. nb) or, without a list, 0 .. nb.
-__attribute__((target("avx2"))) float screen_pass_avx2(Front::Hot* hot, const std::uint32_t* list,
-                                                       std::size_t nb, const FrontCamera& c) {
+__attribute__((target("avx2"))) float screen_pass_avx2(Front::Hot* hot, std::size_t nb,
+                                                       const FrontCamera& c,
+                                                       std::vector<Front::Keyed>* changed) {
   const __m256 ex = _mm256_set1_ps(c.ex), ey = _mm256_set1_ps(c.ey), ez = _mm256_set1_ps(c.ez);
   const __m256 kappa = _mm256_set1_ps(c.kappa), margin = _mm256_set1_ps(c.margin);
   const __m256 zero = _mm256_setzero_ps(), border = _mm256_set1_ps(Front::kBorderRadius);
@@ -98,8 +103,7 @@ __attribute__((target("avx2"))) float screen_pass_avx2(Front::Hot* hot, const st
   // final value within the first blocks, so that is rare.
   float w = 0.0f;
   __m256 kw = _mm256_set1_ps(INFINITY);  // K / w, generous by 2^-20
-  for (std::size_t k = 0; k < nb; ++k) {
-    const std::size_t b = list != nullptr ? list[k] : k;
+  for (std::size_t b = 0; b < nb; ++b) {
     Front::Hot& h = hot[b];
     const __m256 dx = _mm256_sub_ps(_mm256_load_ps(h.x), ex);
     const __m256 dy = _mm256_sub_ps(_mm256_load_ps(h.y), ey);
@@ -127,6 +131,22 @@ __attribute__((target("avx2"))) float screen_pass_avx2(Front::Hot* hot, const st
     const auto view_bits = std::uint32_t(_mm256_movemask_ps(in)) & valid;
     hot[b].m.active = std::uint8_t(act_bits);
     hot[b].m.view = std::uint8_t(view_bits);
+    if (changed != nullptr) {
+      // The priorities of the lanes whose test disagrees with their state (the budgeted
+      // update's queues), computed here for all eight lanes at once.
+      const std::uint32_t d = (act_bits ^ hot[b].m.split) & valid;
+      if (d != 0) {
+        __m256 den = _mm256_sub_ps(_mm256_sqrt_ps(d2), r);
+        den = _mm256_max_ps(den, near);
+        alignas(32) float pk[8];
+        _mm256_store_ps(pk, _mm256_div_ps(_mm256_mul_ps(mu, scale), den));
+        for (std::uint32_t x = d; x != 0; x &= x - 1) {
+          const std::uint32_t l = std::uint32_t(__builtin_ctz(x));
+          changed->push_back(
+              {(view_bits >> l) & 1 ? pk[l] : -1.0f, std::uint32_t(b) * Front::kLanes + l});
+        }
+      }
+    }
     const std::uint32_t q = view_bits & ~act_bits;  // in view, the test failed
     if (q == 0) continue;
     const __m256 a = _mm256_add_ps(_mm256_mul_ps(mu, kw), r);
@@ -254,7 +274,8 @@ void Front::set_result(std::uint32_t e, std::uint32_t bits) noexcept {
   set_word(m, (word(m) & ~(0x00010100u << l)) | set);
 }
 
-float Front::evaluate(const FrontCamera& c) {
+float Front::evaluate(const FrontCamera& c, std::vector<Keyed>* changed) {
+  if (changed != nullptr) changed->clear();
   const std::size_t nb = blocks();
   if (c.world) {
     float worst = 0;
@@ -263,13 +284,14 @@ float Front::evaluate(const FrontCamera& c) {
       const std::uint32_t t = world_test(mu(e), radius(e), c, &p);
       set_result(e, t);
       if (!(t & kActive)) worst = std::max(worst, p);
+      if (changed != nullptr && bool(t & kActive) != split(e)) changed->push_back({p, e});
     }
     return worst;
   }
 #ifdef RIDGELINE_FRONT_AVX2
-  if (have_avx2()) return screen_pass_avx2(hot_.data(), nullptr, nb, c);
+  if (have_avx2()) return screen_pass_avx2(hot_.data(), nb, c, changed);
 #endif
-  return screen_pass_scalar(hot_.data(), nullptr, nb, c);
+  return screen_pass_scalar(hot_.data(), nb, c, changed);
 }
 
 std::uint8_t Front::test_one(std::uint32_t e, const FrontCamera& c, float* priority) noexcept {

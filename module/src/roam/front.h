@@ -142,9 +142,16 @@ class Front {
   /// Empties the front; keeps the memory.
   void clear() noexcept;
 
+  /// An entry whose test disagrees with its state, and its priority (-1 for a merge candidate
+  /// out of view).
+  struct Keyed {
+    float key;
+    std::uint32_t entry;
+  };
   /// Tests every entry for `c` (result() of each). Returns the largest priority of an entry in
-  /// view whose test fails (0 when none).
-  float evaluate(const FrontCamera& c);
+  /// view whose test fails (0 when none). With `changed`, also lists the entries whose test
+  /// disagrees with their state with their priorities, computed in the same pass.
+  float evaluate(const FrontCamera& c, std::vector<Keyed>* changed = nullptr);
   /// Tests one entry (a new one, or one whose data changed) the same way, bit for bit; returns
   /// kActive | kInView bits. `priority`, when given, receives its priority.
   std::uint8_t test_one(std::uint32_t e, const FrontCamera& c, float* priority = nullptr) noexcept;

@@ -130,8 +130,8 @@ void to_ranges(std::vector<std::uint64_t>& bits, std::vector<MeshRange>& out) {
 }  // namespace
 
 std::vector<std::uint32_t> PatchOutput::take_dirty() {
-  std::vector<std::uint32_t> out;
-  out.swap(dirty_list_);
+  std::vector<std::uint32_t> out(dirty_list_);  // the list keeps its capacity
+  dirty_list_.clear();
   std::sort(out.begin(), out.end());
   for (std::uint32_t pi : out) {
     Patch& p = patches_[pi];

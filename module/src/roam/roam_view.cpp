@@ -19,6 +19,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <functional>
 #include <unordered_set>
 
 #include "format.h"
@@ -348,19 +349,38 @@ void RoamView::Impl::converge_all() {
 // split matters more). Keys are this update's priorities; out-of-view diamonds merge first.
 float RoamView::Impl::converge_budgeted(double threshold, std::uint32_t cap) {
   Impl& m = *this;
-  using Item = std::pair<float, std::uint32_t>;  // priority, node
-  std::vector<Item> splits, merges;
+  using Item = Impl::Item;
+  // The queues are members: an update allocates nothing once they have grown (an allocation
+  // after other code gave memory back to the system faults pages in: ~0.5 ms spikes).
+  std::vector<Item>& splits = m.split_queue;
+  std::vector<Item>& merges = m.merge_queue;
+  splits.clear();
+  merges.clear();
   auto split_key = [&](std::uint32_t e) { return m.front.priority(e, m.cam); };
   auto merge_key = [&](std::uint32_t e) {
     return (m.front.result(e) & kInView) ? m.front.priority(e, m.cam) : -1.0f;
   };
+  float held_back = 0;  // the largest priority of a split candidate left out of the queue
   if (cap == 0) {
-    // Without a cap the candidates are the entries whose test disagrees with their state:
-    // collect()'s lists, which skip the blocks the pass found unchanged.
-    splits.reserve(m.to_split.size());
-    merges.reserve(m.to_merge.size());
-    for (std::uint32_t n : m.to_split) splits.push_back({split_key(m.nodes[n].entry()), n});
-    for (std::uint32_t n : m.to_merge) merges.push_back({-merge_key(m.nodes[n].entry()), n});
+    // Without a cap the candidates are the entries whose test disagrees with their state, with
+    // the priorities the pass computed (keyed). Far from convergence there are thousands while
+    // the budget allows a few hundred changes: only the most important go in the queues (the
+    // rest is found again by the next update's pass), so building them costs little.
+    const std::size_t keep = std::max<std::size_t>(1024, 4 * std::size_t(m.budget_ops));
+    splits.reserve(std::min(keep, m.keyed.size()));
+    merges.reserve(std::min(keep, m.keyed.size()));
+    for (const Front::Keyed& k : m.keyed)
+      (m.front.split(k.entry) ? merges : splits)
+          .push_back({m.front.split(k.entry) ? -k.key : k.key, m.front.node(k.entry)});
+    auto trim = [&](std::vector<Item>& v, bool is_split) {
+      if (v.size() <= keep) return;
+      std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(keep), v.end(), std::greater<>());
+      if (is_split)
+        for (std::size_t i = keep; i < v.size(); ++i) held_back = std::max(held_back, v[i].first);
+      v.resize(keep);
+    };
+    trim(splits, true);
+    trim(merges, false);
   } else {
     for (std::uint32_t e = 0; e < m.front.size(); ++e) {
       if (m.front.split(e)) {
@@ -375,7 +395,8 @@ float RoamView::Impl::converge_budgeted(double threshold, std::uint32_t cap) {
   }
   std::make_heap(splits.begin(), splits.end());
   std::make_heap(merges.begin(), merges.end());  // max of -key: the lowest key on top
-  std::vector<std::uint32_t> fresh;
+  std::vector<std::uint32_t>& fresh = m.fresh_nodes;
+  fresh.clear();
   auto push_fresh = [&] {
     for (std::uint32_t n : fresh) {
       const std::uint32_t e = m.nodes[n].entry();
@@ -431,6 +452,7 @@ float RoamView::Impl::converge_budgeted(double threshold, std::uint32_t cap) {
   };
   std::uint64_t ops = 0;
   bool alternate = false;
+  const std::uint32_t splits0 = m.st.splits, merges0 = m.st.merges;
   for (;;) {
     if (++ops > 16ull * (m.triangles + 4096)) break;  // a safety net against a trade cycle
     if (m.out_of_time()) {
@@ -500,7 +522,8 @@ float RoamView::Impl::converge_budgeted(double threshold, std::uint32_t cap) {
   // What stays unsplit in view: the splits left in the queue (active), and the tests that failed
   // (fresh_worst: this update's pass and every diamond tested since).
   const Item* s = top_split();
-  const float left = std::max(m.fresh_worst, s ? s->first : 0.0f);
+  const float left = std::max({m.fresh_worst, s ? s->first : 0.0f, held_back});
+  m.budget_ops = (m.st.splits - splits0) + (m.st.merges - merges0);
   // Under a cap, the splits that end the mesh on the data's border are forced, as crack fixes
   // are: every one the cap held back is made now, past the cap (docs/roam.md).
   if (cap != 0 && m.may_pad && !m.out_of_time()) m.split_border();
@@ -622,8 +645,8 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
     std::abort();
   }
 #endif
-  // 2. The test.
-  m.fresh_worst = m.front.evaluate(m.cam);
+  // 2. The test (with the changes' priorities when a time budget alone orders them).
+  m.fresh_worst = m.front.evaluate(m.cam, m.has_deadline && cap == 0 ? &m.keyed : nullptr);
   m.st.priority_updates += m.front.size();
   m.collect();
   // Coherence loses when much of the mesh must go at once (a teleport, a snap turn): a rebuild
@@ -660,7 +683,8 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
                              ? std::max(threshold, double(remaining))
                              : threshold;
   m.st.memory_bytes = m.nodes.memory_bytes() + m.front.memory_bytes() +
-                      (m.to_merge.capacity() + m.to_split.capacity()) * sizeof(std::uint32_t);
+                      (m.to_merge.capacity() + m.to_split.capacity()) * sizeof(std::uint32_t) +
+                      m.keyed.capacity() * sizeof(Front::Keyed);
   m.st.output_bytes = m.out.memory_bytes();
   m.st.upload_bytes = m.out.take_upload_bytes();
   m.st.dirty_patches = m.out.dirty_patch_count();

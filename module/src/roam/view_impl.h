@@ -52,6 +52,11 @@ struct RoamView::Impl {
   RoamStats st;
   float fresh_worst = 0;  // largest priority of a failing test in view seen this update
   std::vector<std::uint32_t> to_merge, to_split;  // nodes (worklists)
+  std::vector<roam::Front::Keyed> keyed;  // the pass's changed entries and priorities (budgets)
+  using Item = std::pair<float, std::uint32_t>;  // priority, node
+  std::vector<Item> split_queue, merge_queue;    // converge_budgeted()'s queues
+  std::vector<std::uint32_t> fresh_nodes;        // nodes a budgeted change made or freed
+  std::uint32_t budget_ops = 0;                  // changes the last budgeted update made
   bool has_deadline = false;
   std::chrono::steady_clock::time_point deadline;
   std::uint32_t clock_checks = 0;
