@@ -12,6 +12,8 @@
 //   --threshold PX  both at PX pixels (without --triangles)
 //   --flush-mb M    between frames, read and write M MiB of other memory (the rest of an
 //                   engine's frame evicting the terrain's data); 0 (default): caches stay warm
+//   --cold N        instead: N fresh views' first updates at the path's first camera (cold
+//                   start: the mesh built from the roots), their median (ROAM only)
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -66,7 +68,7 @@ int usage(const char* why) {
 
 int main(int argc, char** argv) {
   double threshold = -1, flush_mb = 0;
-  unsigned triangles = 0, rounds = 1, patch_exponent = 6;
+  unsigned triangles = 0, rounds = 1, patch_exponent = 6, cold = 0;
   std::string only, json_path;
   for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
@@ -88,6 +90,8 @@ int main(int argc, char** argv) {
       rounds = unsigned(number(1, 1000));
     else if (a == "--flush-mb")
       flush_mb = number(0, 4096);
+    else if (a == "--cold")
+      cold = unsigned(number(1, 1000));
     else if (a == "--patch-exponent")
       patch_exponent = unsigned(number(2, 10));
     else if (a == "--only" && v != nullptr &&
@@ -108,15 +112,33 @@ int main(int argc, char** argv) {
   const bool do_roam = only != "soar", do_soar = only != "roam";
 
   std::unique_ptr<RoamView> view;
+  std::shared_ptr<const Landscape> landscape;
   if (do_roam) {
     auto land = Landscape::create(terrain, {.patch_exponent = patch_exponent});
     if (!land) return usage(land.error().message.c_str());
+    landscape = *land;
     RoamSettings s;
     s.threshold = threshold;
     s.max_triangles = triangles;
     auto v = RoamView::create(*land, s);
     if (!v) return usage(v.error().message.c_str());
     view = std::move(*v);
+  }
+  if (cold > 0 && view) {
+    std::vector<double> ms;
+    std::size_t tris = 0;
+    for (unsigned k = 0; k < cold; ++k) {
+      auto v = RoamView::create(landscape, view->settings()).value();
+      const auto w0 = std::chrono::steady_clock::now();
+      const auto st = v->update(cams[0]);
+      ms.push_back(
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - w0).count());
+      tris = st ? st->triangles : 0;
+    }
+    std::printf(
+        "{\n \"cold_start_update_ms_median\": %.3f,\n \"triangles\": %zu,\n \"runs\": %u\n}\n",
+        median(ms), tris, cold);
+    return 0;
   }
   std::unique_ptr<report::Soar> soar;
   double path_kappa = INFINITY;

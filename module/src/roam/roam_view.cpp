@@ -308,6 +308,10 @@ void RoamView::Impl::prefetch_change(const std::vector<std::uint32_t>& list, boo
   prefetch_record(i - bu, j - bw);
 }
 
+// Breadth first: the changes a wave of changes asks for (parents that became mergeable and
+// inactive, children that are active) make the next wave, so each wave's list is known before
+// it starts and the next changes' data can be fetched ahead (prefetch_change()); and coarser
+// diamonds split before finer ones, so few splits need forcing.
 void RoamView::Impl::converge_all() {
   Impl& m = *this;
 #ifdef RIDGELINE_ROAM_PARANOID
@@ -316,31 +320,29 @@ void RoamView::Impl::converge_all() {
     std::abort();
   }
 #endif
-  std::vector<std::uint32_t>& list = m.to_merge;
-  while (!list.empty()) {
-    m.prefetch_change(list, false);
-    const std::uint32_t n = list.back();
-    list.pop_back();
-    if (m.merge_candidate(n)) m.merge(n, &list);
+  std::vector<std::uint32_t>& next = m.next_wave;
+  for (std::vector<std::uint32_t>* list : {&m.to_merge, &m.to_split}) {
+    const bool split = list == &m.to_split;
+    next.clear();
+    while (!list->empty()) {
+      while (!list->empty()) {
+        m.prefetch_change(*list, split);
+        const std::uint32_t n = list->back();
+        list->pop_back();
+        if (split) {
+          if (m.split_candidate(n) && !m.split(n, false, &next)) ++m.st.pending_splits;
+        } else if (m.merge_candidate(n)) {
+          m.merge(n, &next);
+        }
 #ifdef RIDGELINE_ROAM_PARANOID
-    if (auto e = m.check(); !e.empty()) {
-      std::fprintf(stderr, "after merge of %u: %s\n", n, e.c_str());
-      std::abort();
-    }
+        if (auto e = m.check(); !e.empty()) {
+          std::fprintf(stderr, "after %s of %u: %s\n", split ? "split" : "merge", n, e.c_str());
+          std::abort();
+        }
 #endif
-  }
-  std::vector<std::uint32_t>& work = m.to_split;
-  while (!work.empty()) {
-    m.prefetch_change(work, true);
-    const std::uint32_t n = work.back();
-    work.pop_back();
-    if (m.split_candidate(n) && !m.split(n, false, &work)) ++m.st.pending_splits;
-#ifdef RIDGELINE_ROAM_PARANOID
-    if (auto e = m.check(); !e.empty()) {
-      std::fprintf(stderr, "after split of %u: %s\n", n, e.c_str());
-      std::abort();
+      }
+      list->swap(next);
     }
-#endif
   }
 }
 
@@ -683,7 +685,8 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
                              ? std::max(threshold, double(remaining))
                              : threshold;
   m.st.memory_bytes = m.nodes.memory_bytes() + m.front.memory_bytes() +
-                      (m.to_merge.capacity() + m.to_split.capacity()) * sizeof(std::uint32_t) +
+                      (m.to_merge.capacity() + m.to_split.capacity() + m.next_wave.capacity()) *
+                          sizeof(std::uint32_t) +
                       m.keyed.capacity() * sizeof(Front::Keyed);
   m.st.output_bytes = m.out.memory_bytes();
   m.st.upload_bytes = m.out.take_upload_bytes();

@@ -52,6 +52,7 @@ struct RoamView::Impl {
   RoamStats st;
   float fresh_worst = 0;  // largest priority of a failing test in view seen this update
   std::vector<std::uint32_t> to_merge, to_split;  // nodes (worklists)
+  std::vector<std::uint32_t> next_wave;           // converge_all()'s next wave
   std::vector<roam::Front::Keyed> keyed;  // the pass's changed entries and priorities (budgets)
   using Item = std::pair<float, std::uint32_t>;  // priority, node
   std::vector<Item> split_queue, merge_queue;    // converge_budgeted()'s queues
