@@ -53,6 +53,27 @@ for row in n5250 n20800 n53000 t1; do
   done
 done
 
+# The same comparison frame by frame in one process (tests/bench/bench_roam_core.cpp): ROAM's
+# update + output and SOAR's refine + emit alternate on every frame, with nothing else between
+# frames (warm) and with 64 MiB of other memory read and written between frames (the rest of an
+# engine's frame evicting the terrain's data).
+core=build/release/tests/bench/bench_roam_core
+rm -f "$work/vs_soar_core.jsonl"
+if [ -x "$core" ]; then
+  for row in n5250 n20800 n53000 t1; do
+    case $row in
+      t1) cargs=(--threshold 1) ;;
+      *) cargs=(--triangles "${row#n}") ;;
+    esac
+    for flush in 0 64; do
+      "$core" "${cargs[@]}" --rounds "$rounds" --flush-mb "$flush" |
+        python3 -c "import json,sys; d=json.load(sys.stdin); d['row']='$row'; d['load']=$(cut -d' ' -f1 /proc/loadavg); print(json.dumps(d))" \
+        >> "$work/vs_soar_core.jsonl"
+    done
+  done
+fi
+export CORE_JSONL=$work/vs_soar_core.jsonl
+
 python3 - "$work/vs_soar.jsonl" "$out" "$rounds" <<'PY'
 import json, statistics, sys
 runs = [json.loads(l) for l in open(sys.argv[1])]
@@ -96,10 +117,24 @@ for row in dict.fromkeys(r["row"] for r in runs):
     })
 json.dump({"command": "scripts/bench_roam_vs_soar.sh", "rounds": int(sys.argv[3]),
            "rows": rows}, open(sys.argv[2], "w"), indent=1)
+import os
+core = os.environ.get("CORE_JSONL")
+if core and os.path.exists(core):
+    d = json.load(open(sys.argv[2]))
+    d["bench_roam_core"] = [json.loads(l) for l in open(core)]
+    json.dump(d, open(sys.argv[2], "w"), indent=1)
 for r in rows:
     print(f'{r["row"]:>7}: ROAM {r["roam_update_plus_output_ms"]:.3f} ms, SOAR '
           f'{r["soar_refine_and_emit_ms"]:.3f} ms, SOAR/ROAM {r["soar_over_roam_wall"]:.2f} (wall) '
           f'{r["soar_over_roam_cpu"]:.2f} (cpu); triangles {r["roam_triangles"]:.0f} / '
           f'{r["soar_triangles"]:.0f}; RMS {r["roam_rms_error_m"]:.3f} / {r["soar_rms_error_m"]:.3f} m')
+PY
+[ -f "$work/vs_soar_core.jsonl" ] && python3 - "$work/vs_soar_core.jsonl" <<'PY'
+import json, sys
+for l in open(sys.argv[1]):
+    d = json.loads(l)
+    print(f'{d["row"]:>7} flush {d["flush_mb"]:>3g} MiB: ROAM {d["roam_update_plus_output_ms_median"]:.3f} ms, '
+          f'SOAR {d["soar_refine_emit_ms_median"]:.3f} ms, SOAR/ROAM {d["soar_over_roam_median_of_frame_ratios"]:.2f} '
+          f'(frame by frame); triangles {d["roam_triangles_median"]:.0f} / {d["soar_triangles_median"]:.0f}')
 PY
 echo "wrote $out"
