@@ -5,11 +5,11 @@
 #include <cmath>
 #include <limits>
 
-#include "edit_layer.h"
-#include "edit_log.h"
-#include "ray_hierarchy.h"
+#include "edit/edit_layer.h"
+#include "edit/edit_log.h"
+#include "surface/ray_hierarchy.h"
 #include "ridgeline/detail.h"
-#include "surface_eval.h"
+#include "surface/surface_eval.h"
 #include "terrain_fine.h"
 
 namespace ridgeline {

@@ -4,12 +4,12 @@
 #include <bit>
 #include <cmath>
 
-#include "edit_layer.h"
+#include "edit/edit_layer.h"
 #include "format.h"
-#include "ray_hierarchy.h"
+#include "surface/ray_hierarchy.h"
 #include "ridgeline/detail.h"
 #include "ridgeline/terrain.h"
-#include "surface_eval.h"
+#include "surface/surface_eval.h"
 #include "terrain_fine.h"
 
 namespace ridgeline {

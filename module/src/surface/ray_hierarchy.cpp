@@ -10,7 +10,7 @@
 // Everything runs in double precision in lattice-local coordinates (grid units from sample (0, 0)
 // along x and z, metres above the height offset along y), so terrains far from the world origin
 // lose nothing.
-#include "ray_hierarchy.h"
+#include "surface/ray_hierarchy.h"
 
 #include <algorithm>
 #include <cmath>
@@ -18,7 +18,7 @@
 #include <limits>
 
 #include "ridgeline/detail.h"
-#include "surface_eval.h"
+#include "surface/surface_eval.h"
 
 namespace ridgeline {
 

@@ -14,7 +14,7 @@
 #include "ridgeline/heightfield.h"
 #include "ridgeline/surface.h"
 #include "ridgeline/terrain.h"
-#include "surface_eval.h"
+#include "surface/surface_eval.h"
 
 namespace ridgeline {
 

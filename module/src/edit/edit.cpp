@@ -13,10 +13,10 @@
 #include <cstring>
 #include <numbers>
 
-#include "edit_layer.h"
-#include "edit_log.h"
+#include "edit/edit_layer.h"
+#include "edit/edit_log.h"
 #include "format.h"
-#include "ray_hierarchy.h"
+#include "surface/ray_hierarchy.h"
 #include "ridgeline/detail.h"
 
 namespace ridgeline {
