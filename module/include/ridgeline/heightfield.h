@@ -119,7 +119,7 @@ class Heightfield {
  private:
   Heightfield() = default;
   friend class EditLayer;  // writes heights during an edit (terrain.h's exclusive access)
-  friend class Terrain;    // clone()
+  friend class Surface;    // Terrain::clone()
   Heightfield duplicate() const {
     Heightfield h;
     h.heights_ = heights_;
