@@ -96,8 +96,19 @@ struct LatticePoint {
   typename Lattice::Height h[3];
 };
 
+/// The finest cell (i, j) holding lattice position (u, v) (finest-lattice units from vertex
+/// (0, 0), inside the lattice: a point on the far edges belongs to the last cell) and the
+/// triangle under it: the one rule by which every query finds its triangle.
+template <class Lattice>
+inline CellTriangle cell_at(const Lattice& g, double u, double v, std::int64_t& i,
+                            std::int64_t& j) noexcept {
+  i = std::min(static_cast<std::int64_t>(u), g.at.vertices_x - 2);
+  j = std::min(static_cast<std::int64_t>(v), g.at.vertices_z - 2);
+  return locate_in_cell(i, j, static_cast<float>(u - double(i)), static_cast<float>(v - double(j)));
+}
+
 /// Finds the cell and triangle under world (x, z) and reads its corners; false off the footprint
-/// (NaN fails the range test too). A point on the far edge belongs to the last cell.
+/// (NaN fails the range test too).
 template <class Lattice>
 inline bool locate(const Lattice& g, double x, double z, LatticePoint<Lattice>& p) noexcept {
   const SurfaceLattice& at = g.at;
@@ -105,10 +116,7 @@ inline bool locate(const Lattice& g, double x, double z, LatticePoint<Lattice>& 
   const double v = (z - at.origin_z) * at.inv_spacing_z;
   const double max_u = double(at.vertices_x - 1), max_v = double(at.vertices_z - 1);
   if (!(u >= 0.0 && u <= max_u && v >= 0.0 && v <= max_v)) return false;
-  p.i = std::min(static_cast<std::int64_t>(u), at.vertices_x - 2);
-  p.j = std::min(static_cast<std::int64_t>(v), at.vertices_z - 2);
-  p.tri = locate_in_cell(p.i, p.j, static_cast<float>(u - double(p.i)),
-                         static_cast<float>(v - double(p.j)));
+  p.tri = cell_at(g, u, v, p.i, p.j);
   for (int k = 0; k < 3; ++k) p.h[k] = g.local(p.i + p.tri.di[k], p.j + p.tri.dj[k]);
   return true;
 }

@@ -190,12 +190,9 @@ template <class Lattice>
 PointPlane point_plane(const Lattice& g, double u, double v) noexcept {
   u *= g.scale, v *= g.scale;  // finest-lattice units (exact: a power of two)
   PointPlane p;
-  p.i = std::min(static_cast<std::int64_t>(u), g.at.vertices_x - 2);
-  p.j = std::min(static_cast<std::int64_t>(v), g.at.vertices_z - 2);
+  const CellTriangle tri = detail::cell_at(g, u, v, p.i, p.j);
   p.fu = u - double(p.i);
   p.fv = v - double(p.j);
-  const CellTriangle tri =
-      locate_in_cell(p.i, p.j, static_cast<float>(p.fu), static_cast<float>(p.fv));
   p.plane = detail::cell_plane(g, p.i, p.j, tri);
   return p;
 }
