@@ -78,13 +78,20 @@ struct DetailLattice {
   std::int64_t height() const noexcept { return at.vertices_z; }
 };
 
+/// The view of `s`'s lattice of each kind (the caller knows which one `s` has).
+inline StoredLattice stored_lattice(const Surface& s) noexcept {
+  return {s.heightfield(), s.lattice()};
+}
+inline DetailLattice detail_lattice(const Surface& s) noexcept {
+  const int L = int(s.lattice().levels);
+  return {L, std::ldexp(1.0, L), std::ldexp(1.0, -L), s.heightfield(), s.lattice(), s};
+}
+
 /// Calls f(view) with the view of `s`'s lattice and returns what it returns.
 template <class F>
 decltype(auto) with_lattice(const Surface& s, F&& f) {
-  const SurfaceLattice& at = s.lattice();
-  if (at.levels == 0) return f(StoredLattice{s.heightfield(), at});
-  const int L = int(at.levels);
-  return f(DetailLattice{L, std::ldexp(1.0, L), std::ldexp(1.0, -L), s.heightfield(), at, s});
+  if (s.lattice().levels == 0) return f(stored_lattice(s));
+  return f(detail_lattice(s));
 }
 
 /// A point located on a lattice: its finest cell (i, j), the triangle under it and the local
@@ -100,8 +107,8 @@ struct LatticePoint {
 /// (0, 0), inside the lattice: a point on the far edges belongs to the last cell) and the
 /// triangle under it: the one rule by which every query finds its triangle.
 template <class Lattice>
-inline CellTriangle cell_at(const Lattice& g, double u, double v, std::int64_t& i,
-                            std::int64_t& j) noexcept {
+[[gnu::always_inline]] inline CellTriangle cell_at(const Lattice& g, double u, double v,
+                                                   std::int64_t& i, std::int64_t& j) noexcept {
   i = std::min(static_cast<std::int64_t>(u), g.at.vertices_x - 2);
   j = std::min(static_cast<std::int64_t>(v), g.at.vertices_z - 2);
   return locate_in_cell(i, j, static_cast<float>(u - double(i)), static_cast<float>(v - double(j)));
@@ -110,14 +117,18 @@ inline CellTriangle cell_at(const Lattice& g, double u, double v, std::int64_t& 
 /// Finds the cell and triangle under world (x, z) and reads its corners; false off the footprint
 /// (NaN fails the range test too).
 template <class Lattice>
-inline bool locate(const Lattice& g, double x, double z, LatticePoint<Lattice>& p) noexcept {
+[[gnu::always_inline]] inline bool locate(const Lattice& g, double x, double z,
+                                          LatticePoint<Lattice>& p) noexcept {
   const SurfaceLattice& at = g.at;
   const double u = (x - at.origin_x) * at.inv_spacing_x;
   const double v = (z - at.origin_z) * at.inv_spacing_z;
   const double max_u = double(at.vertices_x - 1), max_v = double(at.vertices_z - 1);
   if (!(u >= 0.0 && u <= max_u && v >= 0.0 && v <= max_v)) return false;
   p.tri = cell_at(g, u, v, p.i, p.j);
-  for (int k = 0; k < 3; ++k) p.h[k] = g.local(p.i + p.tri.di[k], p.j + p.tri.dj[k]);
+  // Written out: as a loop, -O3 versions it for a unit row stride and spills the heights.
+  p.h[0] = g.local(p.i + p.tri.di[0], p.j + p.tri.dj[0]);
+  p.h[1] = g.local(p.i + p.tri.di[1], p.j + p.tri.dj[1]);
+  p.h[2] = g.local(p.i + p.tri.di[2], p.j + p.tri.dj[2]);
   return true;
 }
 

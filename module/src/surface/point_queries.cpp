@@ -13,15 +13,19 @@ namespace {
 
 using detail::LatticePoint;
 
+// Height and face normal are the whole arithmetic of the fast queries: always inlined, so that
+// each query compiles to one straight function on the stored lattice.
 template <class Lattice>
-double height_at(const Lattice& g, const LatticePoint<Lattice>& p) noexcept {
+[[gnu::always_inline]] inline double height_at(const Lattice& g,
+                                               const LatticePoint<Lattice>& p) noexcept {
   // In the lattice's own precision (float for the stored samples), as the mesh output does.
   return g.at.height_offset +
          double(p.tri.w[0] * p.h[0] + p.tri.w[1] * p.h[1] + p.tri.w[2] * p.h[2]);
 }
 
 template <class Lattice>
-glm::vec3 face_normal_at(const Lattice& g, const LatticePoint<Lattice>& p) noexcept {
+[[gnu::always_inline]] inline glm::vec3 face_normal_at(const Lattice& g,
+                                                       const LatticePoint<Lattice>& p) noexcept {
   return detail::plane_normal(detail::plane_of(p.tri, p.h[0], p.h[1], p.h[2]), g.at.inv_spacing_x,
                               g.at.inv_spacing_z);
 }
@@ -35,49 +39,91 @@ glm::vec3 smooth_normal_at(const Lattice& g, const LatticePoint<Lattice>& p) noe
   return detail::unit(n);
 }
 
-// Locates (x, z) and, when on the footprint, returns what `answer` makes of the point.
-template <class T, class Answer>
-std::optional<T> at_point(const Surface& s, double x, double z, Answer&& answer) noexcept {
-  return detail::with_lattice(s, [&](const auto& g) -> std::optional<T> {
-    LatticePoint<std::remove_cvref_t<decltype(g)>> p;
-    if (!detail::locate(g, x, z, p)) return std::nullopt;
-    return answer(g, p);
-  });
+// What each point query makes of the located point: Answer::at(lattice, point).
+struct Height {
+  template <class G>
+  static double at(const G& g, const LatticePoint<G>& p) noexcept {
+    return height_at(g, p);
+  }
+};
+struct FaceNormal {
+  template <class G>
+  static glm::vec3 at(const G& g, const LatticePoint<G>& p) noexcept {
+    return face_normal_at(g, p);
+  }
+};
+struct SmoothNormal {
+  template <class G>
+  static glm::vec3 at(const G& g, const LatticePoint<G>& p) noexcept {
+    return smooth_normal_at(g, p);
+  }
+};
+struct Material {
+  template <class G>
+  static std::uint8_t at(const G& g, const LatticePoint<G>& p) noexcept {
+    return g.material(p.i, p.j);
+  }
+};
+struct HeightAndNormal {
+  template <class G>
+  static HeightNormal at(const G& g, const LatticePoint<G>& p) noexcept {
+    return {height_at(g, p), face_normal_at(g, p), g.material(p.i, p.j)};
+  }
+};
+struct Everything {
+  template <class G>
+  static SurfaceSample at(const G& g, const LatticePoint<G>& p) noexcept {
+    return {height_at(g, p), face_normal_at(g, p), smooth_normal_at(g, p), g.material(p.i, p.j)};
+  }
+};
+
+// The query on one view: locate, then answer; empty off the footprint.
+template <class Answer, class G>
+[[gnu::always_inline]] inline auto answer_on(const G& g, double x, double z) noexcept
+    -> std::optional<decltype(Answer::at(g, LatticePoint<G>{}))> {
+  LatticePoint<G> p;
+  if (!detail::locate(g, x, z, p)) return std::nullopt;
+  return Answer::at(g, p);
+}
+
+// With detail, out of line: such a query costs microseconds, while the stored path it would
+// otherwise be inlined next to costs nanoseconds and would pay for every register it needs.
+template <class Answer>
+[[gnu::noinline]] auto answer_on_detail(const Surface& s, double x, double z) noexcept {
+  return answer_on<Answer>(detail::detail_lattice(s), x, z);
+}
+
+// Point query `Answer` at world (x, z), on whichever view the surface has.
+template <class Answer>
+auto point_query(const Surface& s, double x, double z) noexcept {
+  if (s.detail_levels() == 0) return answer_on<Answer>(detail::stored_lattice(s), x, z);
+  return answer_on_detail<Answer>(s, x, z);
 }
 
 }  // namespace
 
 std::optional<double> Surface::height(double x, double z) const noexcept {
-  return at_point<double>(*this, x, z,
-                          [](const auto& g, const auto& p) { return height_at(g, p); });
+  return point_query<Height>(*this, x, z);
 }
 
 std::optional<glm::vec3> Surface::face_normal(double x, double z) const noexcept {
-  return at_point<glm::vec3>(*this, x, z,
-                             [](const auto& g, const auto& p) { return face_normal_at(g, p); });
+  return point_query<FaceNormal>(*this, x, z);
 }
 
 std::optional<glm::vec3> Surface::smooth_normal(double x, double z) const noexcept {
-  return at_point<glm::vec3>(*this, x, z,
-                             [](const auto& g, const auto& p) { return smooth_normal_at(g, p); });
+  return point_query<SmoothNormal>(*this, x, z);
 }
 
 std::optional<std::uint8_t> Surface::material(double x, double z) const noexcept {
-  return at_point<std::uint8_t>(*this, x, z,
-                                [](const auto& g, const auto& p) { return g.material(p.i, p.j); });
+  return point_query<Material>(*this, x, z);
 }
 
 std::optional<HeightNormal> Surface::height_normal(double x, double z) const noexcept {
-  return at_point<HeightNormal>(*this, x, z, [](const auto& g, const auto& p) {
-    return HeightNormal{height_at(g, p), face_normal_at(g, p), g.material(p.i, p.j)};
-  });
+  return point_query<HeightAndNormal>(*this, x, z);
 }
 
 std::optional<SurfaceSample> Surface::sample(double x, double z) const noexcept {
-  return at_point<SurfaceSample>(*this, x, z, [](const auto& g, const auto& p) {
-    return SurfaceSample{height_at(g, p), face_normal_at(g, p), smooth_normal_at(g, p),
-                         g.material(p.i, p.j)};
-  });
+  return point_query<Everything>(*this, x, z);
 }
 
 void Surface::heights(std::span<const glm::dvec2> xz, std::span<double> out) const noexcept {
