@@ -128,24 +128,30 @@ std::optional<SurfaceSample> Surface::sample(double x, double z) const noexcept 
 
 void Surface::heights(std::span<const glm::dvec2> xz, std::span<double> out) const noexcept {
   const std::size_t n = std::min(xz.size(), out.size());
-  detail::with_lattice(*this, [&](const auto& g) {
-    // Scattered points miss the cache on every lookup: start fetching the cell of the point
-    // kAhead places on while this one is evaluated.
-    constexpr std::size_t kAhead = 8;
-    const SurfaceLattice& at = g.at;
-    const double max_u = double(at.vertices_x - 2), max_v = double(at.vertices_z - 2);
-    LatticePoint<std::remove_cvref_t<decltype(g)>> p;
-    for (std::size_t k = 0; k < n; ++k) {
-      if (k + kAhead < n) {
-        const double u = (xz[k + kAhead].x - at.origin_x) * at.inv_spacing_x;
-        const double v = (xz[k + kAhead].y - at.origin_z) * at.inv_spacing_z;
-        if (u >= 0.0 && u <= max_u && v >= 0.0 && v <= max_v)
-          g.prefetch(static_cast<std::int64_t>(u), static_cast<std::int64_t>(v));
-      }
-      out[k] = detail::locate(g, xz[k].x, xz[k].y, p) ? height_at(g, p)
-                                                      : std::numeric_limits<double>::quiet_NaN();
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  if (detail_levels() != 0) {
+    for (std::size_t k = 0; k < n; ++k)
+      out[k] = answer_on_detail<Height>(*this, xz[k].x, xz[k].y).value_or(kNaN);
+    return;
+  }
+  // A copy of the placement: the stores to `out` cannot then alias it, so it stays in registers.
+  const SurfaceLattice at = lattice();
+  const detail::StoredLattice g{heightfield(), at};
+  const double max_u = double(at.vertices_x - 2), max_v = double(at.vertices_z - 2);
+  // Scattered points miss the cache once the samples outgrow it: start fetching the cell of the
+  // point kAhead places on while this one is evaluated (clamped into the lattice, branch-free;
+  // NaN goes to 0: a hint only).
+  constexpr std::size_t kAhead = 8;
+  const std::size_t ahead = n > kAhead ? n - kAhead : 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (k < ahead) {
+      const glm::dvec2 q = xz[k + kAhead];
+      const double u = std::min(max_u, std::max(0.0, (q.x - at.origin_x) * at.inv_spacing_x));
+      const double v = std::min(max_v, std::max(0.0, (q.y - at.origin_z) * at.inv_spacing_z));
+      g.prefetch(static_cast<std::int64_t>(u), static_cast<std::int64_t>(v));
     }
-  });
+    out[k] = answer_on<Height>(g, xz[k].x, xz[k].y).value_or(kNaN);
+  }
 }
 
 void Surface::samples(std::span<const glm::dvec2> xz, std::span<SurfaceSample> out,
