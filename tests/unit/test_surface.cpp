@@ -313,7 +313,7 @@ TEST(Surface, CloneSharesTheDetailFieldAndAnswersTheSame) {
   EXPECT_NE(c->surface().detail_cache(), t->surface().detail_cache());
   EXPECT_EQ(c->surface().detail_hash(), t->surface().detail_hash());
   EXPECT_EQ(c->surface().heights_hash(), t->surface().heights_hash());
-  const SurfaceLattice& at = t->surface().lattice();
+  const SurfaceLattice at = t->surface().lattice();  // a copy: t goes below
   for (int k = 0; k < 200; ++k) {
     const double x = at.origin_x + 0.47 * k, z = at.origin_z + 0.23 * k;
     EXPECT_EQ(c->surface().sample(x, z)->smooth_normal, t->surface().sample(x, z)->smooth_normal);
