@@ -223,8 +223,9 @@ class Surface {
   std::optional<SurfaceSample> sample(double x, double z) const noexcept;
 
   /// Batched heights: out[k] = height(xz[k]) or NaN off the footprint, for k < min(xz.size(),
-  /// out.size()). Faster per point than height() on scattered points: the samples of the points
-  /// a few places ahead are fetched from memory while the current one is evaluated.
+  /// out.size()), bit for bit. On stored samples larger than 8 MiB (more than the cache holds)
+  /// it fetches the cell of the point a few places ahead while evaluating the current one, which
+  /// pays on scattered points.
   void heights(std::span<const glm::dvec2> xz, std::span<double> out) const noexcept;
   /// Batched samples: valid[k] says whether out[k] is meaningful (out[k] is SurfaceSample{} when
   /// not), for k below the smallest of the three sizes.
