@@ -58,14 +58,13 @@ std::size_t peak_rss_bytes() {
 
 // Generation time of one tile per level, each timed alone, from a fixed parent on this thread.
 nlohmann::ordered_json time_tiles(const DetailField& f, int reps, std::size_t* tile_bytes) {
-  const Heightfield& hf = f.terrain().heightfield();
   nlohmann::ordered_json out = nlohmann::ordered_json::array();
   volatile std::int32_t sink = 0;
   for (std::uint32_t level = 1; level <= f.levels(); ++level) {
     // The tile over the middle of the terrain.
     const DetailTileKey key{
-        level, std::int32_t(((std::int64_t{hf.width()} - 1) / 2 << level) / kDetailTileCells),
-        std::int32_t(((std::int64_t{hf.height()} - 1) / 2 << level) / kDetailTileCells)};
+        level, std::int32_t(((std::int64_t{f.base_width()} - 1) / 2 << level) / kDetailTileCells),
+        std::int32_t(((std::int64_t{f.base_height()} - 1) / 2 << level) / kDetailTileCells)};
     const auto parent = level > 1 ? f.make_tile_chain(key.parent()) : nullptr;
     std::vector<double> ms;
     for (int r = -3; r < reps; ++r) {  // three unreported warm-up runs
@@ -76,7 +75,7 @@ nlohmann::ordered_json time_tiles(const DetailField& f, int reps, std::size_t* t
       *tile_bytes = tile->memory_bytes();
       if (r >= 0) ms.push_back(t);
     }
-    const double spacing = std::ldexp(std::max(hf.spacing_x(), hf.spacing_z()), -int(level));
+    const double spacing = std::ldexp(std::max(f.spacing_x(), f.spacing_z()), -int(level));
     out.push_back({{"level", level},
                    {"spacing_m", spacing},
                    {"median_ms", percentile(ms, 0.5)},
@@ -241,7 +240,7 @@ int run_bench_detail(const BenchDetailArgs& a) {
   desc.worker_threads = static_cast<std::uint32_t>(*workers);
   auto cache = DetailCache::create(field, desc);
   if (!cache) return report_error(cache.error().message);
-  auto stream = DetailStream::create(**cache, rule);
+  auto stream = DetailStream::create(terrain->surface(), **cache, rule);
   if (!stream) return report_error(stream.error().message);
 
   const Camera& first = flight->frames.front().camera;

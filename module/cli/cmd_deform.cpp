@@ -73,10 +73,10 @@ int run_deform(const DeformArgs& a) {
                               {"edits_clipped", clipped},
                               {"edits_clamped", clamped},
                               {"samples_changed", samples},
-                              {"edited_chunks", t.edited_chunks()},
+                              {"edited_chunks", t.surface().edited_chunks()},
                               {"apply_ms", ms},
                               {"base_hash", hex(t.base_hash())},
-                              {"heights_hash", hex(t.heights_hash())}};
+                              {"heights_hash", hex(t.surface().heights_hash())}};
   if (changed > 0) j["changed"] = box_json(total);
   if (!a.save.empty()) j["saved"] = a.save;
   if (auto s = write_json(j, a.json_path); !s) return report_error(s.message());

@@ -64,7 +64,7 @@ Result<std::unique_ptr<Game>> Game::create(const GameOptions& options) {
     g->terrain_ = std::move(*t);
     ridgeline::DetailViewRule rule;
     rule.pixels = options.detail_stream_pixels;
-    auto stream = ridgeline::DetailStream::create(*g->terrain_->detail_cache(), rule);
+    auto stream = ridgeline::DetailStream::create(g->terrain_->surface(), *g->terrain_->detail_cache(), rule);
     if (!stream) return Error{"game: " + stream.error().message};
     g->stream_.emplace(std::move(*stream));
   } else {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "ridgeline/detail.h"
+#include "ridgeline/terrain.h"
 
 using namespace ridgeline;
 using Clock = std::chrono::steady_clock;
@@ -28,7 +29,7 @@ int main(int argc, char** argv) {
   auto terrain = Terrain::create(std::move(hf).value());
   DetailParams params;
   params.levels = 12;
-  auto field = DetailField::create(terrain, params);
+  auto field = DetailField::create(terrain->heightfield(), params);
   if (!field) {
     std::fprintf(stderr, "%s\n", field.error().message.c_str());
     return 1;

@@ -15,6 +15,7 @@
 #include "ridgeline/detail_stream.h"
 #include "ridgeline/scenes.h"
 #include "ridgeline/surface.h"
+#include "ridgeline/terrain.h"
 
 using namespace ridgeline;
 
@@ -33,8 +34,9 @@ std::shared_ptr<const Terrain> make_world() {
 
 // Height of the level-`level` surface at (x, z) from a resident tile: the piecewise-linear
 // interpolation (diagonal rule) of base + detail at the lattice vertices.
-double level_height(const DetailField& f, const DetailTile& tile, double x, double z) {
-  const Heightfield& hf = f.terrain().heightfield();
+double level_height(const Terrain& base, const DetailField& f, const DetailTile& tile, double x,
+                    double z) {
+  const Heightfield& hf = base.heightfield();
   const std::uint32_t l = tile.key().level;
   const double sx = std::ldexp(hf.spacing_x(), -int(l)), sz = std::ldexp(hf.spacing_z(), -int(l));
   const double u = (x - hf.origin_x()) / sx, v = (z - hf.origin_z()) / sz;
@@ -47,9 +49,9 @@ double level_height(const DetailField& f, const DetailTile& tile, double x, doub
   double h = 0;
   for (int c = 0; c < 3; ++c) {
     const std::int64_t vi = i + t.di[c], vj = j + t.dj[c];
-    const double base = f.terrain().height(f.lattice_x(l, vi), f.lattice_z(l, vj)).value_or(0.0);
+    const double b = base.height(f.lattice_x(l, vi), f.lattice_z(l, vj)).value_or(0.0);
     h += t.w[c] *
-         (base + tile.detail(std::int32_t(vi - tile.first_i()), std::int32_t(vj - tile.first_j())));
+         (b + tile.detail(std::int32_t(vi - tile.first_i()), std::int32_t(vj - tile.first_j())));
   }
   return h;
 }
@@ -79,11 +81,11 @@ constexpr float kTint[8][3] = {{0.62f, 0.62f, 0.62f}, {0.35f, 0.45f, 0.85f}, {0.
 
 // Renders a panel of `width_m` metres centred on the eye into rgb (kPanel x kPanel at column
 // offset `x0` of an image `stride` pixels wide).
-void render_panel(const DetailField& f, const DetailSnapshot& snap,
+void render_panel(const Terrain& base, const DetailField& f, const DetailSnapshot& snap,
                   const std::vector<DetailTileNeed>& tiles, const Camera& cam,
                   const DetailViewRule& rule, double width_m, bool stored_only,
                   std::vector<std::uint8_t>& rgb, int stride, int x0) {
-  const Heightfield& hf = f.terrain().heightfield();
+  const Heightfield& hf = base.heightfield();
   const double px = width_m / kPanel;
   std::vector<Pixel> img(std::size_t(kPanel) * kPanel);
   auto needed = [&](const DetailTileKey& k) {
@@ -100,7 +102,7 @@ void render_panel(const DetailField& f, const DetailSnapshot& snap,
       const double x = cam.eye.x + (c + 0.5 - kPanel / 2.0) * px;
       const double z = cam.eye.z + (r + 0.5 - kPanel / 2.0) * px;
       Pixel& p = img[std::size_t(c) + std::size_t(r) * kPanel];
-      p.height = f.terrain().height(x, z).value_or(0.0);
+      p.height = base.height(x, z).value_or(0.0);
       for (std::uint32_t l = stored_only ? 0 : f.levels(); l >= 1; --l) {
         const double sx = std::ldexp(hf.spacing_x(), -int(l)) * kDetailTileCells;
         const double sz = std::ldexp(hf.spacing_z(), -int(l)) * kDetailTileCells;
@@ -111,7 +113,7 @@ void render_panel(const DetailField& f, const DetailSnapshot& snap,
           last_tile[l] = needed(k) ? snap.find(k) : nullptr;
         }
         if (last_tile[l]) {
-          p.height = level_height(f, *last_tile[l], x, z);
+          p.height = level_height(base, f, *last_tile[l], x, z);
           p.level = l;
           break;
         }
@@ -158,16 +160,21 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: detail_image OUT.png\n");
     return 2;
   }
+  // The stored surface, and the same world with the detail streamed over it.
   auto terrain = make_world();
   if (!terrain) return 1;
   DetailParams params;
   params.levels = 7;
-  auto field = DetailField::create(terrain, params);
-  if (!field) {
-    std::fprintf(stderr, "%s\n", field.error().message.c_str());
+  DetailCacheDesc desc;
+  desc.worker_threads = 0;
+  auto world = scenes::flight_world();
+  if (!world) return 1;
+  auto detailed = Terrain::create(std::move(world).value(), params, desc);
+  if (!detailed) {
+    std::fprintf(stderr, "%s\n", detailed.error().message.c_str());
     return 1;
   }
-  const DetailField& f = **field;
+  const DetailField& f = *(*detailed)->detail();
   // The camera: on the flight's line (z = 50 km), over the steepest ground among a few places
   // (where the shape field lets the detail show most), 50 m up, heading east, 1280 x 720
   // pixels, 60 degrees: the benchmark's camera and request rule.
@@ -181,23 +188,20 @@ int main(int argc, char** argv) {
   cam.eye = {best_x, *terrain->height(best_x, z) + 50, z};
   cam.target = {best_x + 200, cam.eye.y - 30, z};
   DetailViewRule rule;
-  DetailCacheDesc desc;
-  desc.worker_threads = 0;
-  auto cache = DetailCache::create(*field, desc);
-  if (!cache) return 1;
-  auto stream = DetailStream::create(**cache, rule);
+  DetailCache& cache = *(*detailed)->detail_cache();
+  auto stream = DetailStream::create((*detailed)->surface(), cache, rule);
   auto st = stream->frame(cam);
   if (!st || st->needed_resident != st->needed) {
     std::fprintf(stderr, "streaming frame failed\n");
     return 1;
   }
-  const auto snap = (*cache)->snapshot();
+  const auto snap = cache.snapshot();
   // The stored surface and the streamed one over the same 200 m, then 6 km around the camera.
   const int width = 3 * kPanel + 16;
   std::vector<std::uint8_t> rgb(std::size_t(width) * kPanel * 3, 255);
-  render_panel(f, *snap, stream->tiles(), cam, rule, 200, true, rgb, width, 0);
-  render_panel(f, *snap, stream->tiles(), cam, rule, 200, false, rgb, width, kPanel + 8);
-  render_panel(f, *snap, stream->tiles(), cam, rule, 6000, false, rgb, width, 2 * kPanel + 16);
+  render_panel(*terrain, f, *snap, stream->tiles(), cam, rule, 200, true, rgb, width, 0);
+  render_panel(*terrain, f, *snap, stream->tiles(), cam, rule, 200, false, rgb, width, kPanel + 8);
+  render_panel(*terrain, f, *snap, stream->tiles(), cam, rule, 6000, false, rgb, width, 2 * kPanel + 16);
 
   auto out = OIIO::ImageOutput::create(argv[1]);
   if (!out) {

@@ -1,7 +1,7 @@
 // Fuzz target: the deformation-state loader (load_edits_from_memory, what load_edits runs on the
 // file's bytes) onto a fresh small terrain per input. The seed is a real save of that terrain, so
 // the fuzzer starts past the header and hash checks. Inputs whose first byte is even get their
-// trailing FNV-1a checksum recomputed (the file format's, module/src/edit.cpp), so that mutations
+// trailing FNV-1a checksum recomputed (the file format's, module/src/edit/edit_file.cpp), so that mutations
 // reach the chunk parsing instead of stopping at "checksum mismatch". A refused input must leave
 // the terrain unchanged; an accepted one is one change-log entry at most, with a ray pyramid equal
 // to a rebuild.
@@ -28,7 +28,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
     std::memcpy(bytes.data() + size - 8, &h, 8);  // little-endian, as the file stores it
   }
-  const std::uint64_t before = terrain->heights_hash();
+  const std::uint64_t before = terrain->surface().heights_hash();
   auto r = load_edits_from_memory(*terrain, bytes);
   if (r) {
     (void)terrain->height(100, 100);
@@ -36,7 +36,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const TerrainChanges c = terrain->changes_since(0);
     if (c.version != (r->empty() ? 0u : 1u) || c.changes.size() != c.version) __builtin_trap();
     if (!terrain->check_invariants().empty()) __builtin_trap();
-  } else if (terrain->heights_hash() != before || terrain->edit_version() != 0) {
+  } else if (terrain->surface().heights_hash() != before || terrain->edit_version() != 0) {
     __builtin_trap();  // a refused file changed the terrain
   }
   return 0;

@@ -15,12 +15,13 @@
 #include "ridgeline/detail.h"
 #include "ridgeline/scenes.h"
 #include "ridgeline/surface.h"
+#include "ridgeline/terrain.h"
 
 namespace ridgeline {
 namespace {
 
 // 65 x 65 samples, 8 m apart: a flat plain (x < 200 m) next to steep sinusoidal hills.
-std::shared_ptr<const Terrain> make_terrain() {
+Heightfield make_heightfield() {
   auto hf = scenes::field(
       {.width = 65, .height = 65, .spacing_x = 8, .spacing_z = 8, .origin_x = -100, .origin_z = 50},
       [](int i, int j) {
@@ -28,19 +29,35 @@ std::shared_ptr<const Terrain> make_terrain() {
         return x < 200 ? 10.0 : 10 + 60 * std::sin(x / 40.0) * std::cos(z / 55.0) + 0.3 * (x - 200);
       });
   EXPECT_TRUE(hf.ok());
-  return Terrain::create(std::move(hf).value());
+  return std::move(hf).value();
 }
 
-std::shared_ptr<const DetailField> make_field(std::uint32_t levels, std::uint64_t seed = 7,
-                                              double amplitude = 3.0, double gain = 0.55) {
+std::shared_ptr<const Terrain> make_terrain() { return Terrain::create(make_heightfield()); }
+
+DetailParams params(std::uint32_t levels, std::uint64_t seed, double amplitude, double gain) {
   DetailParams p;
   p.levels = levels;
   p.seed = seed;
   p.amplitude = amplitude;
   p.gain = gain;
-  auto f = DetailField::create(make_terrain(), p);
+  return p;
+}
+
+std::shared_ptr<const DetailField> make_field(std::uint32_t levels, std::uint64_t seed = 7,
+                                              double amplitude = 3.0, double gain = 0.55) {
+  auto f = DetailField::create(make_heightfield(), params(levels, seed, amplitude, gain));
   EXPECT_TRUE(f.ok()) << (f.ok() ? "" : f.error().message);
   return std::move(f).value();
+}
+
+// make_terrain() with make_field()'s detail as part of its surface (a synchronous cache).
+std::shared_ptr<const Terrain> make_detailed(std::uint32_t levels, std::uint64_t seed = 7,
+                                             double amplitude = 3.0, double gain = 0.55) {
+  DetailCacheDesc d;
+  d.worker_threads = 0;
+  auto t = Terrain::create(make_heightfield(), params(levels, seed, amplitude, gain), d);
+  EXPECT_TRUE(t.ok()) << (t.ok() ? "" : t.error().message);
+  return std::move(t).value();
 }
 
 std::uint64_t fnv(std::uint64_t h, std::int32_t v) {
@@ -60,9 +77,9 @@ std::uint64_t hash_rows(const DetailField& f, std::int64_t j0, std::int64_t j1) 
 }
 
 TEST(Detail, BadParamsRefused) {
-  auto terrain = make_terrain();
+  const Heightfield hf = make_heightfield();
   auto refused = [&](DetailParams p, const char* needle) {
-    auto f = DetailField::create(terrain, p);
+    auto f = DetailField::create(hf, p);
     ASSERT_FALSE(f.ok()) << needle;
     EXPECT_NE(f.error().message.find(needle), std::string::npos) << f.error().message;
     EXPECT_FALSE(validate_detail_params(p).ok());
@@ -104,11 +121,10 @@ TEST(Detail, BadParamsRefused) {
   p.levels = 12;
   p.amplitude = 1000;
   p.gain = 1;
-  auto f = DetailField::create(terrain, p);
+  auto f = DetailField::create(hf, p);
   ASSERT_FALSE(f.ok());
   EXPECT_NE(f.error().message.find("can reach"), std::string::npos) << f.error().message;
   EXPECT_TRUE(validate_detail_params(p).ok());  // each field alone is fine
-  EXPECT_FALSE(DetailField::create(nullptr, DetailParams{}).ok());
 
   // The cache refuses what it cannot work with.
   auto field = make_field(4);
@@ -135,10 +151,12 @@ TEST(Detail, LevelZeroAndParentSamplesKeepTheirValues) {
       ASSERT_EQ(f->detail_raw(l, 2 * i, 2 * j), f->detail_raw(l - 1, i, j)) << l << " " << i;
   }
   // The finest lattice at a base sample is the stored height exactly.
-  const Heightfield& hf = f->terrain().heightfield();
+  auto t = make_detailed(5);
+  const Heightfield& hf = t->heightfield();
   for (std::uint32_t j = 0; j < hf.height(); j += 7)
     for (std::uint32_t i = 0; i < hf.width(); i += 5)
-      EXPECT_EQ(*f->height(5, std::int64_t{i} << 5, std::int64_t{j} << 5), hf.world(i, j));
+      EXPECT_EQ(t->surface().vertex_height(std::int64_t{i} << 5, std::int64_t{j} << 5),
+                hf.local(i, j));
 }
 
 TEST(Detail, TilesReproduceTheDirectEvaluatorBitForBit) {
@@ -225,11 +243,12 @@ TEST(Detail, DeterministicAcrossRunsAndThreadCounts) {
   EXPECT_NE(one, hash_rows(*make_field(6, 12346), -40, 216));
 
   // Heights (base + detail, doubles) over a region: one thread against three, bit for bit.
+  auto detailed = make_detailed(6, 12345);
   auto height_hash = [&](std::int64_t j0, std::int64_t j1) {
     std::uint64_t h = 0xcbf29ce484222325ull;
     for (std::int64_t j = j0; j < j1; ++j)
       for (std::int64_t i = 1000; i < 1300; ++i) {
-        const double v = f->height(6, i, j).value_or(-1.0);
+        const double v = detailed->surface().vertex_height(i, j);
         std::uint64_t bits;
         std::memcpy(&bits, &v, sizeof bits);
         h = fnv(fnv(h, std::int32_t(bits)), std::int32_t(bits >> 32));
@@ -349,22 +368,26 @@ TEST(Detail, ShapeFieldIsSmoothAndFollowsSlope) {
 
 TEST(Detail, HeightsAreBasePlusDetail) {
   auto f = make_field(4);
-  const Terrain& t = f->terrain();
+  auto base = make_terrain();  // the same samples without detail
+  auto t = make_detailed(4);   // with f's detail
+  const Surface& s = t->surface();
+  const double offset = t->heightfield().height_offset();
   std::mt19937_64 rng(4);
   std::uniform_int_distribution<std::int64_t> idx(0, 64 << 4);
   for (int n = 0; n < 500; ++n) {
     const std::int64_t i = idx(rng), j = idx(rng);
-    const auto h = f->height(4, i, j);
-    ASSERT_TRUE(h);
-    const auto base = t.height(f->lattice_x(4, i), f->lattice_z(4, j));
-    ASSERT_TRUE(base);
-    EXPECT_NEAR(*h, *base + f->detail(4, i, j), 1e-4);
+    const auto b = base->height(f->lattice_x(4, i), f->lattice_z(4, j));
+    ASSERT_TRUE(b);
+    EXPECT_NEAR(offset + s.vertex_height(i, j), *b + f->detail(4, i, j), 1e-4);
+    EXPECT_EQ(s.vertex_detail(i, j), f->detail(4, i, j));
   }
-  EXPECT_FALSE(f->height(4, -1, 0));
-  EXPECT_FALSE(f->height(4, 0, (64 << 4) + 1));
-  EXPECT_FALSE(f->height(5, 0, 0));
-  EXPECT_TRUE(f->height(4, 64 << 4, 64 << 4));
+  // Outside the lattice the vertex is clamped in (the padding rule).
+  EXPECT_EQ(s.vertex_height(-1, 0), s.vertex_height(0, 0));
+  EXPECT_EQ(s.vertex_height(0, (64 << 4) + 1), s.vertex_height(0, 64 << 4));
   EXPECT_EQ(f->lattice_x(4, 16), -100 + 8.0);
+  EXPECT_EQ(f->lattice_z(4, 16), 50 + 8.0);
+  EXPECT_EQ(f->base_width(), 65u);
+  EXPECT_EQ(f->spacing_x(), 8.0);
 }
 
 // Tiles of the 128 x 128-cell lattice along a diagonal flight, finest level first with its

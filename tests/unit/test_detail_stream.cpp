@@ -14,6 +14,7 @@
 
 #include "ridgeline/detail_stream.h"
 #include "ridgeline/scenes.h"
+#include "ridgeline/terrain.h"
 
 namespace ridgeline {
 namespace {
@@ -22,7 +23,7 @@ constexpr double kSpacing = 100.0;    // metres between stored samples
 constexpr std::uint32_t kSize = 257;  // 25.6 km square
 
 // 257 x 257 samples, 100 m apart: rolling hills with a plain in the south.
-std::shared_ptr<const Terrain> make_terrain() {
+Heightfield make_heightfield() {
   auto hf = scenes::field(
       {.width = kSize,
        .height = kSize,
@@ -35,17 +36,25 @@ std::shared_ptr<const Terrain> make_terrain() {
         return z < 3000 ? 20.0 : 200 + 150 * std::sin(x / 1700.0) * std::cos(z / 2300.0);
       });
   EXPECT_TRUE(hf.ok());
-  return Terrain::create(std::move(hf).value());
+  return std::move(hf).value();
 }
 
-std::shared_ptr<const DetailField> make_field(std::uint32_t levels = 6) {
+// The terrain with 6 detail levels (seed 11, 4 m) as part of its surface, a synchronous cache.
+std::shared_ptr<const Terrain> make_detailed() {
   DetailParams p;
-  p.levels = levels;
+  p.levels = 6;
   p.seed = 11;
   p.amplitude = 4.0;
-  auto f = DetailField::create(make_terrain(), p);
-  EXPECT_TRUE(f.ok()) << (f.ok() ? "" : f.error().message);
-  return std::move(f).value();
+  DetailCacheDesc d;
+  d.worker_threads = 0;
+  auto t = Terrain::create(make_heightfield(), p, d);
+  EXPECT_TRUE(t.ok()) << (t.ok() ? "" : t.error().message);
+  return std::move(t).value();
+}
+
+// The terrain's detail field, keeping the terrain alive (for caches of its own).
+std::shared_ptr<const DetailField> field_of(const std::shared_ptr<const Terrain>& t) {
+  return std::shared_ptr<const DetailField>(t, t->detail());
 }
 
 DetailCacheDesc cache_desc(std::size_t budget_bytes, std::uint32_t workers) {
@@ -65,10 +74,11 @@ Camera camera_at(double x, double z, double y, double heading_x = 1, double head
 
 // Brute force: every tile of every level over the footprint, with the distance as documented
 // (the vertical part from every stored sample under tiles of at most 16 cells per side).
-std::set<std::tuple<std::uint32_t, int, int, bool>> brute_force(const DetailField& f,
+std::set<std::tuple<std::uint32_t, int, int, bool>> brute_force(const Terrain& terrain,
                                                                 const Camera& c,
                                                                 const DetailViewRule& rule) {
-  const Heightfield& hf = f.terrain().heightfield();
+  const Heightfield& hf = terrain.heightfield();
+  const DetailField& f = *terrain.detail();
   auto vertical = [&](double lo, double hi) { return std::max({0.0, c.eye.y - hi, lo - c.eye.y}); };
   const double amp = f.contribution_bound(1);
   const double global_dy = vertical(hf.height_offset() + hf.min_local() - amp,
@@ -105,17 +115,17 @@ std::set<std::tuple<std::uint32_t, int, int, bool>> brute_force(const DetailFiel
 }
 
 TEST(DetailStream, RuleListsExactlyTheTilesWithinTheRadius) {
-  auto f = make_field();
+  auto terrain = make_detailed();
   DetailViewRule rule;
   // Inside, near a corner (tiles clipped by the footprint), high up, and outside the footprint.
   for (const Camera& c : {camera_at(9000, 14000, 260), camera_at(-400, 400, 40),
                           camera_at(12000, 12000, 3000), camera_at(-2500, 9000, 50)}) {
     std::vector<DetailTileNeed> tiles;
-    ASSERT_TRUE(detail_tiles_for_view(*f, c, rule, tiles).ok());
+    ASSERT_TRUE(detail_tiles_for_view(terrain->surface(), c, rule, tiles).ok());
     std::set<std::tuple<std::uint32_t, int, int, bool>> got;
     for (const auto& t : tiles) got.insert({t.key.level, t.key.tx, t.key.tz, t.needed});
     EXPECT_EQ(got.size(), tiles.size()) << "a tile listed twice";
-    EXPECT_EQ(got, brute_force(*f, c, rule));
+    EXPECT_EQ(got, brute_force(*terrain, c, rule));
     // Coarsest level first, nearest first within a level.
     for (std::size_t k = 1; k < tiles.size(); ++k) {
       ASSERT_LE(tiles[k - 1].key.level, tiles[k].key.level);
@@ -126,8 +136,9 @@ TEST(DetailStream, RuleListsExactlyTheTilesWithinTheRadius) {
   }
   // A camera high above everything needs fewer fine tiles than one near the ground.
   std::vector<DetailTileNeed> low, high;
-  ASSERT_TRUE(detail_tiles_for_view(*f, camera_at(9000, 14000, 400), rule, low).ok());
-  ASSERT_TRUE(detail_tiles_for_view(*f, camera_at(9000, 14000, 2500), rule, high).ok());
+  const Surface& s = terrain->surface();
+  ASSERT_TRUE(detail_tiles_for_view(s, camera_at(9000, 14000, 400), rule, low).ok());
+  ASSERT_TRUE(detail_tiles_for_view(s, camera_at(9000, 14000, 2500), rule, high).ok());
   auto count = [](const std::vector<DetailTileNeed>& v, std::uint32_t l) {
     return std::count_if(v.begin(), v.end(), [l](const auto& t) { return t.key.level == l; });
   };
@@ -136,7 +147,8 @@ TEST(DetailStream, RuleListsExactlyTheTilesWithinTheRadius) {
 }
 
 TEST(DetailStream, RadiiHalvePerLevelAndAncestorsAreNeeded) {
-  auto f = make_field();
+  auto terrain = make_detailed();
+  auto f = field_of(terrain);
   const Camera c = camera_at(7000, 15000, 250);
   DetailViewRule rule;
   const double k = projection_scale(c);
@@ -148,7 +160,7 @@ TEST(DetailStream, RadiiHalvePerLevelAndAncestorsAreNeeded) {
   EXPECT_DOUBLE_EQ(detail_level_radius(*f, c, 3, rule), kSpacing / 8 * k / 2);
 
   std::vector<DetailTileNeed> tiles;
-  ASSERT_TRUE(detail_tiles_for_view(*f, c, DetailViewRule{}, tiles).ok());
+  ASSERT_TRUE(detail_tiles_for_view(terrain->surface(), c, DetailViewRule{}, tiles).ok());
   std::set<std::tuple<std::uint32_t, int, int>> needed;
   for (const auto& t : tiles)
     if (t.needed) needed.insert({t.key.level, t.key.tx, t.key.tz});
@@ -161,11 +173,12 @@ TEST(DetailStream, RadiiHalvePerLevelAndAncestorsAreNeeded) {
 }
 
 TEST(DetailStream, BadInputRefused) {
-  auto f = make_field();
+  auto terrain = make_detailed();
+  auto f = field_of(terrain);
   std::vector<DetailTileNeed> tiles(3);
   const Camera good = camera_at(9000, 9000, 300);
   auto refused = [&](const DetailViewRule& rule, const Camera& c, const char* needle) {
-    const Status s = detail_tiles_for_view(*f, c, rule, tiles);
+    const Status s = detail_tiles_for_view(terrain->surface(), c, rule, tiles);
     ASSERT_FALSE(s.ok()) << needle;
     EXPECT_NE(s.message().find(needle), std::string::npos) << s.message();
     EXPECT_TRUE(tiles.empty());
@@ -199,8 +212,16 @@ TEST(DetailStream, BadInputRefused) {
   ASSERT_TRUE(cache.ok());
   r = {};
   r.prefetch = std::numeric_limits<double>::infinity();
-  EXPECT_FALSE(DetailStream::create(**cache, r).ok());
-  auto stream = DetailStream::create(**cache);
+  EXPECT_FALSE(DetailStream::create(terrain->surface(), **cache, r).ok());
+  // A cache of another field (the same parameters, another object) is not the surface's.
+  auto other = DetailField::create(make_heightfield(), terrain->detail()->params());
+  ASSERT_TRUE(other.ok());
+  auto other_cache = DetailCache::create(*other, cache_desc(8u << 20, 0));
+  ASSERT_TRUE(other_cache.ok());
+  auto wrong = DetailStream::create(terrain->surface(), **other_cache);
+  ASSERT_FALSE(wrong.ok());
+  EXPECT_NE(wrong.error().message.find("another detail field"), std::string::npos);
+  auto stream = DetailStream::create(terrain->surface(), **cache);
   ASSERT_TRUE(stream.ok());
   bad = good;
   bad.fov_y_deg = 180;
@@ -245,13 +266,13 @@ struct FlightResult {
 // Flies from (1000, 13000) east at 300 m/s, 40 m above the stored surface, dt 1/60 s, for
 // `metres`; checks the budget after every frame and tiles against the direct evaluator now
 // and then.
-FlightResult fly(const std::shared_ptr<const DetailField>& f, const DetailCacheDesc& desc,
+FlightResult fly(const std::shared_ptr<const Terrain>& terrain, const DetailCacheDesc& desc,
                  double metres, bool working_set_fits = true) {
   FlightResult r;
-  auto cache = DetailCache::create(f, desc);
+  auto cache = DetailCache::create(field_of(terrain), desc);
   EXPECT_TRUE(cache.ok()) << (cache.ok() ? "" : cache.error().message);
   if (!cache.ok()) return r;
-  auto stream = DetailStream::create(**cache);
+  auto stream = DetailStream::create(terrain->surface(), **cache);
   EXPECT_TRUE(stream.ok());
   std::mt19937 rng(5);
   const double speed = 300, dt = 1.0 / 60;
@@ -259,7 +280,7 @@ FlightResult fly(const std::shared_ptr<const DetailField>& f, const DetailCacheD
   Camera c;
   for (int k = 0; k <= frames; ++k) {
     const double x = 1000 + speed * dt * k, z = 13000;
-    c = camera_at(x, z, *f->terrain().height(x, z) + 40, 1, 0.2);
+    c = camera_at(x, z, *terrain->height(x, z) + 40, 1, 0.2);
     auto st = stream->frame(c);
     EXPECT_TRUE(st.ok());
     if (!st.ok()) return r;
@@ -289,9 +310,9 @@ FlightResult fly(const std::shared_ptr<const DetailField>& f, const DetailCacheD
 }
 
 TEST(DetailStream, FlightStaysUnderBudgetSynchronous) {
-  auto f = make_field();
+  auto terrain = make_detailed();
   const std::size_t budget = std::size_t{32} << 20;
-  const FlightResult r = fly(f, cache_desc(budget, 0), 20000);
+  const FlightResult r = fly(terrain, cache_desc(budget, 0), 20000);
   EXPECT_LE(r.max_resident_bytes, budget);
   // The working set fits: every needed tile is there every frame, and the flight reached the
   // budget and evicted (20 km of tiles do not fit in 32 MB).
@@ -302,10 +323,10 @@ TEST(DetailStream, FlightStaysUnderBudgetSynchronous) {
 }
 
 TEST(DetailStream, FlightStaysUnderBudgetAsynchronous) {
-  auto f = make_field();
+  auto terrain = make_detailed();
   const std::size_t budget = std::size_t{32} << 20;
   for (std::uint32_t workers : {1u, 3u}) {
-    const FlightResult r = fly(f, cache_desc(budget, workers), 20000);
+    const FlightResult r = fly(terrain, cache_desc(budget, workers), 20000);
     EXPECT_LE(r.max_resident_bytes, budget) << workers;
     EXPECT_GT(r.evicted, 0u) << workers;
   }
@@ -314,9 +335,9 @@ TEST(DetailStream, FlightStaysUnderBudgetAsynchronous) {
 TEST(DetailStream, BudgetBelowTheWorkingSetStillHolds) {
   // A budget smaller than what the view needs: the LRU keeps the bytes under it; needed tiles
   // are then missing at times (it thrashes), which the statistics show.
-  auto f = make_field();
+  auto terrain = make_detailed();
   const std::size_t budget = std::size_t{6} << 20;  // 86 tiles
-  const FlightResult r = fly(f, cache_desc(budget, 0), 60, false);
+  const FlightResult r = fly(terrain, cache_desc(budget, 0), 60, false);
   EXPECT_LE(r.max_resident_bytes, budget);
   EXPECT_GT(r.max_needed * 73000, budget);
   EXPECT_LT(r.min_needed_fraction, 1.0);

@@ -48,14 +48,14 @@ TEST(DetailSurface, QueriesInterpolateTheFinestLattice) {
     for (std::int64_t i = 0; i < t->fine_width(); i += 29) {
       EXPECT_NEAR(*t->height(i * fs, j * fs), t->fine_local_height(i, j), 1e-9);
       if (i % 8 == 0 && j % 8 == 0) {
-        EXPECT_EQ(t->detail_at(i, j), 0.0);
+        EXPECT_EQ(t->surface().vertex_detail(i, j), 0.0);
         EXPECT_NEAR(t->fine_local_height(i, j), t->heightfield().local(i / 8, j / 8), 1e-5);
       }
     }
   // Detail is really there: some finest vertex differs from the stored interpolation.
   double largest = 0;
   for (std::int64_t i = 1; i < 400; i += 2)
-    largest = std::max(largest, std::abs(t->detail_at(i, 77)));
+    largest = std::max(largest, std::abs(t->surface().vertex_detail(i, 77)));
   EXPECT_GT(largest, 0.01);
   // Inside a finest triangle the height is the barycentric blend of its corners: at the centre
   // of a cell's edge midpoint between two vertices, the mean.
@@ -242,9 +242,9 @@ TEST(DetailSurface, EditsAndSaveFilesWithDetail) {
   auto v = RoamView::create(l, {.metric = ErrorMetric::kWorldMetres, .threshold = 0.3}).value();
   const Camera cam = camera_at({128, 300, -50}, {128, 0, 128});
   ASSERT_TRUE(v->converge(cam));
-  const double d0 = t->detail_at(101, 77);
+  const double d0 = t->surface().vertex_detail(101, 77);
   ASSERT_TRUE(t->apply_edit({.x = 100, .z = 80, .radius = 20, .depth = 6}));
-  EXPECT_EQ(t->detail_at(101, 77), d0) << "detail rides on top of edits";
+  EXPECT_EQ(t->surface().vertex_detail(101, 77), d0) << "detail rides on top of edits";
   ASSERT_TRUE(v->converge(cam));
   ASSERT_EQ(v->check_invariants(), "");
   ASSERT_EQ(check_crack_free(*v), "");

@@ -122,13 +122,13 @@ TEST(Brushes, RaiseLowerFlattenSmooth) {
 
 TEST(Limits, DefinedAnswers) {
   auto t = flat_terrain(65);
-  const auto h0 = t->heights_hash();
+  const auto h0 = t->surface().heights_hash();
   EXPECT_FALSE(t->apply_edit({.x = NAN, .z = 1}));
   EXPECT_FALSE(t->apply_edit({.x = 1, .z = 1, .radius = -1}));
   EXPECT_FALSE(t->apply_edit({.x = 1, .z = 1, .radius = INFINITY}));
   EXPECT_FALSE(t->apply_edit({.x = 1, .z = 1, .strength = 2}));
   EXPECT_FALSE(t->apply_edit({.x = 1, .z = 1, .radius = 1000}));  // larger than the terrain
-  EXPECT_EQ(t->heights_hash(), h0);
+  EXPECT_EQ(t->surface().heights_hash(), h0);
   // Wholly outside: a no-op with an empty region.
   auto r = t->apply_edit({.x = 500, .z = 500, .radius = 10});
   ASSERT_TRUE(r);
@@ -241,35 +241,35 @@ TEST(EditFile, RoundTripUndoAndRefusals) {
   auto t = noise_terrain(129);
   auto l = Landscape::create(t, {.patch_exponent = 4}).value();
   const std::string a = tmp_path("edits_a.bin"), b = tmp_path("edits_b.bin");
-  const auto h0 = t->heights_hash();
+  const auto h0 = t->surface().heights_hash();
   ASSERT_TRUE(save_edits(*t, a));  // empty layer
   ASSERT_TRUE(t->apply_edit({.x = 40, .z = 60, .radius = 12, .depth = 4}));
   ASSERT_TRUE(
       t->apply_edit({.brush = Brush::kFlatten, .x = 200, .z = 250, .radius = 20, .height = 50}));
-  const auto h1 = t->heights_hash();
+  const auto h1 = t->surface().heights_hash();
   ASSERT_NE(h0, h1);
   ASSERT_TRUE(save_edits(*t, b));
   ASSERT_TRUE(t->apply_edit({.x = 100, .z = 100, .radius = 30, .depth = 9}));
   // Undo by loading the earlier saves; bounds follow.
   auto r = load_edits(*t, b);
   ASSERT_TRUE(r) << r.error().message;
-  EXPECT_EQ(t->heights_hash(), h1);
+  EXPECT_EQ(t->surface().heights_hash(), h1);
   expect_bounds_equal_rebuild(*l);
   ASSERT_TRUE(load_edits(*t, a));
-  EXPECT_EQ(t->heights_hash(), h0);
-  EXPECT_EQ(t->edited_chunks(), 0u);
+  EXPECT_EQ(t->surface().heights_hash(), h0);
+  EXPECT_EQ(t->surface().edited_chunks(), 0u);
   ASSERT_TRUE(load_edits(*t, b));
-  EXPECT_EQ(t->heights_hash(), h1);
+  EXPECT_EQ(t->surface().heights_hash(), h1);
   // A fresh terrain with the same base loads it to the same hash.
   auto t2 = noise_terrain(129);
   ASSERT_TRUE(load_edits(*t2, b));
-  EXPECT_EQ(t2->heights_hash(), h1);
+  EXPECT_EQ(t2->surface().heights_hash(), h1);
 
   // Refusals change nothing.
   std::ifstream in(b, std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   ASSERT_TRUE(t->apply_edit({.x = 10, .z = 10, .radius = 5}));
-  const auto h2 = t->heights_hash();
+  const auto h2 = t->surface().heights_hash();
   for (std::size_t cut : {std::size_t{0}, std::size_t{10}, std::size_t{63}, std::size_t{72},
                           bytes.size() / 2, bytes.size() - 1}) {
     auto bad = load_edits_from_memory(*t, std::string_view(bytes).substr(0, cut));
@@ -287,7 +287,7 @@ TEST(EditFile, RoundTripUndoAndRefusals) {
   ASSERT_FALSE(foreign);
   EXPECT_NE(foreign.error().message.find("another terrain"), std::string::npos);
   EXPECT_FALSE(load_edits(*t, tmp_path("missing.bin")));
-  EXPECT_EQ(t->heights_hash(), h2);
+  EXPECT_EQ(t->surface().heights_hash(), h2);
   expect_bounds_equal_rebuild(*l);
 }
 
@@ -307,7 +307,7 @@ TEST(EditFile, FailedSaveKeepsThePreviousFile) {
     EXPECT_NE(s.message().find("previous file"), std::string::npos) << s.message();
     auto fresh = flat_terrain(65);
     ASSERT_TRUE(load_edits(*fresh, f));  // the old (empty) state is intact
-    EXPECT_EQ(fresh->edited_chunks(), 0u);
+    EXPECT_EQ(fresh->surface().edited_chunks(), 0u);
   }
   EXPECT_FALSE(save_edits(*t, tmp_path("no/such/dir/state.bin")));
 }
@@ -591,13 +591,13 @@ TEST(EditFile, EveryRegionOfTheHeaderAndBodyIsGuarded) {
   std::ifstream in(file, std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const std::size_t chunk = 8 + 4 * 32 * 32;
-  ASSERT_GE(t->edited_chunks(), 2u);
-  ASSERT_EQ(bytes.size(), 64 + t->edited_chunks() * chunk + 8);
+  ASSERT_GE(t->surface().edited_chunks(), 2u);
+  ASSERT_EQ(bytes.size(), 64 + t->surface().edited_chunks() * chunk + 8);
   // The fresh terrain the file is loaded onto; every refusal leaves it as it was.
   auto target = noise_terrain(129);
-  const auto h0 = target->heights_hash();
+  const auto h0 = target->surface().heights_hash();
   ASSERT_TRUE(load_edits_from_memory(*target, bytes)) << "the intact file loads";
-  ASSERT_EQ(target->heights_hash(), t->heights_hash());
+  ASSERT_EQ(target->surface().heights_hash(), t->surface().heights_hash());
   ASSERT_EQ(target->check_invariants(), "");
   target = noise_terrain(129);
   auto fnv = [](const std::string& b) {
@@ -620,7 +620,7 @@ TEST(EditFile, EveryRegionOfTheHeaderAndBodyIsGuarded) {
     EXPECT_NE(r.error().message.find(why), std::string::npos)
         << "byte " << at << ": " << r.error().message << " (wanted '" << why << "')";
     EXPECT_EQ(r.error().message.rfind("edit file", 0), 0u) << r.error().message;
-    EXPECT_EQ(target->heights_hash(), h0) << "byte " << at << " changed the terrain";
+    EXPECT_EQ(target->surface().heights_hash(), h0) << "byte " << at << " changed the terrain";
     EXPECT_EQ(target->edit_version(), 0u);
   };
   // The header field each byte belongs to, and what a change there must say when the checksum is
@@ -647,7 +647,7 @@ TEST(EditFile, EveryRegionOfTheHeaderAndBodyIsGuarded) {
       refused(reseal(c), g.resealed, at);
     }
   // The body: every chunk's indices and its first, a middle and its last value, and the checksum.
-  for (std::size_t k = 0; k < t->edited_chunks(); ++k) {
+  for (std::size_t k = 0; k < t->surface().edited_chunks(); ++k) {
     const std::size_t base = 64 + k * chunk;
     for (std::size_t at = base; at < base + 8; ++at) {
       std::string c = bytes;
@@ -691,7 +691,7 @@ TEST(Brushes, KeepDetailFalseIsRefusedOverDetailAndNeedsNothingWithout) {
   cache.worker_threads = 0;
   cache.budget_bytes = std::size_t{16} << 20;
   auto t = Terrain::create(std::move(hf).value(), p, cache).value();
-  const auto h0 = t->heights_hash();
+  const auto h0 = t->surface().heights_hash();
   const double y0 = *t->height(100, 80);
   for (Brush b : {Brush::kFlatten, Brush::kSmooth, Brush::kCrater}) {
     auto r = t->apply_edit(
@@ -701,7 +701,7 @@ TEST(Brushes, KeepDetailFalseIsRefusedOverDetailAndNeedsNothingWithout) {
         << r.error().message;
     EXPECT_NE(r.error().message.find("2 levels"), std::string::npos) << r.error().message;
   }
-  EXPECT_EQ(t->heights_hash(), h0);
+  EXPECT_EQ(t->surface().heights_hash(), h0);
   EXPECT_EQ(*t->height(100, 80), y0);
   EXPECT_EQ(t->edit_version(), 0u);
   EXPECT_TRUE(t->changes_since(0).empty());
@@ -720,5 +720,5 @@ TEST(Brushes, KeepDetailFalseIsRefusedOverDetailAndNeedsNothingWithout) {
   flat_false.keep_detail = false;
   ASSERT_TRUE(a->apply_edit(flat));
   ASSERT_TRUE(b->apply_edit(flat_false));
-  EXPECT_EQ(a->heights_hash(), b->heights_hash());
+  EXPECT_EQ(a->surface().heights_hash(), b->surface().heights_hash());
 }

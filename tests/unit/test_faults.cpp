@@ -44,7 +44,7 @@ std::shared_ptr<const DetailField> make_field(std::uint32_t levels) {
   DetailParams p;
   p.levels = levels;
   p.seed = 3;
-  auto f = DetailField::create(make_terrain(), p);
+  auto f = DetailField::create(make_terrain()->heightfield(), p);
   EXPECT_TRUE(f.ok()) << (f.ok() ? "" : f.error().message);
   return std::move(f).value();
 }

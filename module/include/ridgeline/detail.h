@@ -1,7 +1,7 @@
 // Procedural detail below the stored resolution (docs/surface.md "Detail and edits";
 // docs/detail.md): the detail function, its tiles, a tile cache with worker threads, and
-// conservative amplitude bounds. A Terrain created with DetailParams owns a field and a cache
-// and makes them part of its surface (queries, Landscape, RoamView).
+// conservative amplitude bounds. A Terrain created with DetailParams makes a field and a cache
+// part of its Surface (surface.h: queries, Landscape, RoamView).
 #pragma once
 
 #include <cstddef>
@@ -12,8 +12,8 @@
 #include <span>
 #include <vector>
 
+#include "ridgeline/heightfield.h"
 #include "ridgeline/result.h"
-#include "ridgeline/terrain.h"
 
 namespace ridgeline {
 
@@ -119,8 +119,11 @@ class DetailTile {
   std::uint32_t levels_ = 0;  // L of the field (measured only when key_.level == L)
 };
 
-/// The detail function over a terrain: immutable after create(); shared as
-/// std::shared_ptr<const DetailField>; every method may run concurrently from any threads.
+/// The detail function over a heightfield's lattice: immutable after create(); shared as
+/// std::shared_ptr<const DetailField>; every method may run concurrently from any threads. It
+/// keeps what it derived from the heightfield (placement, size, shape field), not the heightfield
+/// itself: later edits of the samples change the surface's base, never the detail (whose shape
+/// field stays as created), and the field refers to no terrain.
 ///
 /// Definition (docs/detail.md): detail D_0 = 0 on the base lattice. Level l >= 1 keeps the parent
 /// values on the even-even samples, D_l(2i, 2j) = D_{l-1}(i, j), and sets every new sample to the
@@ -132,14 +135,23 @@ class DetailTile {
 /// computed once at create() in double with correctly rounded operations only, then quantised).
 class DetailField {
  public:
-  /// Validates `params` and derives the shape field from the terrain's slopes (once, at the base
-  /// resolution: 2 bytes per stored sample). Fails with a precise message on bad params.
-  static Result<std::shared_ptr<const DetailField>> create(std::shared_ptr<const Terrain> terrain,
+  /// Validates `params` and derives the shape field from the slopes of `base`'s samples (once, at
+  /// the base resolution: 2 bytes per stored sample); copies its placement and size. `base` is
+  /// not referenced after the call. Fails with a precise message on bad params.
+  static Result<std::shared_ptr<const DetailField>> create(const Heightfield& base,
                                                            const DetailParams& params);
 
   const DetailParams& params() const noexcept { return params_; }
-  const Terrain& terrain() const noexcept { return *base_; }
   std::uint32_t levels() const noexcept { return params_.levels; }
+  /// Stored samples per axis of the heightfield the field was made for: level l's lattice spans
+  /// indices 0 .. (width - 1) * 2^l along x, the same along z with height.
+  std::uint32_t base_width() const noexcept { return std::uint32_t(shape_w_); }
+  std::uint32_t base_height() const noexcept { return std::uint32_t(shape_h_); }
+  /// That heightfield's spacing (metres) and world origin.
+  double spacing_x() const noexcept { return spacing_x_; }
+  double spacing_z() const noexcept { return spacing_z_; }
+  double origin_x() const noexcept { return origin_x_; }
+  double origin_z() const noexcept { return origin_z_; }
 
   /// Detail at level-`level` lattice sample (i, j) in units of kDetailUnit, evaluated directly
   /// (no cache, no allocation): reproduces the tile recurrence bit for bit. level <= levels()
@@ -158,11 +170,8 @@ class DetailField {
   void detail_window(std::uint32_t level, std::int64_t i0, std::int64_t j0, std::uint32_t w,
                      std::uint32_t h, std::span<std::int32_t> out) const;
 
-  /// World height of level-`level` lattice sample (i, j), metres: the stored piecewise-linear
-  /// surface there plus the detail. Empty off the footprint (0 <= i <= (width-1) * 2^level, the
-  /// same for j) or for level > levels().
-  std::optional<double> height(std::uint32_t level, std::int64_t i, std::int64_t j) const noexcept;
-  /// World position (x, z) of level-`level` sample (i, j), metres.
+  /// World position (x, z) of level-`level` sample (i, j), metres. (The height there, base plus
+  /// detail, is the surface's: Surface::vertex_height() at level L.)
   double lattice_x(std::uint32_t level, std::int64_t i) const noexcept;
   double lattice_z(std::uint32_t level, std::int64_t j) const noexcept;
 
@@ -206,15 +215,9 @@ class DetailField {
   DetailField() = default;
   friend struct DetailKernel;
 
-  std::shared_ptr<const Terrain> keep_;  // keeps a standalone field's terrain alive
-  const Terrain* base_ = nullptr;        // the terrain (a Terrain owning its field: no cycle)
-  friend class Terrain;
-  static Result<std::shared_ptr<const DetailField>> create_for(const Terrain& terrain,
-                                                               const DetailParams& params);
-  static Result<std::shared_ptr<DetailField>> build(const Terrain& terrain,
-                                                    const DetailParams& params);
   void measure_increments(DetailTile& tile) const;
   DetailParams params_;
+  double spacing_x_ = 1, spacing_z_ = 1, origin_x_ = 0, origin_z_ = 0;  // the base's placement
   std::uint64_t seed_mix_ = 0;
   // Octave amplitude per level in kDetailUnit (index 0 is 0).
   std::int64_t amp_[kMaxDetailLevels + 1] = {};

@@ -12,6 +12,7 @@
 #include "ridgeline/camera.h"
 #include "ridgeline/detail.h"
 #include "ridgeline/result.h"
+#include "ridgeline/surface.h"
 
 namespace ridgeline {
 
@@ -57,11 +58,12 @@ struct DetailTileNeed {
 double detail_level_radius(const DetailField& field, const Camera& camera, std::uint32_t level,
                            const DetailViewRule& rule) noexcept;
 
-/// Replaces `out` by the tiles of levels 1..L that `camera` requests under `rule`, coarsest
-/// level first, nearest first within a level. Only tiles whose rectangle overlaps the terrain's
-/// footprint are listed. Fails (and leaves `out` empty) on an invalid camera or rule, or when
-/// more than rule.max_tiles tiles would be listed. Thread-safe (reads the field only).
-Status detail_tiles_for_view(const DetailField& field, const Camera& camera,
+/// Replaces `out` by the tiles of levels 1..L of `surface`'s detail that `camera` requests under
+/// `rule`, coarsest level first, nearest first within a level (no tiles without detail). Only
+/// tiles whose rectangle overlaps the footprint are listed. Fails (and leaves `out` empty) on an
+/// invalid camera or rule, or when more than rule.max_tiles tiles would be listed. Reads the
+/// surface's detail field and stored samples: any thread, like the surface's queries.
+Status detail_tiles_for_view(const Surface& surface, const Camera& camera,
                              const DetailViewRule& rule, std::vector<DetailTileNeed>& out);
 
 /// What one DetailStream::frame() did and saw.
@@ -80,12 +82,17 @@ struct DetailFrameStats {
 /// Drives a DetailCache from a camera, once per frame: lists the tiles (detail_tiles_for_view),
 /// requests them (needed tiles urgent, nearest last so that it is generated first; prefetched
 /// tiles in distance order), calls update(), and checks the new snapshot for the needed tiles.
-/// Never waits for generation. Holds a reference to the cache, which must outlive it. One
-/// thread at a time (it is the cache's owner's frame loop).
+/// Never waits for generation. Holds references to the surface (its terrain must outlive the
+/// stream) and to the cache, which must outlive it too. One thread at a time (it is the cache's
+/// owner's frame loop).
 class DetailStream {
  public:
-  /// Fails on an invalid rule.
-  static Result<DetailStream> create(DetailCache& cache, const DetailViewRule& rule = {});
+  /// Streams `surface`'s detail through `cache`: the surface's own (*Surface::detail_cache()) or
+  /// another cache of the same detail field (DetailCache::field() is *surface.detail(), e.g. one
+  /// with other budgets made from std::shared_ptr<const DetailField>(terrain,
+  /// terrain->detail())). Fails on an invalid rule or a cache of another field.
+  static Result<DetailStream> create(const Surface& surface, DetailCache& cache,
+                                     const DetailViewRule& rule = {});
 
   /// One frame for `camera`. Fails on an invalid camera or too many tiles (the cache is then
   /// neither asked nor updated).
@@ -98,7 +105,9 @@ class DetailStream {
   const DetailViewRule& rule() const noexcept { return rule_; }
 
  private:
-  DetailStream(DetailCache& cache, const DetailViewRule& rule) : cache_(&cache), rule_(rule) {}
+  DetailStream(const Surface& surface, DetailCache& cache, const DetailViewRule& rule)
+      : surface_(&surface), cache_(&cache), rule_(rule) {}
+  const Surface* surface_;
   DetailCache* cache_;
   DetailViewRule rule_;
   std::vector<DetailTileNeed> tiles_;

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "ridgeline/log.h"
 #include "ridgeline/result.h"
 
 namespace ridgeline {
@@ -81,9 +82,12 @@ class Heightfield {
   double extent_x() const noexcept { return (width_ - 1) * spacing_x_; }
   double extent_z() const noexcept { return (height_ - 1) * spacing_z_; }
 
-  /// Height of sample (i, j) relative to height_offset(), metres. No bounds check beyond an
-  /// assert: i < width(), j < height().
+  /// Height of sample (i, j) relative to height_offset(), metres. i < width(), j < height():
+  /// asserted (RIDGELINE_ASSERT, log.h: on in Debug and sanitizer builds); no other bounds check,
+  /// so a release build reads out of range (this is the queries' inner loop). Use
+  /// local_clamped() for indices that may lie outside.
   float local(std::uint32_t i, std::uint32_t j) const noexcept {
+    RIDGELINE_ASSERT(i < width_ && j < height_);
     return heights_[i + static_cast<std::size_t>(j) * width_];
   }
   /// Like local() but clamps (i, j) into the grid: the edge-repeating padding of docs/surface.md.
@@ -101,8 +105,10 @@ class Heightfield {
   float max_local() const noexcept { return max_local_; }
 
   bool has_materials() const noexcept { return !materials_.empty(); }
-  /// Material id of cell (i, j), 0 when the field has no material layer. i < width-1, j < height-1.
+  /// Material id of cell (i, j), 0 when the field has no material layer. i < width-1,
+  /// j < height-1: asserted like local().
   std::uint8_t material(std::uint32_t i, std::uint32_t j) const noexcept {
+    RIDGELINE_ASSERT(i + 1 < width_ && j + 1 < height_);
     return materials_.empty() ? 0 : materials_[i + static_cast<std::size_t>(j) * (width_ - 1)];
   }
 
@@ -119,7 +125,7 @@ class Heightfield {
  private:
   Heightfield() = default;
   friend class EditLayer;  // writes heights during an edit (terrain.h's exclusive access)
-  friend class Terrain;    // clone()
+  friend class Surface;    // Terrain::clone()
   Heightfield duplicate() const {
     Heightfield h;
     h.heights_ = heights_;

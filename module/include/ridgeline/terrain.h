@@ -1,6 +1,7 @@
-// Terrain: shared, read-mostly terrain data (heightfield, procedural detail, edits, ray hierarchy),
-// the physics queries on its surface (surface.h, docs/surface.md) and the change log through which
-// views, physics and engines learn what edits changed.
+// Terrain: the shared terrain an engine builds once: its surface (surface.h: stored samples,
+// edits and procedural detail, with the point queries), the ray hierarchy that rays and box
+// queries descend, and the edit transaction with the change log through which views, physics
+// and engines learn what edits changed.
 #pragma once
 
 #include <cstdint>
@@ -16,6 +17,7 @@
 
 #include "ridgeline/heightfield.h"
 #include "ridgeline/result.h"
+#include "ridgeline/surface.h"
 
 namespace ridgeline {
 
@@ -29,47 +31,12 @@ struct Edit;
 struct EditLimits;
 struct EditResult;
 class ChangeLog;
-
-/// Height, both normals and the material at a point of the surface.
-struct SurfaceSample {
-  double height = 0;             ///< world height, metres
-  glm::vec3 face_normal{0, 1, 0};    ///< unit normal of the triangle under the point (physics)
-  glm::vec3 smooth_normal{0, 1, 0};  ///< unit normal interpolated from vertex normals (shading)
-  std::uint8_t material = 0;     ///< material id of the cell under the point
-};
-
-/// Height, face normal and material at a point: what a physics contact needs, cheaper than
-/// SurfaceSample (no smooth normal).
-struct HeightNormal {
-  double height = 0;                ///< world height, metres
-  glm::vec3 face_normal{0, 1, 0};   ///< unit normal of the triangle under the point
-  std::uint8_t material = 0;        ///< material id of the cell under the point
-};
-
-/// The first intersection of a ray with the surface.
-struct RayHit {
-  double distance = 0;        ///< metres along the (normalised) direction from the origin
-  glm::dvec3 point{0};        ///< world position of the hit
-  glm::vec3 normal{0, 1, 0};  ///< face normal of the triangle hit (unit, points up)
-  std::uint8_t material = 0;
-  bool started_below = false;  ///< the origin was below the surface: distance 0, point = origin
-};
-
-/// A full-detail surface triangle in world coordinates, counter-clockwise seen from above.
-struct SurfaceTriangle {
-  glm::dvec3 v[3];
-  std::uint8_t material = 0;
-};
-
-/// Axis-aligned box in world coordinates (metres). min <= max per axis.
-struct Box {
-  glm::dvec3 min{0};
-  glm::dvec3 max{0};
-};
+struct SampleChanges;
 
 /// An inclusive range of finest-lattice vertex indices, [i0, i1] x [j0, j1]: vertex (i, j) sits
-/// at world (origin_x + i * spacing_x / 2^L, origin_z + j * spacing_z / 2^L), L being
-/// Terrain::detail_levels() (the stored samples when L = 0). Empty when i1 < i0 or j1 < j0.
+/// at world (origin_x + i * spacing_x / 2^L, origin_z + j * spacing_z / 2^L), L being the
+/// surface's detail levels (SurfaceLattice; the stored samples when L = 0). Empty when i1 < i0 or
+/// j1 < j0.
 struct LatticeRange {
   std::int64_t i0 = 0, j0 = 0, i1 = -1, j1 = -1;
   bool empty() const noexcept { return i1 < i0 || j1 < j0; }
@@ -109,7 +76,11 @@ struct TerrainChanges {
 inline constexpr std::size_t kChangeLogCapacity = 1024;
 
 /// The terrain shared by every view and every physics query. Created once from a Heightfield;
-/// changed afterwards only by edits (apply_edit, load_edits in edit.h).
+/// changed afterwards only by edits (apply_edit, load_edits in edit.h). It composes three parts:
+/// the Surface (surface(): the finest lattice and every point query on it), the ray hierarchy
+/// (a min/max pyramid over the stored samples that raycast() and triangles_in_box() descend
+/// before reading the surface's lattice), and the edit transaction (apply_edit(): the surface's
+/// samples, the pyramid, the version and the change log, changed together).
 ///
 /// Edits are pulled, not pushed: every edit that changes the surface bumps edit_version() and
 /// records what it changed in a bounded change log; whoever caches something derived from the
@@ -137,10 +108,11 @@ class Terrain {
   static std::shared_ptr<Terrain> create(Heightfield heightfield);
   /// A terrain whose surface includes procedural detail with L = detail.levels levels
   /// (docs/detail.md, docs/surface.md): every query, Landscape and RoamView then works on the
-  /// finest lattice (spacing / 2^L), whose vertex heights are base + detail (+ edits). The terrain
-  /// owns the detail field and a tile cache made from `cache`; detail values come from the cache's
-  /// tiles when resident and from the direct evaluator otherwise (bit-identical). Fails, naming the
-  /// field, on invalid parameters. detail.levels == 0 gives a terrain without detail.
+  /// finest lattice (spacing / 2^L), whose vertex heights are base + detail (+ edits). The
+  /// surface owns the detail field and a tile cache made from `cache`; detail values come from
+  /// the cache's tiles when resident and from the direct evaluator otherwise (bit-identical).
+  /// Fails, naming the field, on invalid parameters, or when the finest lattice would have 2^30
+  /// cells or more per side. detail.levels == 0 gives a terrain without detail.
   static Result<std::shared_ptr<Terrain>> create(Heightfield heightfield, const DetailParams& detail,
                                                  const DetailCacheDesc& cache);
 
@@ -148,28 +120,41 @@ class Terrain {
   Terrain(const Terrain&) = delete;
   Terrain& operator=(const Terrain&) = delete;
 
-  const Heightfield& heightfield() const noexcept { return heightfield_; }
+  /// The surface: stored samples (with edits), detail, the finest lattice and the point queries.
+  const Surface& surface() const noexcept { return surface_; }
 
-  /// World height of the surface at (x, z), metres; empty off-terrain or for non-finite input.
-  std::optional<double> height(double x, double z) const noexcept;
-  /// Face normal (unit, y > 0) of the triangle under (x, z). Points on an edge shared by two
-  /// triangles take the triangle that locate_in_cell() picks.
-  std::optional<glm::vec3> face_normal(double x, double z) const noexcept;
-  /// Smooth normal (unit, y > 0): barycentric blend of the vertex normals of the triangle under
-  /// (x, z); a vertex normal is the area-weighted mean of the face normals of the triangles
-  /// around the vertex.
-  std::optional<glm::vec3> smooth_normal(double x, double z) const noexcept;
-  /// Height, face normal and material in one call (one lookup instead of two); empty off-terrain
-  /// or for non-finite input.
-  std::optional<HeightNormal> height_normal(double x, double z) const noexcept;
-  /// Height, both normals and the material in one call.
-  std::optional<SurfaceSample> sample(double x, double z) const noexcept;
+  // ---- queries ---------------------------------------------------------------------------------
+  // The point queries are the surface's (surface.h documents them); these forward to it.
 
-  /// Batched heights: out[k] = height(xz[k]) or NaN off-terrain. out.size() must be >= xz.size().
-  void heights(std::span<const glm::dvec2> xz, std::span<double> out) const noexcept;
-  /// Batched samples: valid[k] says whether out[k] is meaningful. Sizes as for heights().
+  /// The stored samples, edits included: surface().heightfield().
+  const Heightfield& heightfield() const noexcept { return surface_.heightfield(); }
+  /// Surface::height(): world height at (x, z), metres; empty off-terrain or for non-finite input.
+  std::optional<double> height(double x, double z) const noexcept { return surface_.height(x, z); }
+  /// Surface::face_normal(): unit normal of the finest triangle under (x, z).
+  std::optional<glm::vec3> face_normal(double x, double z) const noexcept {
+    return surface_.face_normal(x, z);
+  }
+  /// Surface::smooth_normal(): blend of the vertex normals of the triangle under (x, z).
+  std::optional<glm::vec3> smooth_normal(double x, double z) const noexcept {
+    return surface_.smooth_normal(x, z);
+  }
+  /// Surface::height_normal(): height, face normal and material in one lookup.
+  std::optional<HeightNormal> height_normal(double x, double z) const noexcept {
+    return surface_.height_normal(x, z);
+  }
+  /// Surface::sample(): height, both normals and the material in one lookup.
+  std::optional<SurfaceSample> sample(double x, double z) const noexcept {
+    return surface_.sample(x, z);
+  }
+  /// Surface::heights(): batched heights, NaN off-terrain.
+  void heights(std::span<const glm::dvec2> xz, std::span<double> out) const noexcept {
+    surface_.heights(xz, out);
+  }
+  /// Surface::samples(): batched samples; valid[k] says whether out[k] is meaningful.
   void samples(std::span<const glm::dvec2> xz, std::span<SurfaceSample> out,
-               std::span<std::uint8_t> valid) const noexcept;
+               std::span<std::uint8_t> valid) const noexcept {
+    surface_.samples(xz, out, valid);
+  }
 
   /// First intersection of the ray origin + t * normalize(direction), 0 <= t <= max_distance,
   /// with the surface: the smallest such t at which the ray is over the footprint and at or below
@@ -186,12 +171,14 @@ class Terrain {
   /// - Empty when the ray misses, leaves the footprint before meeting the surface (nothing beyond
   ///   the edge is hit), direction is zero, max_distance <= 0 or NaN, or any origin or direction
   ///   component is non-finite. Direction need not be normalised; its length is irrelevant.
-  /// Cost: the ray descends a min/max pyramid, so a long ray costs about the number of pyramid
-  /// nodes it crosses at the level where it clears the terrain, not the number of cells.
+  /// Cost: the ray descends the min/max pyramid (widened by the detail bound), so a long ray
+  /// costs about the number of pyramid nodes it crosses at the level where it clears the
+  /// terrain, not the number of cells; it meets the surface's finest cells only in the leaf
+  /// blocks it cannot skip.
   std::optional<RayHit> raycast(const glm::dvec3& origin, const glm::dvec3& direction,
                                 double max_distance) const noexcept;
 
-  /// Appends to `out` every full-detail triangle whose xz footprint overlaps the box's xz range
+  /// Appends to `out` every finest-lattice triangle whose xz footprint overlaps the box's xz range
   /// (closed: touching counts; exact triangle/rectangle test, not bounding boxes) and whose
   /// height range (min..max of its corners) overlaps [box.min.y, box.max.y]: what a physics
   /// mid-phase asks for. Triangles are in world coordinates, counter-clockwise seen from above
@@ -202,43 +189,35 @@ class Terrain {
   std::size_t triangles_in_box(const Box& box, std::vector<SurfaceTriangle>& out,
                                std::size_t max_triangles = 0) const;
 
-  // ---- procedural detail (detail.h, docs/detail.md) ----------------------------------------
+  // ---- the surface's lattice and detail, as existing callers (the tessellator) read them -------
 
-  /// Detail levels L of the surface (0: the stored lattice is the finest).
-  std::uint32_t detail_levels() const noexcept { return detail_levels_; }
-  /// The detail field, or null without detail.
-  const DetailField* detail() const noexcept { return detail_.get(); }
-  /// The tile cache, or null without detail. Its owner (the engine's frame loop, once per frame)
-  /// calls update(); views request tiles through it. Thread-safe (detail.h).
-  DetailCache* detail_cache() const noexcept { return cache_.get(); }
-  /// Finest-lattice samples per axis: (width - 1) * 2^L + 1 and (height - 1) * 2^L + 1.
-  std::int64_t fine_width() const noexcept;
-  std::int64_t fine_height() const noexcept;
-  /// Height relative to the offset of finest-lattice vertex (i, j) (base + detail + edits);
-  /// indices outside the footprint are clamped to it (the padding rule). Detail comes from the
-  /// cache's current snapshot (kept per thread, refreshed when the cache publishes: no lock per
-  /// call) or is evaluated directly. Without detail this is the stored height.
-  double fine_local_height(std::int64_t i, std::int64_t j) const noexcept;
-  /// Vertex normal (area-weighted, unit, y > 0) at finest-lattice vertex (i, j), which must lie
-  /// in the footprint: what shading wants at a mesh vertex.
-  glm::vec3 lattice_vertex_normal(std::int64_t i, std::int64_t j) const noexcept;
-  /// Measured bound (metres) on |D_L - P_{from_level - 1}| over the finest-lattice rectangle
-  /// [i0, i1] x [j0, j1] when it lies inside one resident finest tile (its
-  /// DetailTile::measured_contribution), else +infinity. Through the per-thread snapshot.
+  /// surface().detail_levels(): detail levels L (0: the stored lattice is the finest).
+  std::uint32_t detail_levels() const noexcept { return surface_.detail_levels(); }
+  /// surface().detail(): the detail field, or null without detail.
+  const DetailField* detail() const noexcept { return surface_.detail(); }
+  /// surface().detail_cache(): the tile cache, or null without detail.
+  DetailCache* detail_cache() const noexcept { return surface_.detail_cache(); }
+  /// surface().lattice().vertices_x and vertices_z: finest-lattice samples per axis,
+  /// (width - 1) * 2^L + 1 and (height - 1) * 2^L + 1.
+  std::int64_t fine_width() const noexcept { return surface_.lattice().vertices_x; }
+  std::int64_t fine_height() const noexcept { return surface_.lattice().vertices_z; }
+  /// surface().vertex_height(i, j): local height of finest-lattice vertex (i, j), clamped in.
+  double fine_local_height(std::int64_t i, std::int64_t j) const noexcept {
+    return surface_.vertex_height(i, j);
+  }
+  /// surface().measured_detail_bound(): a resident finest tile's measured detail bound.
   double measured_detail_bound(std::uint32_t from_level, std::int64_t i0, std::int64_t j0,
-                               std::int64_t i1, std::int64_t j1) const noexcept;
-  /// Detail (metres) at finest-lattice vertex (i, j) alone; 0 without detail.
-  double detail_at(std::int64_t i, std::int64_t j) const noexcept;
-  /// 64-bit hash of the detail parameters (0 without detail): save files record it.
-  std::uint64_t detail_hash() const noexcept { return detail_hash_; }
+                               std::int64_t i1, std::int64_t j1) const noexcept {
+    return surface_.measured_detail_bound(from_level, i0, j0, i1, j1);
+  }
 
   // ---- deformation (edit.h, docs/deformation.md) -------------------------------------------
 
-  /// Applies one brush as one transaction: changes the heights (clamped to the edit limits),
-  /// refreshes the ray pyramid over the changed blocks, bumps edit_version() and records the
-  /// change in the log (changes_since()). Every query sees the new surface when it returns;
-  /// Landscapes and RoamViews catch up at their next sync() / update(). Cost follows the edited
-  /// area, never the terrain size.
+  /// Applies one brush as one transaction: changes the surface's stored samples (clamped to the
+  /// edit limits; the edit layer keeps the originals), refreshes the ray pyramid over the changed
+  /// blocks, bumps edit_version() and records the change in the log (changes_since()). Every
+  /// query sees the new surface when it returns; Landscapes and RoamViews catch up at their next
+  /// sync() / update(). Cost follows the edited area, never the terrain size.
   /// Errors (nothing changes): a field fails validate_edit(), the radius exceeds the terrain's
   /// larger extent, the area cap is exceeded with EditLimits::refuse_oversize, or keep_detail is
   /// false on a terrain with detail (edit.h). A brush wholly outside the terrain, or one that
@@ -248,12 +227,8 @@ class Terrain {
   /// Limits for later edits (validated: finite, area > 0, min < max; else an error and no change).
   Status set_edit_limits(const EditLimits& limits);
   const EditLimits& edit_limits() const noexcept;
-  /// Number of 32 x 32-sample chunks the edit layer holds (0 when unedited).
-  std::size_t edited_chunks() const noexcept;
   /// Hash of the heightfield as created, before any edit (what save files record).
   std::uint64_t base_hash() const noexcept { return base_hash_; }
-  /// Hash of the current heights (base + edits): equal hashes, equal surfaces.
-  std::uint64_t heights_hash() const noexcept { return heightfield_.content_hash(); }
   /// The surface's version: 0 as created, one more with every edit or load that changed a
   /// height (one change-log entry each).
   std::uint64_t edit_version() const noexcept { return edit_version_; }
@@ -266,48 +241,46 @@ class Terrain {
   /// it is one merged entry and `trimmed` (correct, coarser). A version above edit_version() is
   /// not this terrain's: one entry covering the whole footprint, `trimmed`. Cost: O(entries
   /// returned); allocates only when something changed. Any thread, concurrently with queries
-  /// and other pulls, never during an edit.
+  /// and other pulls, never during an edit. docs/engine_integration.md shows a physics engine's
+  /// heightfield collider kept up to date this way.
   TerrainChanges changes_since(std::uint64_t version) const;
-  /// A deep copy (heights, ray pyramid, edit layer, limits, version and change log), not
-  /// attached to any Landscape: a snapshot a physics thread can query while this terrain is
-  /// being edited.
+  /// A deep copy (samples, edit layer, limits, ray pyramid, version and change log; the detail
+  /// field is shared, immutable, with a tile cache of its own), not attached to any Landscape: a
+  /// snapshot a physics thread can query while this terrain is being edited.
   std::shared_ptr<Terrain> clone() const;
 
   /// Checks the query structures against the surface: the ray pyramid equals, node by node, one
-  /// rebuilt from the current heights. Returns an empty string when it holds, else the first
+  /// rebuilt from the current samples. Returns an empty string when it holds, else the first
   /// difference. O(samples): for tests and debugging after edits.
   std::string check_invariants() const;
 
-  /// Bytes held: heights, materials, ray hierarchy.
+  /// Bytes held: the surface (surface().memory_bytes()) and the ray hierarchy.
   std::size_t memory_bytes() const noexcept;
   /// Bytes held by the ray hierarchy alone (the min/max pyramid over 4 x 4-cell blocks, about
   /// 0.67 bytes per sample).
   std::size_t ray_hierarchy_bytes() const noexcept;
 
  private:
-  explicit Terrain(Heightfield heightfield);
+  Terrain(Heightfield heightfield, std::shared_ptr<const DetailField> detail,
+          std::unique_ptr<DetailCache> cache);
+  Terrain(const Terrain& other, Surface::CloneTag);
 
-  Heightfield heightfield_;
+  // The edit transaction (module/src/edit/): after the surface's samples changed, refreshes the
+  // ray pyramid over them, bumps the version, records the change and fills the result's box.
+  void commit(const SampleChanges& changes, EditResult& result);
+  // The surface's samples and edit layer, as the edit code writes them.
+  Heightfield& samples_for_edit() noexcept { return surface_.samples_; }
+  EditLayer& edit_layer() noexcept { return *surface_.edits_; }
+  const EditLayer& edit_layer() const noexcept { return *surface_.edits_; }
+
+  Surface surface_;
   std::unique_ptr<RayHierarchy> rays_;
-  std::unique_ptr<EditLayer> edits_;
   std::unique_ptr<ChangeLog> log_;
   std::uint64_t base_hash_ = 0;
   std::uint64_t edit_version_ = 0;
-  std::uint32_t detail_levels_ = 0;
-  std::shared_ptr<const DetailField> detail_;
-  std::unique_ptr<DetailCache> cache_;
-  std::uint64_t detail_hash_ = 0;
-  // Detail versions of the point queries (terrain_detail.cpp).
-  struct FineLocated;
-  bool locate_fine(double x, double z, FineLocated& p) const noexcept;
-  double fine_height_at(const FineLocated& p) const noexcept;
-  glm::vec3 fine_face_normal(const FineLocated& p) const noexcept;
-  glm::vec3 fine_smooth_normal(const FineLocated& p) const noexcept;
-  std::uint8_t fine_material(const FineLocated& p) const noexcept;
-  // Cached for the query fast path.
-  double inv_spacing_x_ = 1, inv_spacing_z_ = 1;
 
-  // The edit file's reader and writer (edit.cpp) reach the edit layer and the transaction.
+  // The edit file's reader and writer (edit/edit_file.cpp) reach the edit layer and the
+  // transaction.
   friend Result<EditResult> load_edits_from_memory(Terrain&, std::string_view);
   friend Status save_edits(const Terrain&, const std::string&);
 };

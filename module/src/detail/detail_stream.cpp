@@ -25,9 +25,8 @@ constexpr std::int64_t kLocalRangeCells = 16;
 // of every cell the tile overlaps (the stored surface there lies within their range) widened by
 // the bound of the detail over the tile.
 template <class Vertical>
-double vertical_to_tile(const DetailField& field, std::uint32_t level, std::int64_t tx,
-                        std::int64_t tz, const Vertical& vertical) {
-  const Heightfield& hf = field.terrain().heightfield();
+double vertical_to_tile(const Heightfield& hf, const DetailField& field, std::uint32_t level,
+                        std::int64_t tx, std::int64_t tz, const Vertical& vertical) {
   const std::int64_t li0 = tx * kDetailTileCells, lj0 = tz * kDetailTileCells;
   const std::int64_t li1 = li0 + kDetailTileCells, lj1 = lj0 + kDetailTileCells;
   // Stored sample indices covering [li0, li1] / 2^level (floor and ceiling), clamped.
@@ -64,17 +63,18 @@ Status validate_detail_view_rule(const DetailViewRule& rule) {
 double detail_level_radius(const DetailField& field, const Camera& camera, std::uint32_t level,
                            const DetailViewRule& rule) noexcept {
   if (level == 0 || level > field.levels() || !(rule.pixels > 0)) return 0.0;
-  const Heightfield& hf = field.terrain().heightfield();
-  const double spacing = std::ldexp(std::max(hf.spacing_x(), hf.spacing_z()), -int(level));
+  const double spacing = std::ldexp(std::max(field.spacing_x(), field.spacing_z()), -int(level));
   return spacing * projection_scale(camera) / rule.pixels;
 }
 
-Status detail_tiles_for_view(const DetailField& field, const Camera& camera,
+Status detail_tiles_for_view(const Surface& surface, const Camera& camera,
                              const DetailViewRule& rule, std::vector<DetailTileNeed>& out) {
   out.clear();
   if (auto s = validate_detail_view_rule(rule); !s) return s;
   if (auto s = validate_camera(camera); !s) return s;
-  const Heightfield& hf = field.terrain().heightfield();
+  if (!surface.detail()) return {};
+  const DetailField& field = *surface.detail();
+  const Heightfield& hf = surface.heightfield();
   // The height range any surface point can have: a lower bound of the vertical distance.
   const double amp = field.contribution_bound(1);
   const double global_top = hf.height_offset() + double(hf.max_local()) + amp;
@@ -125,7 +125,7 @@ Status detail_tiles_for_view(const DetailField& field, const Camera& camera,
         const double dxz2 = dx * dx + dz * dz;
         if (dxz2 + global_dy * global_dy > reach * reach) continue;
         const double dy =
-            local_range ? vertical_to_tile(field, level, tx, tz, vertical) : global_dy;
+            local_range ? vertical_to_tile(hf, field, level, tx, tz, vertical) : global_dy;
         const double d = std::sqrt(dxz2 + dy * dy);
         if (d > reach) continue;
         if (out.size() >= rule.max_tiles) {
@@ -146,13 +146,16 @@ Status detail_tiles_for_view(const DetailField& field, const Camera& camera,
   return {};
 }
 
-Result<DetailStream> DetailStream::create(DetailCache& cache, const DetailViewRule& rule) {
+Result<DetailStream> DetailStream::create(const Surface& surface, DetailCache& cache,
+                                          const DetailViewRule& rule) {
   if (auto s = validate_detail_view_rule(rule); !s) return Error{s.message()};
-  return DetailStream(cache, rule);
+  if (&cache.field() != surface.detail())
+    return Error{"detail stream: the cache holds tiles of another detail field than the surface's"};
+  return DetailStream(surface, cache, rule);
 }
 
 Result<DetailFrameStats> DetailStream::frame(const Camera& camera) {
-  if (auto s = detail_tiles_for_view(cache_->field(), camera, rule_, tiles_); !s)
+  if (auto s = detail_tiles_for_view(*surface_, camera, rule_, tiles_); !s)
     return Error{s.message()};
   DetailFrameStats st;
   st.requested = tiles_.size();

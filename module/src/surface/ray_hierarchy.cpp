@@ -10,15 +10,15 @@
 // Everything runs in double precision in lattice-local coordinates (grid units from sample (0, 0)
 // along x and z, metres above the height offset along y), so terrains far from the world origin
 // lose nothing.
-#include "ray_hierarchy.h"
+#include "surface/ray_hierarchy.h"
 
 #include <algorithm>
 #include <cmath>
 #include <glm/geometric.hpp>
 #include <limits>
 
-#include "ridgeline/detail.h"
-#include "surface_eval.h"
+#include "surface/lattice.h"
+#include "surface/surface_eval.h"
 
 namespace ridgeline {
 
@@ -166,103 +166,53 @@ std::size_t RayHierarchy::memory_bytes() const noexcept {
 
 namespace {
 
-// Fills a hit at distance t on the triangle with plane `plane` in cell (i, j) of `hf` (a
-// Heightfield or a grid view with material(i, j)).
-template <class Grid>
-void fill_hit(const Grid& hf, double inv_sx, double inv_sz, const glm::dvec3& origin,
-              const glm::dvec3& dir, std::uint32_t i, std::uint32_t j,
-              const detail::CellPlane& plane, double t, bool started_below, RayHit& hit) noexcept {
+// Fills a hit at distance t on the triangle with plane `plane` in cell (i, j) of lattice `g`.
+template <class Lattice>
+void fill_hit(const Lattice& g, const glm::dvec3& origin, const glm::dvec3& dir, std::int64_t i,
+              std::int64_t j, const detail::CellPlane& plane, double t, bool started_below,
+              RayHit& hit) noexcept {
   hit.distance = t;
   hit.point = t == 0.0 ? origin : origin + dir * t;
-  hit.normal = detail::plane_normal(plane, inv_sx, inv_sz);
-  hit.material = hf.material(i, j);
+  hit.normal = detail::plane_normal(plane, g.at.inv_spacing_x, g.at.inv_spacing_z);
+  hit.material = g.material(i, j);
   hit.started_below = started_below;
 }
 
-
-// The stored lattice and the finest lattice of a terrain with detail, as grids for the walks.
-struct BaseGrid {
-  const Heightfield& hf;
-  double isx, isz;
-  float local(std::uint32_t i, std::uint32_t j) const noexcept { return hf.local(i, j); }
-  std::uint8_t material(std::uint32_t i, std::uint32_t j) const noexcept { return hf.material(i, j); }
-};
-struct FineGrid {
-  const Terrain& t;
-  int L;
-  double isx, isz;  // 1 / finest spacing
-  double local(std::uint32_t i, std::uint32_t j) const noexcept { return t.fine_local_height(i, j); }
-  std::uint8_t material(std::uint32_t i, std::uint32_t j) const noexcept {
-    const Heightfield& hf = t.heightfield();
-    return hf.material(std::min(i >> L, hf.width() - 2), std::min(j >> L, hf.height() - 2));
-  }
-};
-
-// The surface under a point: its cell, the point's fractions in it, the triangle's plane.
+// The surface under a point: its finest cell, the point's fractions in it, the triangle's plane.
 struct PointPlane {
-  std::uint32_t i = 0, j = 0;
+  std::int64_t i = 0, j = 0;
   double fu = 0, fv = 0;
   detail::CellPlane plane{};
 };
 
-template <class Grid>
-PointPlane point_plane(const Grid& g, double u, double v, std::int64_t cells_x,
-                       std::int64_t cells_z) noexcept {
+// (u, v) in stored-lattice units, inside the footprint.
+template <class Lattice>
+PointPlane point_plane(const Lattice& g, double u, double v) noexcept {
+  u *= g.scale, v *= g.scale;  // finest-lattice units (exact: a power of two)
   PointPlane p;
-  p.i = static_cast<std::uint32_t>(std::min<std::int64_t>(static_cast<std::int64_t>(u), cells_x - 1));
-  p.j = static_cast<std::uint32_t>(std::min<std::int64_t>(static_cast<std::int64_t>(v), cells_z - 1));
-  p.fu = u - p.i;
-  p.fv = v - p.j;
-  const CellTriangle tri =
-      locate_in_cell(p.i, p.j, static_cast<float>(p.fu), static_cast<float>(p.fv));
+  const CellTriangle tri = detail::cell_at(g, u, v, p.i, p.j);
+  p.fu = u - double(p.i);
+  p.fv = v - double(p.j);
   p.plane = detail::cell_plane(g, p.i, p.j, tri);
   return p;
 }
 
 }  // namespace
 
-struct RayHierarchy::BaseMode {
-  BaseGrid grid;
-  std::int64_t cells_x, cells_z;
-  double inflate() const noexcept { return 0.0; }
-  // (u, v) in stored-lattice units, inside the footprint.
-  PointPlane point(double u, double v) const noexcept { return point_plane(grid, u, v, cells_x, cells_z); }
-  bool leaf(const RayHierarchy& rh, const Ray& r, std::uint32_t bx, std::uint32_t bz, double ta,
-            double tb, RayHit& hit) const noexcept {
-    const std::int64_t ci0 = std::int64_t{bx} << kLeafShift, cj0 = std::int64_t{bz} << kLeafShift;
-    const std::int64_t ci1 = std::min<std::int64_t>(ci0 + kLeafCells, cells_x) - 1;
-    const std::int64_t cj1 = std::min<std::int64_t>(cj0 + kLeafCells, cells_z) - 1;
-    return rh.walk_cells(grid, r, ci0, cj0, ci1, cj1, ta, tb, hit);
-  }
-};
-
-struct RayHierarchy::FineMode {
-  FineGrid grid;
-  std::int64_t cells_x, cells_z;  // stored cells
-  double widen;                   // detail amplitude bound, metres
-  double inflate() const noexcept { return widen; }
-  PointPlane point(double u, double v) const noexcept {
-    return point_plane(grid, std::ldexp(u, grid.L), std::ldexp(v, grid.L), cells_x << grid.L,
-                       cells_z << grid.L);
-  }
-  bool leaf(const RayHierarchy& rh, const Ray& r, std::uint32_t bx, std::uint32_t bz, double ta,
-            double tb, RayHit& hit) const noexcept {
-    const int L = grid.L;
-    Ray f = r;  // the same ray in finest-lattice units
-    f.u0 = std::ldexp(r.u0, L), f.v0 = std::ldexp(r.v0, L);
-    f.du = std::ldexp(r.du, L), f.dv = std::ldexp(r.dv, L);
-    f.inv_du = std::ldexp(r.inv_du, -L), f.inv_dv = std::ldexp(r.inv_dv, -L);
-    const std::int64_t ci0 = std::int64_t{bx} << kLeafShift, cj0 = std::int64_t{bz} << kLeafShift;
-    const std::int64_t ci1 = std::min<std::int64_t>(ci0 + kLeafCells, cells_x);
-    const std::int64_t cj1 = std::min<std::int64_t>(cj0 + kLeafCells, cells_z);
-    return rh.walk_cells(grid, f, ci0 << L, cj0 << L, (ci1 << L) - 1, (cj1 << L) - 1, ta, tb, hit);
-  }
-};
-
-template <class Grid>
-bool RayHierarchy::walk_cells(const Grid& grid, const Ray& r, std::int64_t ci0, std::int64_t cj0,
-                              std::int64_t ci1, std::int64_t cj1, double ta, double tb,
-                              RayHit& hit) const noexcept {
+// Tests the finest cells of leaf block (bx, bz) that the ray crosses during [ta, tb], in ray
+// order (a 2D DDA over the block's 2^L x 2^L finest cells per stored cell).
+template <class Lattice>
+bool RayHierarchy::walk_leaf(const Lattice& g, const Ray& stored, std::uint32_t bx,
+                             std::uint32_t bz, double ta, double tb, RayHit& hit) const noexcept {
+  const int L = g.levels;
+  Ray r = stored;  // the same ray in finest-lattice units (exact: powers of two)
+  r.u0 *= g.scale, r.v0 *= g.scale, r.du *= g.scale, r.dv *= g.scale;
+  r.inv_du *= g.inv_scale, r.inv_dv *= g.inv_scale;
+  const std::int64_t cells_x = g.at.vertices_x - 1, cells_z = g.at.vertices_z - 1;
+  const std::int64_t ci0 = std::int64_t{bx} << (kLeafShift + L);
+  const std::int64_t cj0 = std::int64_t{bz} << (kLeafShift + L);
+  const std::int64_t ci1 = std::min<std::int64_t>(ci0 + (kLeafCells << L), cells_x) - 1;
+  const std::int64_t cj1 = std::min<std::int64_t>(cj0 + (kLeafCells << L), cells_z) - 1;
   // Truncation acts as floor here: anything below 0 is clamped up to ci0 >= 0 anyway.
   std::int64_t ci = std::clamp<std::int64_t>(
       static_cast<std::int64_t>(std::max(r.u0 + r.du * ta, -1.0)), ci0, ci1);
@@ -283,9 +233,8 @@ bool RayHierarchy::walk_cells(const Grid& grid, const Ray& r, std::int64_t ci0, 
     const double tc = std::max(t, std::min({tnu, tnv, tb}));
 
     // The cell: skip it when the ray stays above its highest corner.
-    const auto i = static_cast<std::uint32_t>(ci), j = static_cast<std::uint32_t>(cj);
-    const double h00 = grid.local(i, j), h10 = grid.local(i + 1, j);
-    const double h01 = grid.local(i, j + 1), h11 = grid.local(i + 1, j + 1);
+    const double h00 = g.local(ci, cj), h10 = g.local(ci + 1, cj);
+    const double h01 = g.local(ci, cj + 1), h11 = g.local(ci + 1, cj + 1);
     const double cmax = std::max(std::max(h00, h10), std::max(h01, h11));
     const double ylow = r.y0 + r.dy * (r.dy < 0 ? tc : t);
     if (ylow <= cmax + touch_) {
@@ -309,7 +258,7 @@ bool RayHierarchy::walk_cells(const Grid& grid, const Ray& r, std::int64_t ci0, 
         const CellTriangle tri =
             locate_in_cell(ci, cj, static_cast<float>(std::clamp(ou + r.du * pm, 0.0, 1.0)),
                            static_cast<float>(std::clamp(ov + r.dv * pm, 0.0, 1.0)));
-        const detail::CellPlane plane = detail::cell_plane(grid, i, j, tri);
+        const detail::CellPlane plane = detail::cell_plane(g, ci, cj, tri);
         const double ha = plane.at(ou + r.du * pa, ov + r.dv * pa);
         const double fa = (r.y0 + r.dy * pa) - ha;
         double th;
@@ -321,7 +270,7 @@ bool RayHierarchy::walk_cells(const Grid& grid, const Ray& r, std::int64_t ci0, 
           if (fb > touch_) continue;
           th = fb <= 0 ? std::clamp(pa + (pb - pa) * (fa / (fa - fb)), pa, pb) : pb;
         }
-        fill_hit(grid, grid.isx, grid.isz, r.origin, r.dir, i, j, plane, th, false, hit);
+        fill_hit(g, r.origin, r.dir, ci, cj, plane, th, false, hit);
         return true;
       }
     }
@@ -338,30 +287,28 @@ bool RayHierarchy::walk_cells(const Grid& grid, const Ray& r, std::int64_t ci0, 
   }
 }
 
-std::optional<RayHit> RayHierarchy::raycast(const Heightfield& hf, const glm::dvec3& origin,
+std::optional<RayHit> RayHierarchy::raycast(const Surface& s, const glm::dvec3& origin,
                                             const glm::dvec3& direction,
                                             double max_distance) const noexcept {
-  const BaseMode mode{{hf, inv_sx_, inv_sz_}, hf.width() - 1, hf.height() - 1};
-  return raycast_impl(mode, hf, origin, direction, max_distance);
+  return detail::with_lattice(s, [&](const auto& g) {
+    return raycast_impl(g, s.detail_bound(), origin, direction, max_distance);
+  });
 }
 
-std::optional<RayHit> RayHierarchy::raycast_fine(const Terrain& t, const glm::dvec3& origin,
-                                                 const glm::dvec3& direction,
-                                                 double max_distance) const noexcept {
-  const Heightfield& hf = t.heightfield();
-  const int L = int(t.detail_levels());
-  const FineMode mode{{t, L, std::ldexp(inv_sx_, L), std::ldexp(inv_sz_, L)},
-                      hf.width() - 1,
-                      hf.height() - 1,
-                      t.detail()->contribution_bound(1)};
-  return raycast_impl(mode, hf, origin, direction, max_distance);
+std::size_t RayHierarchy::triangles_in_box(const Surface& s, const Box& box,
+                                           std::vector<SurfaceTriangle>& out,
+                                           std::size_t max_triangles) const {
+  return detail::with_lattice(
+      s, [&](const auto& g) { return boxes_impl(g, s.detail_bound(), box, out, max_triangles); });
 }
 
-template <class Mode>
-std::optional<RayHit> RayHierarchy::raycast_impl(const Mode& mode, const Heightfield& hf,
+// `widen`: the detail bound, metres, by which the pyramid's stored maxima are raised.
+template <class Lattice>
+std::optional<RayHit> RayHierarchy::raycast_impl(const Lattice& g, double widen,
                                                  const glm::dvec3& origin,
                                                  const glm::dvec3& direction,
                                                  double max_distance) const noexcept {
+  const Heightfield& hf = g.hf;
   if (!(max_distance > 0.0)) return std::nullopt;  // also NaN
   for (int a = 0; a < 3; ++a)
     if (!std::isfinite(origin[a]) || !std::isfinite(direction[a])) return std::nullopt;
@@ -392,14 +339,14 @@ std::optional<RayHit> RayHierarchy::raycast_impl(const Mode& mode, const Heightf
   if (r.du == 0.0 && r.dv == 0.0) {
     // Vertical: only the surface under the origin can be hit.
     if (!(r.u0 >= 0.0 && r.u0 <= umax && r.v0 >= 0.0 && r.v0 <= vmax)) return std::nullopt;
-    const PointPlane p = mode.point(r.u0, r.v0);
+    const PointPlane p = point_plane(g, r.u0, r.v0);
     const double f = r.y0 - p.plane.at(p.fu, p.fv);  // height above the surface
     if (f <= touch_) {
-      fill_hit(mode.grid, mode.grid.isx, mode.grid.isz, origin, d, p.i, p.j, p.plane, 0.0, f < 0.0, hit);
+      fill_hit(g, origin, d, p.i, p.j, p.plane, 0.0, f < 0.0, hit);
       return hit;
     }
     if (r.dy > 0.0 || f > max_distance) return std::nullopt;
-    fill_hit(mode.grid, mode.grid.isx, mode.grid.isz, origin, d, p.i, p.j, p.plane, f, false, hit);
+    fill_hit(g, origin, d, p.i, p.j, p.plane, f, false, hit);
     return hit;
   }
 
@@ -416,11 +363,10 @@ std::optional<RayHit> RayHierarchy::raycast_impl(const Mode& mode, const Heightf
     const double t = r.t_enter;
     const double u = std::clamp(r.u0 + r.du * t, 0.0, umax);
     const double v = std::clamp(r.v0 + r.dv * t, 0.0, vmax);
-    const PointPlane p = mode.point(u, v);
+    const PointPlane p = point_plane(g, u, v);
     const double f = (r.y0 + r.dy * t) - p.plane.at(p.fu, p.fv);
     if (f <= touch_) {
-      fill_hit(mode.grid, mode.grid.isx, mode.grid.isz, origin, d, p.i, p.j, p.plane, t,
-               t == 0.0 && f < 0.0, hit);
+      fill_hit(g, origin, d, p.i, p.j, p.plane, t, t == 0.0 && f < 0.0, hit);
       return hit;
     }
   }
@@ -460,7 +406,7 @@ std::optional<RayHit> RayHierarchy::raycast_impl(const Mode& mode, const Heightf
     const double t_out = std::max(t, std::min(std::min(tnu, tnv), r.t_exit));
     const float node_max = level.max[level.index(x, z)];
     const double ylow = r.y0 + r.dy * (r.dy < 0 ? t_out : t);
-    if (ylow <= double(node_max) + mode.inflate() + touch_) {
+    if (ylow <= double(node_max) + widen + touch_) {
       if (l > 0) {
         // Descend into the child that holds the ray at t (ties go the way the ray moves).
         --l;
@@ -472,7 +418,7 @@ std::optional<RayHit> RayHierarchy::raycast_impl(const Mode& mode, const Heightf
         z = std::min<std::int64_t>(z, levels_[l].nz - 1);
         continue;
       }
-      if (mode.leaf(*this, r, std::uint32_t(x), std::uint32_t(z), t, t_out, hit)) return hit;
+      if (walk_leaf(g, r, std::uint32_t(x), std::uint32_t(z), t, t_out, hit)) return hit;
     }
     // Step to the next node along the ray.
     if (t_out >= r.t_exit) return std::nullopt;
@@ -495,34 +441,22 @@ std::optional<RayHit> RayHierarchy::raycast_impl(const Mode& mode, const Heightf
   }
 }
 
-std::size_t RayHierarchy::triangles_in_box(const Heightfield& hf, const Box& box,
-                                           std::vector<SurfaceTriangle>& out,
-                                           std::size_t max_triangles) const {
-  return boxes_impl(BaseGrid{hf, inv_sx_, inv_sz_}, hf, 0, 0.0, box, out, max_triangles);
-}
-
-std::size_t RayHierarchy::triangles_in_box_fine(const Terrain& t, const Box& box,
-                                                std::vector<SurfaceTriangle>& out,
-                                                std::size_t max_triangles) const {
-  const int L = int(t.detail_levels());
-  return boxes_impl(FineGrid{t, L, std::ldexp(inv_sx_, L), std::ldexp(inv_sz_, L)},
-                    t.heightfield(), L, t.detail()->contribution_bound(1), box, out,
-                    max_triangles);
-}
-
-template <class Grid>
-std::size_t RayHierarchy::boxes_impl(const Grid& g, const Heightfield& hf, int L, double widen,
-                                     const Box& box, std::vector<SurfaceTriangle>& out,
+// `widen` as for raycast_impl.
+template <class Lattice>
+std::size_t RayHierarchy::boxes_impl(const Lattice& g, double widen, const Box& box,
+                                     std::vector<SurfaceTriangle>& out,
                                      std::size_t max_triangles) const {
+  const SurfaceLattice& at = g.at;
+  const int L = g.levels;
   for (int a = 0; a < 3; ++a)
     if (!std::isfinite(box.min[a]) || !std::isfinite(box.max[a]) || !(box.min[a] <= box.max[a]))
       return 0;
-  // Cells of `g` (the stored lattice, or the finest one: 2^L per stored cell).
-  const double sx = std::ldexp(hf.spacing_x(), -L), sz = std::ldexp(hf.spacing_z(), -L);
-  const double ua = (box.min.x - hf.origin_x()) / sx, ub = (box.max.x - hf.origin_x()) / sx;
-  const double va = (box.min.z - hf.origin_z()) / sz, vb = (box.max.z - hf.origin_z()) / sz;
-  const double ylo = box.min.y - hf.height_offset(), yhi = box.max.y - hf.height_offset();
-  const double umax = std::ldexp(hf.width() - 1.0, L), vmax = std::ldexp(hf.height() - 1.0, L);
+  // Finest cells (2^L per stored cell side).
+  const double sx = at.spacing_x, sz = at.spacing_z;
+  const double ua = (box.min.x - at.origin_x) / sx, ub = (box.max.x - at.origin_x) / sx;
+  const double va = (box.min.z - at.origin_z) / sz, vb = (box.max.z - at.origin_z) / sz;
+  const double ylo = box.min.y - at.height_offset, yhi = box.max.y - at.height_offset;
+  const double umax = double(at.vertices_x - 1), vmax = double(at.vertices_z - 1);
   if (ub < 0.0 || vb < 0.0 || ua > umax || va > vmax) return 0;
   // Closed cell ranges: a box touching a cell's edge overlaps that cell.
   const auto cell_lo = [](double a, double cells) {
@@ -545,14 +479,13 @@ std::size_t RayHierarchy::boxes_impl(const Grid& g, const Heightfield& hf, int L
         ci |= (std::int64_t{1} << shift) - 1;  // to the block's last cell
         continue;
       }
-      const auto i = static_cast<std::uint32_t>(ci), j = static_cast<std::uint32_t>(cj);
       // The box in this cell's fractional coordinates.
       const double bu0 = ua - double(ci), bu1 = ub - double(ci);
       const double bv0 = va - double(cj), bv1 = vb - double(cj);
       for (int which = 0; which < 2; ++which) {
         const CellTriangle t = detail::cell_triangle(ci, cj, which);
         double h[3];
-        for (int k = 0; k < 3; ++k) h[k] = g.local(i + t.di[k], j + t.dj[k]);
+        for (int k = 0; k < 3; ++k) h[k] = g.local(ci + t.di[k], cj + t.dj[k]);
         const double hmin = std::min({h[0], h[1], h[2]}), hmax = std::max({h[0], h[1], h[2]});
         if (hmax < ylo || hmin > yhi) continue;
         // Separating axes: the box's axes hold (the cell overlaps the box and the triangle
@@ -572,31 +505,15 @@ std::size_t RayHierarchy::boxes_impl(const Grid& g, const Heightfield& hf, int L
         if (max_triangles != 0 && added == max_triangles) return added;
         SurfaceTriangle st;
         for (int k = 0; k < 3; ++k)
-          st.v[k] = {hf.origin_x() + double(ci + t.di[k]) * sx, hf.height_offset() + h[k],
-                     hf.origin_z() + double(cj + t.dj[k]) * sz};
-        st.material = g.material(i, j);
+          st.v[k] = {at.origin_x + double(ci + t.di[k]) * sx, at.height_offset + h[k],
+                     at.origin_z + double(cj + t.dj[k]) * sz};
+        st.material = g.material(ci, cj);
         out.push_back(st);
         ++added;
       }
     }
   }
   return added;
-}
-
-std::string Terrain::check_invariants() const {
-  return rays_->compare(RayHierarchy(heightfield_));
-}
-
-std::optional<RayHit> Terrain::raycast(const glm::dvec3& origin, const glm::dvec3& direction,
-                                       double max_distance) const noexcept {
-  if (detail_levels_ != 0) return rays_->raycast_fine(*this, origin, direction, max_distance);
-  return rays_->raycast(heightfield_, origin, direction, max_distance);
-}
-
-std::size_t Terrain::triangles_in_box(const Box& box, std::vector<SurfaceTriangle>& out,
-                                      std::size_t max_triangles) const {
-  if (detail_levels_ != 0) return rays_->triangles_in_box_fine(*this, box, out, max_triangles);
-  return rays_->triangles_in_box(heightfield_, box, out, max_triangles);
 }
 
 }  // namespace ridgeline

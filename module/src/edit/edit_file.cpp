@@ -1,0 +1,265 @@
+// The edit layer's file (docs/deformation.md, "The edit file"): a versioned, checksummed binary
+// image of every edited chunk, written atomically and read back as one transaction.
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <bit>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+
+#include "edit/edit_layer.h"
+#include "format.h"
+#include "ridgeline/edit.h"
+
+namespace ridgeline {
+
+static_assert(std::endian::native == std::endian::little,
+              "the edit file is little-endian and read by memcpy");
+
+namespace {
+
+constexpr char kMagic[8] = {'R', 'I', 'D', 'G', 'E', 'E', 'D', 'T'};
+constexpr std::uint32_t kVersion = 1;
+constexpr std::size_t kHeaderBytes = 64;
+constexpr std::size_t kChunkValues = std::size_t{EditLayer::kChunk} * EditLayer::kChunk;
+constexpr std::size_t kChunkBytes = 8 + 4 * kChunkValues;
+
+std::uint64_t fnv1a(const char* p, std::size_t n) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (std::size_t k = 0; k < n; ++k) {
+    h ^= static_cast<unsigned char>(p[k]);
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+template <class T>
+void put(std::string& out, const T& v) {
+  out.append(reinterpret_cast<const char*>(&v), sizeof v);
+}
+template <class T>
+T get(std::string_view in, std::size_t at) {
+  T v;
+  std::memcpy(&v, in.data() + at, sizeof v);
+  return v;
+}
+
+}  // namespace
+
+Status save_edits(const Terrain& terrain, const std::string& path) {
+  const Heightfield& hf = terrain.heightfield();
+  const EditLayer& layer = terrain.edit_layer();
+  const std::vector<std::uint64_t> keys = layer.sorted_keys();
+  std::string out;
+  out.reserve(kHeaderBytes + keys.size() * kChunkBytes + 8);
+  out.append(kMagic, 8);
+  put(out, kVersion);
+  put(out, EditLayer::kChunk);
+  put(out, terrain.base_hash());
+  put(out, terrain.surface().detail_hash());
+  put(out, hf.width());
+  put(out, hf.height());
+  put(out, std::uint64_t{keys.size()});
+  put(out, std::uint64_t{0});
+  put(out, std::uint64_t{0});
+  for (std::uint64_t k : keys) {
+    const std::uint32_t cx = std::uint32_t(k), cz = std::uint32_t(k >> 32);
+    put(out, cx);
+    put(out, cz);
+    const std::uint32_t i0 = cx << EditLayer::kChunkShift, j0 = cz << EditLayer::kChunkShift;
+    for (std::uint32_t dj = 0; dj < EditLayer::kChunk; ++dj)
+      for (std::uint32_t di = 0; di < EditLayer::kChunk; ++di) {
+        const bool in = i0 + di < hf.width() && j0 + dj < hf.height();
+        put(out, in ? hf.local(i0 + di, j0 + dj) : 0.0f);
+      }
+  }
+  put(out, fnv1a(out.data(), out.size()));
+
+  // Temporary file in the same folder, fsync, rename over the target, fsync the folder.
+  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0)
+    return Error{"save edits '" + path + "': cannot create '" + tmp + "': " + std::strerror(errno)};
+  std::size_t done = 0;
+  while (done < out.size()) {
+    const ssize_t n = ::write(fd, out.data() + done, out.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int err = n < 0 ? errno : ENOSPC;
+      ::close(fd);
+      ::unlink(tmp.c_str());
+      return Error{"save edits '" + path + "': writing failed (" + std::strerror(err) +
+                   "); the previous file is unchanged"};
+    }
+    done += std::size_t(n);
+  }
+  // A full disk may show only here (delayed allocation, network file systems). The descriptor
+  // is closed whatever fsync answered.
+  int err = ::fsync(fd) != 0 ? errno : 0;
+  if (::close(fd) != 0 && err == 0) err = errno;
+  if (err != 0) {
+    ::unlink(tmp.c_str());
+    return Error{"save edits '" + path + "': flushing failed (" + std::strerror(err) +
+                 "); the previous file is unchanged"};
+  }
+  if (::rename(tmp.c_str(), path.c_str()) != 0) {
+    err = errno;
+    ::unlink(tmp.c_str());
+    return Error{"save edits '" + path + "': rename failed (" + std::strerror(err) +
+                 "); the previous file is unchanged"};
+  }
+  const std::size_t slash = path.find_last_of('/');
+  const std::string dir =
+      slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
+  if (const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC); dfd >= 0) {
+    ::fsync(dfd);
+    ::close(dfd);
+  }
+  return {};
+}
+
+// The header fields that tie a file to a terrain (base hash, detail hash, size); `in` holds at
+// least the header.
+static Status check_edit_header(const Terrain& terrain, std::string_view in) {
+  const Heightfield& hf = terrain.heightfield();
+  const std::string what = "edit file";
+  if (std::memcmp(in.data(), kMagic, 8) != 0)
+    return Error{what + ": not a Ridgeline edit file (bad magic)"};
+  const auto version = get<std::uint32_t>(in, 8);
+  if (version != kVersion)
+    return Error{
+        fmt("%s: version %u; this build reads version %u", what.c_str(), version, kVersion)};
+  if (get<std::uint32_t>(in, 12) != EditLayer::kChunk)
+    return Error{fmt("%s: chunk size %u; need %u", what.c_str(), get<std::uint32_t>(in, 12),
+                     EditLayer::kChunk)};
+  if (get<std::uint64_t>(in, 16) != terrain.base_hash())
+    return Error{
+        fmt("%s: saved for another terrain (base data hash %016llx, this terrain's is "
+            "%016llx)",
+            what.c_str(), static_cast<unsigned long long>(get<std::uint64_t>(in, 16)),
+            static_cast<unsigned long long>(terrain.base_hash()))};
+  if (get<std::uint64_t>(in, 24) != terrain.surface().detail_hash())
+    return Error{what + ": saved with other detail parameters (detail hash differs)"};
+  if (get<std::uint32_t>(in, 32) != hf.width() || get<std::uint32_t>(in, 36) != hf.height())
+    return Error{fmt("%s: saved for a %u x %u terrain; this one is %u x %u", what.c_str(),
+                     get<std::uint32_t>(in, 32), get<std::uint32_t>(in, 36), hf.width(),
+                     hf.height())};
+  return {};
+}
+
+Result<EditResult> load_edits_from_memory(Terrain& terrain, std::string_view in) {
+  Heightfield& hf = terrain.samples_for_edit();
+  const std::string what = "edit file";
+  if (in.size() < kHeaderBytes + 8)
+    return Error{fmt("%s: %zu bytes; truncated (a valid file has at least %zu)", what.c_str(),
+                     in.size(), kHeaderBytes + 8)};
+  if (auto s = check_edit_header(terrain, in); !s) return Error{s.message()};
+  const auto count = get<std::uint64_t>(in, 40);
+  const std::uint64_t chunks_x = (hf.width() + EditLayer::kChunk - 1) / EditLayer::kChunk;
+  const std::uint64_t chunks_z = (hf.height() + EditLayer::kChunk - 1) / EditLayer::kChunk;
+  if (count > chunks_x * chunks_z)
+    return Error{fmt("%s: %llu chunks; this terrain has only %llu", what.c_str(),
+                     static_cast<unsigned long long>(count),
+                     static_cast<unsigned long long>(chunks_x * chunks_z))};
+  const std::size_t expected = kHeaderBytes + count * kChunkBytes + 8;
+  if (in.size() != expected)
+    return Error{fmt("%s: %zu bytes; %s (%llu chunks need %zu)", what.c_str(), in.size(),
+                     in.size() < expected ? "truncated" : "trailing bytes",
+                     static_cast<unsigned long long>(count), expected)};
+  if (fnv1a(in.data(), in.size() - 8) != get<std::uint64_t>(in, in.size() - 8))
+    return Error{what + ": checksum mismatch (the file is corrupted)"};
+  if (get<std::uint64_t>(in, 48) != 0 || get<std::uint64_t>(in, 56) != 0)
+    return Error{what +
+                 ": reserved header bytes 48..63 are not zero (written by a newer version, "
+                 "or corrupted)"};
+  const EditLimits& lim = terrain.edit_layer().limits;
+  std::uint64_t prev_key = 0;
+  for (std::uint64_t c = 0; c < count; ++c) {
+    const std::size_t at = kHeaderBytes + c * kChunkBytes;
+    const auto cx = get<std::uint32_t>(in, at), cz = get<std::uint32_t>(in, at + 4);
+    if (cx >= chunks_x || cz >= chunks_z)
+      return Error{fmt("%s: chunk %llu at (%u, %u) lies outside the terrain", what.c_str(),
+                       static_cast<unsigned long long>(c), cx, cz)};
+    const std::uint64_t k = EditLayer::key(cx, cz);
+    if (c > 0 && k <= prev_key)
+      return Error{fmt("%s: chunk %llu out of order or repeated", what.c_str(),
+                       static_cast<unsigned long long>(c))};
+    prev_key = k;
+    for (std::size_t v = 0; v < kChunkValues; ++v) {
+      const auto h = get<float>(in, at + 8 + 4 * v);
+      if (!std::isfinite(h) || h < lim.min_height_rel || h > lim.max_height_rel)
+        return Error{fmt("%s: chunk %llu holds height %g, outside the edit limits", what.c_str(),
+                         static_cast<unsigned long long>(c), double(h))};
+    }
+  }
+
+  // Checked: apply. Undo the current edits, then write the saved chunks.
+  EditLayer& layer = terrain.edit_layer();
+  std::vector<float> old(hf.local_heights().begin(), hf.local_heights().end());
+  std::uint32_t ri0 = ~0u, rj0 = ~0u, ri1 = 0, rj1 = 0;  // chunks touched before or after
+  auto cover = [&](std::uint64_t k) {
+    const std::uint32_t i0 = std::uint32_t(k) << EditLayer::kChunkShift,
+                        j0 = std::uint32_t(k >> 32) << EditLayer::kChunkShift;
+    ri0 = std::min(ri0, i0), rj0 = std::min(rj0, j0);
+    ri1 = std::max(ri1, std::min(i0 + EditLayer::kChunk - 1, hf.width() - 1));
+    rj1 = std::max(rj1, std::min(j0 + EditLayer::kChunk - 1, hf.height() - 1));
+  };
+  for (std::uint64_t k : layer.sorted_keys()) cover(k);
+  layer.restore_all(hf);
+  for (std::uint64_t c = 0; c < count; ++c) {
+    const std::size_t at = kHeaderBytes + c * kChunkBytes;
+    const auto cx = get<std::uint32_t>(in, at), cz = get<std::uint32_t>(in, at + 4);
+    cover(EditLayer::key(cx, cz));
+    const std::uint32_t i0 = cx << EditLayer::kChunkShift, j0 = cz << EditLayer::kChunkShift;
+    layer.touch(hf, i0, j0);
+    for (std::uint32_t dj = 0; dj < EditLayer::kChunk && j0 + dj < hf.height(); ++dj)
+      for (std::uint32_t di = 0; di < EditLayer::kChunk && i0 + di < hf.width(); ++di)
+        EditLayer::write(hf, i0 + di, j0 + dj,
+                         get<float>(in, at + 8 + 4 * (di + dj * EditLayer::kChunk)));
+  }
+  SampleChanges changes;
+  for (std::uint32_t j = rj0; ri0 != ~0u && j <= rj1; ++j)
+    for (std::uint32_t i = ri0; i <= ri1; ++i) {
+      const float before = old[i + std::size_t{j} * hf.width()], after = hf.local(i, j);
+      if (std::bit_cast<std::uint32_t>(before) != std::bit_cast<std::uint32_t>(after))
+        changes.add(i, j, before, after);
+    }
+  EditResult r;
+  terrain.commit(changes, r);
+  return r;
+}
+
+Result<EditResult> load_edits(Terrain& terrain, const std::string& path) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return Error{"load edits '" + path + "': " + std::strerror(errno)};
+  std::string bytes;
+  char buf[1 << 16];
+  // Cap: the largest valid file for this terrain plus one chunk.
+  const Heightfield& hf = terrain.heightfield();
+  const std::size_t cap =
+      kHeaderBytes + 8 +
+      (std::size_t((hf.width() + 31) / 32) * ((hf.height() + 31) / 32) + 1) * kChunkBytes;
+  for (;;) {
+    const std::size_t n = std::fread(buf, 1, sizeof buf, f);
+    bytes.append(buf, n);
+    if (bytes.size() > cap) {
+      std::fclose(f);
+      Status why = check_edit_header(terrain, bytes);  // a foreign file says so
+      return Error{
+          "load edits '" + path +
+          "': " + (why ? std::string("larger than any edit file of this terrain") : why.message())};
+    }
+    if (n < sizeof buf) break;
+  }
+  const bool failed = std::ferror(f) != 0;
+  std::fclose(f);
+  if (failed) return Error{"load edits '" + path + "': read error"};
+  auto r = load_edits_from_memory(terrain, bytes);
+  if (!r) return Error{"load edits '" + path + "': " + r.error().message};
+  return r;
+}
+
+}  // namespace ridgeline
