@@ -148,12 +148,16 @@ void check_against_brute_force(std::uint32_t levels) {
   for (std::int64_t j = 0; j < ref.h; ++j)
     for (std::int64_t i = 0; i < ref.w; ++i) {
       ASSERT_NEAR(s.vertex_height(i, j), ref.at(i, j), 1e-5) << i << ", " << j;
+      // The stored surface alone: the height without the vertex's detail.
+      ASSERT_NEAR(s.vertex_base_height(i, j), s.vertex_height(i, j) - s.vertex_detail(i, j), 1e-9)
+          << i << ", " << j;
       if (i % 3 == 0 && j % 2 == 0)
         expect_near(s.vertex_normal(i, j), vertex_normal_ref(ref, i, j), 1e-5, "vertex normal");
     }
   EXPECT_EQ(s.vertex_height(-5, 3), s.vertex_height(0, 3));
   EXPECT_EQ(s.vertex_height(ref.w + 9, ref.h), s.vertex_height(ref.w - 1, ref.h - 1));
   EXPECT_EQ(s.vertex_normal(-1, -1), s.vertex_normal(0, 0));
+  EXPECT_EQ(s.vertex_base_height(-2, ref.h + 4), s.vertex_base_height(0, ref.h - 1));
   if (levels == 0) {
     EXPECT_EQ(s.vertex_detail(3, 4), 0.0);
   }

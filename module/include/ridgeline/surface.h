@@ -194,6 +194,10 @@ class Surface {
   /// Detail alone (metres) at finest-lattice vertex (i, j), clamped into the lattice; 0 without
   /// detail and at stored samples.
   double vertex_detail(std::int64_t i, std::int64_t j) const noexcept;
+  /// The stored surface alone (edits included, no detail) at finest-lattice vertex (i, j),
+  /// clamped into the lattice: vertex_height() - vertex_detail(), what a vertex's height is
+  /// known to be before its detail is.
+  double vertex_base_height(std::int64_t i, std::int64_t j) const noexcept;
   /// Material id of finest-lattice cell (i, j) (that of the stored cell holding it), clamped into
   /// the lattice's cells; 0 when the heightfield has no material layer.
   std::uint8_t cell_material(std::int64_t i, std::int64_t j) const noexcept;

@@ -118,22 +118,7 @@ Landscape::LatticeBox Landscape::box_of(const LatticeTriangle& t) noexcept {
 }
 
 float Landscape::base_lattice_height(std::int64_t i, std::int64_t j) const noexcept {
-  const Heightfield& hf = terrain_->heightfield();
-  const int L = int(detail_);
-  i = std::clamp<std::int64_t>(i, 0, last_i_);
-  j = std::clamp<std::int64_t>(j, 0, last_j_);
-  if (L == 0) return hf.local(std::uint32_t(i), std::uint32_t(j));
-  const std::int64_t mask = (std::int64_t{1} << L) - 1;
-  std::int64_t k = i >> L, m = j >> L, fi = i & mask, fj = j & mask;
-  if (fi == 0 && fj == 0) return hf.local(std::uint32_t(k), std::uint32_t(m));
-  if (k == std::int64_t(hf.width()) - 1) --k, fi = mask + 1;
-  if (m == std::int64_t(hf.height()) - 1) --m, fj = mask + 1;
-  const float fu = std::ldexp(float(fi), -L), fv = std::ldexp(float(fj), -L);  // exact
-  const CellTriangle c = locate_in_cell(k, m, fu, fv);
-  float h = 0;
-  for (int q = 0; q < 3; ++q)
-    h += c.w[q] * hf.local(std::uint32_t(k + c.di[q]), std::uint32_t(m + c.dj[q]));
-  return h;
+  return static_cast<float>(terrain_->surface().vertex_base_height(i, j));
 }
 
 double Landscape::local_extent() const noexcept {

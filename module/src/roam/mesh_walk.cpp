@@ -136,8 +136,8 @@ std::string RoamView::Impl::check() const {
     drawn[patch] += m.padding(t) ? 0 : 1;
     // Links: leaves that link back, through the link their link word names; levels differ by
     // at most one.
-    for (std::uint32_t k = 0; k < 3; ++k) {
-      const std::uint32_t w = nd.link[k];
+    for (std::uint32_t f = 0; f < 3; ++f) {
+      const std::uint32_t w = nd.link[f];
       if (w == kNone) continue;
       const std::uint32_t nb = to(w);
       if (nb >= m.nodes.size() || !m.nodes[nb].leaf()) {
@@ -145,7 +145,7 @@ std::string RoamView::Impl::check() const {
                   static_cast<unsigned long long>(heap), nb);
         return;
       }
-      if (m.nodes[nb].link[back(w)] != link_word(n, k)) {
+      if (m.nodes[nb].link[back(w)] != link_word(n, f)) {
         err = fmt("leaf %u links to %u (its link %u), which does not link back", n, nb, back(w));
         return;
       }

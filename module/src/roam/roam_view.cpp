@@ -351,7 +351,7 @@ void RoamView::Impl::converge_all() {
 // split matters more). Keys are this update's priorities; out-of-view diamonds merge first.
 float RoamView::Impl::converge_budgeted(double threshold, std::uint32_t cap) {
   Impl& m = *this;
-  using Item = Impl::Item;
+  using Item = Impl::QueueItem;
   // The queues are members: an update allocates nothing once they have grown (an allocation
   // after other code gave memory back to the system faults pages in: ~0.5 ms spikes).
   std::vector<Item>& splits = m.split_queue;

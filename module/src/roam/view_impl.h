@@ -54,10 +54,10 @@ struct RoamView::Impl {
   std::vector<std::uint32_t> to_merge, to_split;  // nodes (worklists)
   std::vector<std::uint32_t> next_wave;           // converge_all()'s next wave
   std::vector<roam::Front::Keyed> keyed;  // the pass's changed entries and priorities (budgets)
-  using Item = std::pair<float, std::uint32_t>;  // priority, node
-  std::vector<Item> split_queue, merge_queue;    // converge_budgeted()'s queues
-  std::vector<std::uint32_t> fresh_nodes;        // nodes a budgeted change made or freed
-  std::uint32_t budget_ops = 0;                  // changes the last budgeted update made
+  using QueueItem = std::pair<float, std::uint32_t>;  // priority, node
+  std::vector<QueueItem> split_queue, merge_queue;    // converge_budgeted()'s queues
+  std::vector<std::uint32_t> fresh_nodes;             // nodes a budgeted change made or freed
+  std::uint32_t budget_ops = 0;                       // changes the last budgeted update made
   bool has_deadline = false;
   std::chrono::steady_clock::time_point deadline;
   std::uint32_t clock_checks = 0;

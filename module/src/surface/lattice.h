@@ -29,6 +29,7 @@ struct StoredLattice {
   Height local(std::int64_t i, std::int64_t j) const noexcept {
     return hf.local(std::uint32_t(i), std::uint32_t(j));
   }
+  Height base(std::int64_t i, std::int64_t j) const noexcept { return local(i, j); }
   std::uint8_t material(std::int64_t i, std::int64_t j) const noexcept {
     return hf.material(std::uint32_t(i), std::uint32_t(j));
   }
@@ -45,7 +46,8 @@ struct StoredLattice {
   std::int64_t height() const noexcept { return at.vertices_z; }
 };
 
-/// The finest lattice of a surface with detail.
+/// The finest lattice of a surface with detail. (DetailLattice::local is base + detail; the
+/// vertex's own detail comes from the surface: its cache or its field.)
 struct DetailLattice {
   using Height = double;
   int levels;        ///< L >= 1
@@ -58,6 +60,10 @@ struct DetailLattice {
   /// The stored surface at the vertex (its cell's triangle plane, evaluated exactly: the
   /// vertex's fractions are multiples of 2^-L) plus the detail there.
   Height local(std::int64_t i, std::int64_t j) const noexcept {
+    return base(i, j) + surface.vertex_detail(i, j);
+  }
+  /// The stored surface alone at the vertex.
+  Height base(std::int64_t i, std::int64_t j) const noexcept {
     const std::int64_t mask = (std::int64_t{1} << levels) - 1;
     std::int64_t k = i >> levels, m = j >> levels, fi = i & mask, fj = j & mask;
     // The far edge belongs to the last cell (fraction 1), as in the point queries.
@@ -65,7 +71,7 @@ struct DetailLattice {
     if (m == std::int64_t(hf.height()) - 1) --m, fj = mask + 1;
     const float fu = std::ldexp(float(fi), -levels), fv = std::ldexp(float(fj), -levels);
     const CellPlane plane = cell_plane(hf, k, m, locate_in_cell(k, m, fu, fv));
-    return plane.at(fu, fv) + surface.vertex_detail(i, j);
+    return plane.at(fu, fv);
   }
   std::uint8_t material(std::int64_t i, std::int64_t j) const noexcept {
     return hf.material(std::min(std::uint32_t(i >> levels), hf.width() - 2),

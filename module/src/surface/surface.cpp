@@ -117,6 +117,12 @@ std::uint8_t Surface::cell_material(std::int64_t i, std::int64_t j) const noexce
   return detail::with_lattice(*this, [&](const auto& g) { return g.material(i, j); });
 }
 
+double Surface::vertex_base_height(std::int64_t i, std::int64_t j) const noexcept {
+  i = std::clamp<std::int64_t>(i, 0, lattice_.vertices_x - 1);
+  j = std::clamp<std::int64_t>(j, 0, lattice_.vertices_z - 1);
+  return detail::with_lattice(*this, [&](const auto& g) { return double(g.base(i, j)); });
+}
+
 double Surface::vertex_detail(std::int64_t i, std::int64_t j) const noexcept {
   if (!detail_) return 0.0;
   i = std::clamp<std::int64_t>(i, 0, lattice_.vertices_x - 1);
