@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
-#include <cstring>
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
@@ -206,12 +205,10 @@ FrontCamera FrontCamera::world_metres(double threshold_m) {
 namespace {
 // The four masks of a block as one word: byte 0 split, 1 active, 2 view, 3 valid (Masks).
 inline std::uint32_t word(const Front::Masks& m) noexcept {
-  std::uint32_t w;
-  std::memcpy(&w, &m, 4);
-  return w;
+  return std::bit_cast<std::uint32_t>(m);
 }
 inline void set_word(Front::Masks& m, std::uint32_t w) noexcept {
-  std::memcpy(&m, &w, 4);
+  m = std::bit_cast<Front::Masks>(w);
 }
 constexpr std::uint32_t kLaneBits = 0x01010101u;  // lane 0's bit in each of the four masks
 }  // namespace

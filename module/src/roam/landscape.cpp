@@ -30,7 +30,6 @@
 #include <thread>
 
 #include "format.h"
-#include "memory_hints.h"
 #include "ridgeline/detail.h"
 #include "ridgeline/log.h"
 #include "ridgeline/surface.h"
@@ -583,8 +582,6 @@ Result<std::shared_ptr<const Landscape>> Landscape::create(std::shared_ptr<const
   l->tiles_x_ = (l->stored_w_ + 3) / 4;
   l->records_.assign(std::size_t(l->tiles_x_) * std::size_t((l->stored_h_ + 3) / 4) * 16,
                      VertexRecord{});
-  // Views read the records at random around their cameras: huge pages spare a TLB miss each.
-  detail::advise_huge_pages(l->records_.data(), l->records_.size() * sizeof(VertexRecord));
   if (l->detail_ == 0)
     for (std::int64_t j = 0; j < l->stored_h_; ++j)
       for (std::int64_t i = 0; i < l->stored_w_; ++i)
