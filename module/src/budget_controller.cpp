@@ -67,6 +67,9 @@ Result<BudgetController> BudgetController::create(const BudgetControllerDesc& d)
                  num(d.min_threshold) + ", " + num(d.max_threshold) + "]"};
   if (!std::isfinite(d.deadband) || d.deadband < 0 || d.deadband >= 0.5)
     return Error{"budget controller: deadband " + num(d.deadband) + "; need 0 <= deadband < 0.5"};
+  if (!std::isfinite(d.headroom_gain) || d.headroom_gain < 0)
+    return Error{"budget controller: headroom_gain " + num(d.headroom_gain) +
+                 "; need a finite value >= 0"};
   if (!std::isfinite(d.smoothing_s) || d.smoothing_s < 0)
     return Error{"budget controller: smoothing_s " + num(d.smoothing_s) + "; need >= 0 seconds"};
   if (!finite_positive(d.raise_gain) || !finite_positive(d.lower_gain))
@@ -173,6 +176,11 @@ double BudgetController::update(double frame_ms, double dt_s) noexcept {
   } else if (rel < -desc_.deadband) {
     want = BudgetAction::kLower;
     e = std::min(-rel - desc_.deadband, 1.0);
+  } else if (desc_.headroom_gain > 0 && rel < -desc_.deadband / 2) {
+    // Inside the band, in its lower half: spend the headroom slowly (lower_gain's place taken
+    // by headroom_gain below).
+    want = BudgetAction::kLower;
+    e = -rel * desc_.headroom_gain / desc_.lower_gain;
   }
   // Reversal hold: the opposite error must persist before the direction flips.
   if (want != BudgetAction::kHold && direction_ != BudgetAction::kHold && want != direction_) {
@@ -211,6 +219,13 @@ Status BudgetController::set_deadband(double deadband) {
   if (!std::isfinite(deadband) || deadband < 0 || deadband >= 0.5)
     return Error{"budget controller: deadband " + num(deadband) + "; need 0 <= deadband < 0.5"};
   desc_.deadband = deadband;
+  return {};
+}
+
+Status BudgetController::set_headroom_gain(double gain) {
+  if (!std::isfinite(gain) || gain < 0)
+    return Error{"budget controller: headroom_gain " + num(gain) + "; need a finite value >= 0"};
+  desc_.headroom_gain = gain;
   return {};
 }
 

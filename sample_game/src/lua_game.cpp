@@ -213,15 +213,15 @@ int g_budget(lua_State* L) {
   return 1;
 }
 
-// game.set_budget{controller=, threshold=, render_scale=, target_ms=, deadband=, min=, max=,
-//                 min_scale=, scale_from=, triangles=, tess_ms=}: every field checked before any
+// game.set_budget{controller=, threshold=, render_scale=, target_ms=, deadband=, headroom=, min=,
+//                 max=, min_scale=, scale_from=, triangles=, tess_ms=}: every field checked before any
 //                 applies.
 int g_set_budget(lua_State* L) {
   GameApi& g = game_of(L);
   luaL_checktype(L, 1, LUA_TTABLE);
-  static const char* const kFields[] = {"controller", "threshold", "render_scale", "target_ms",
-                                        "deadband",   "min",       "max",          "min_scale",
-                                        "scale_from", "triangles", "tess_ms",      nullptr};
+  static const char* const kFields[] = {
+      "controller", "threshold",  "render_scale", "target_ms", "deadband", "headroom", "min",
+      "max",        "min_scale",  "scale_from",   "triangles", "tess_ms",  nullptr};
   check_fields(L, 1, kFields);
   ridgeline::BudgetController& c = g.controller();
   BudgetSettings b = g.budget();
@@ -242,6 +242,10 @@ int g_set_budget(lua_State* L) {
   const bool has_deadband = get_number_field(L, 1, "deadband", &deadband);
   if (has_deadband && !(deadband >= 0 && deadband < 0.5))
     luaL_argerror(L, 1, "field 'deadband': 0 .. 0.5 (exclusive) expected, a fraction of the target");
+  double headroom = c.desc().headroom_gain;
+  const bool has_headroom = get_number_field(L, 1, "headroom", &headroom);
+  if (has_headroom && !(headroom >= 0 && headroom <= 100))
+    luaL_argerror(L, 1, "field 'headroom': 0 .. 100 expected (the gain spending headroom; 0: off)");
   const bool has_lo = get_number_field(L, 1, "min", &lo);
   const bool has_hi = get_number_field(L, 1, "max", &hi);
   if ((has_lo || has_hi) && !(lo >= 0.25 && hi <= 256 && lo <= hi))
@@ -266,6 +270,7 @@ int g_set_budget(lua_State* L) {
   // All checked: apply.
   if (has_target) (void)c.set_target_ms(target);
   if (has_deadband) (void)c.set_deadband(deadband);
+  if (has_headroom) (void)c.set_headroom_gain(headroom);
   if (has_lo || has_hi) (void)c.set_range(lo, hi);
   if (has_min_scale || has_from) (void)c.set_render_scale_range(min_scale, scale_from);
   if (has_threshold || has_scale) {

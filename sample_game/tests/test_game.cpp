@@ -211,6 +211,7 @@ TEST(Game, ApiErrorsNameTheProblem) {
   expect_error("game.set_budget{min=8, max=2}", "0.25 <= min <= max");
   expect_error("game.set_budget{deadband=0.5}", "'deadband': 0 .. 0.5");
   expect_error("game.set_budget{deadband='x'}", "deadband");
+  expect_error("game.set_budget{headroom=-1}", "'headroom': 0 .. 100");
   expect_error("game.burn_ms(1000)", "0 .. 100 milliseconds");
   expect_error("game.camera{mode='orbit'}", "'free', 'follow' or 'map' expected, got 'orbit'");
   expect_error("game.crater{x=1, z=1, radius=0}", "'radius'");
@@ -235,8 +236,12 @@ TEST(Game, SetBudgetAndTheController) {
   auto f = g->update_view(50);
   EXPECT_EQ(f.threshold, 6) << "a fixed threshold ignores frame times";
   EXPECT_LE(f.stats.triangles, 20000u);
-  ASSERT_TRUE(g->host().run("game.set_budget{controller=true, target_ms=20, deadband=0.04}", "b").ok());
+  ASSERT_TRUE(g->host()
+                  .run("game.set_budget{controller=true, target_ms=20, deadband=0.04, headroom=2}",
+                       "b")
+                  .ok());
   EXPECT_DOUBLE_EQ(g->controller().desc().deadband, 0.04);
+  EXPECT_DOUBLE_EQ(g->controller().desc().headroom_gain, 2.0);
   for (int i = 0; i < 60; ++i) f = g->update_view(60);
   EXPECT_GT(f.threshold, 6) << "slow frames raise the threshold";
 }

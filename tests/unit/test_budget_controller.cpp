@@ -97,6 +97,59 @@ TEST(BudgetController, ANarrowerBandSettlesCloserToTheTargetFromBelow) {
   EXPECT_EQ(c.state().reversals, 0u);
 }
 
+TEST(BudgetController, HeadroomIsSpentSlowlyAndTheUpperBandStaysDead) {
+  // A frame time that hardly depends on the threshold (31.8 ms plus 1 / threshold): at 4 px it
+  // is 32.05 ms, inside the band (33 x 0.96 = 31.7 ms) from the start, so without headroom_gain
+  // the controller never moves; with it, it lowers the threshold (spends the headroom) until the
+  // smoothed time reaches the band's upper half (33 x 0.98 = 32.34 ms: 1.85 px), without a
+  // reversal.
+  auto flat = [](double threshold) { return 31.8 + 1.0 / threshold; };
+  for (const double gain : {0.0, 2.0}) {
+    BudgetController c = make({.min_threshold = 1.0, .initial_threshold = 4.0,
+                               .deadband = 0.04, .headroom_gain = gain});
+    double ms = 0;
+    for (int i = 0; i < 30 * 60; ++i) {
+      ms = flat(c.threshold());
+      c.update(ms, kDt);
+    }
+    EXPECT_EQ(c.state().reversals, 0u) << "gain " << gain;
+    if (gain == 0) {
+      EXPECT_DOUBLE_EQ(c.threshold(), 4.0);
+    } else {
+      EXPECT_LT(c.threshold(), 2.0);
+      EXPECT_GT(c.threshold(), 1.6);
+      EXPECT_GE(ms, 33.0 * 0.98 - 0.1);
+      EXPECT_LE(ms, 33.0 * 1.04);
+    }
+  }
+  // The steep plant: it enters the band from below and, with the average's lag, ends in the
+  // upper half already; the headroom creep then has nothing to do, and nothing moves later.
+  BudgetController c = make({.deadband = 0.04, .headroom_gain = 2.0});
+  ASSERT_TRUE(c.reset(3.0).ok());
+  run(c, 30, 0, [](double) { return 0.0; });
+  const double settled = c.threshold();
+  const Trace tr = run(c, 30, 30, [](double) { return 0.0; });
+  EXPECT_GE(tr.frame_ms.back(), 33.0 * 0.98 - 0.2);
+  EXPECT_LE(tr.frame_ms.back(), 33.0 * 1.04);
+  EXPECT_NEAR(c.threshold(), settled, settled * 0.02);
+  EXPECT_EQ(c.state().reversals, 0u);
+  // set_headroom_gain() on a running controller: with the default 8 % band the steep plant
+  // stops near 33 x 0.92; with headroom it moves on to the upper half (<= 1 ms from 33).
+  BudgetController d = make();
+  ASSERT_TRUE(d.reset(3.0).ok());
+  run(d, 20, 0, [](double) { return 0.0; });
+  const double held = d.threshold();
+  ASSERT_LT(plant_ms(held, 0), 33.0 * 0.96);
+  ASSERT_TRUE(d.set_headroom_gain(2.0).ok());
+  run(d, 20, 20, [](double) { return 0.0; });
+  EXPECT_LT(d.threshold(), held);
+  EXPECT_GE(plant_ms(d.threshold(), 0), 33.0 * 0.96 - 0.2);
+  EXPECT_EQ(d.state().reversals, 0u);
+  EXPECT_FALSE(d.set_headroom_gain(-1).ok());
+  EXPECT_FALSE(d.set_headroom_gain(std::numeric_limits<double>::quiet_NaN()).ok());
+  EXPECT_EQ(d.desc().headroom_gain, 2.0);
+}
+
 TEST(BudgetController, NoisySteadyLoadDoesNotReverseBackAndForth) {
   BudgetController c = make();
   run(c, 5, 0, [](double) { return 0.0; });
@@ -197,6 +250,11 @@ TEST(BudgetController, RefusesBadSettingsWithTheFieldNamed) {
   d.min_threshold = 4;
   d.max_threshold = 2;
   expect_error(d, "threshold range [4, 2]");
+  d = {};
+  d.headroom_gain = -0.5;
+  expect_error(d, "headroom_gain -0.5");
+  d.headroom_gain = std::numeric_limits<double>::infinity();
+  expect_error(d, "headroom_gain inf");
   d = {};
   d.initial_threshold = 40;
   expect_error(d, "initial_threshold 40");

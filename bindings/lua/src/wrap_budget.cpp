@@ -193,8 +193,8 @@ bool get_count_field(lua_State* L, int arg, const char* name, double lo, double 
 
 }  // namespace
 
-// ridgeline.budget_controller{target_ms=, min=, max=, threshold=, deadband=, smoothing_s=,
-//   raise_gain=, lower_gain=, reverse_hold_s=, warmup_frames=, median_frames=, max_step_s=,
+// ridgeline.budget_controller{target_ms=, min=, max=, threshold=, deadband=, headroom_gain=,
+//   smoothing_s=, raise_gain=, lower_gain=, reverse_hold_s=, warmup_frames=, median_frames=, max_step_s=,
 //   min_render_scale=, render_scale_from=} -> controller; bad settings raise an error naming
 //   the field (through BudgetController::create's message).
 int new_budget_controller(lua_State* L) {
@@ -203,6 +203,7 @@ int new_budget_controller(lua_State* L) {
                                         "max",
                                         "threshold",
                                         "deadband",
+                                        "headroom_gain",
                                         "smoothing_s",
                                         "raise_gain",
                                         "lower_gain",
@@ -226,6 +227,7 @@ int new_budget_controller(lua_State* L) {
               ? d.min_threshold
               : (d.initial_threshold > d.max_threshold ? d.max_threshold : d.initial_threshold);
     get_number_field(L, 1, "deadband", &d.deadband);
+    get_number_field(L, 1, "headroom_gain", &d.headroom_gain);
     get_number_field(L, 1, "smoothing_s", &d.smoothing_s);
     get_number_field(L, 1, "raise_gain", &d.raise_gain);
     get_number_field(L, 1, "lower_gain", &d.lower_gain);

@@ -21,6 +21,14 @@ struct BudgetControllerDesc {
   /// Hysteresis band, a fraction of the target in [0, 0.5): while the smoothed frame time stays
   /// within target * (1 +- deadband) nothing moves.
   double deadband = 0.08;
+  /// Spending headroom: while the smoothed frame time is inside the band but below
+  /// target * (1 - deadband / 2), the quality still rises, slowly: per second the quality level
+  /// moves by headroom_gain * (1 - smoothed / target). Without it (0, the default) the controller
+  /// stops wherever the frame time enters the band, which on a scene whose frame time hardly
+  /// depends on the threshold can be far above the threshold the frame could afford. The upper
+  /// part of the band, target * (1 - deadband / 2) .. target * (1 + deadband), stays dead, so the
+  /// creep never ends in an oscillation. Finite, >= 0.
+  double headroom_gain = 0.0;
   /// Time constant of the exponential moving average of frame times, seconds; >= 0 (0: no
   /// smoothing).
   double smoothing_s = 0.25;
@@ -119,6 +127,8 @@ class BudgetController {
   /// is kept. A narrower band settles closer to the target (the controller stops wherever the
   /// smoothed frame time enters the band), at the price of reacting to smaller swings.
   Status set_deadband(double deadband);
+  /// Changes headroom_gain (finite, >= 0); the state is kept.
+  Status set_headroom_gain(double gain);
   /// Changes the threshold range; the current threshold is clamped into it (that is the point),
   /// as is render_scale_from_px when it was set.
   Status set_range(double min_threshold, double max_threshold);
