@@ -73,8 +73,9 @@ float screen_pass_scalar(Front::Hot* hot, std::size_t nb, const FrontCamera& c,
     if (changed == nullptr) continue;
     for (std::uint32_t d = std::uint32_t(h.m.active ^ h.m.split) & h.m.valid; d != 0; d &= d - 1) {
       const std::uint32_t l = std::uint32_t(__builtin_ctz(d));
-      changed->push_back(
-          {(h.m.view >> l) & 1 ? p[l] : -1.0f, std::uint32_t(b) * Front::kLanes + l});
+      changed->push_back({(h.m.view >> l) & 1 ? p[l] : -1.0f,
+                          (std::uint32_t(b) * Front::kLanes + l) |
+                              (((h.m.split >> l) & 1u) << 31)});
     }
   }
   return worst;
@@ -141,8 +142,9 @@ __attribute__((target("avx2"))) float screen_pass_avx2(Front::Hot* hot, std::siz
         _mm256_store_ps(pk, _mm256_div_ps(_mm256_mul_ps(mu, scale), den));
         for (std::uint32_t x = d; x != 0; x &= x - 1) {
           const std::uint32_t l = std::uint32_t(__builtin_ctz(x));
-          changed->push_back(
-              {(view_bits >> l) & 1 ? pk[l] : -1.0f, std::uint32_t(b) * Front::kLanes + l});
+          changed->push_back({(view_bits >> l) & 1 ? pk[l] : -1.0f,
+                              (std::uint32_t(b) * Front::kLanes + l) |
+                                  (((hot[b].m.split >> l) & 1u) << 31)});
         }
       }
     }
@@ -281,7 +283,8 @@ float Front::evaluate(const FrontCamera& c, std::vector<Keyed>* changed) {
       const std::uint32_t t = world_test(mu(e), radius(e), c, &p);
       set_result(e, t);
       if (!(t & kActive)) worst = std::max(worst, p);
-      if (changed != nullptr && bool(t & kActive) != split(e)) changed->push_back({p, e});
+      if (changed != nullptr && bool(t & kActive) != split(e))
+        changed->push_back({p, e | (split(e) ? kKeyedSplit : 0u)});
     }
     return worst;
   }

@@ -143,11 +143,13 @@ class Front {
   void clear() noexcept;
 
   /// An entry whose test disagrees with its state, and its priority (-1 for a merge candidate
-  /// out of view).
+  /// out of view). `entry` carries kKeyedSplit when the entry is split (a merge candidate), so
+  /// the queues can be chosen without reading the entry's record.
   struct Keyed {
     float key;
     std::uint32_t entry;
   };
+  static constexpr std::uint32_t kKeyedSplit = 1u << 31;
   /// Tests every entry for `c` (result() of each). Returns the largest priority of an entry in
   /// view whose test fails (0 when none). With `changed`, also lists the entries whose test
   /// disagrees with their state with their priorities, computed in the same pass.
