@@ -131,33 +131,31 @@ __attribute__((target("avx2"))) float screen_pass_avx2(Front::Hot* hot, std::siz
     const auto view_bits = std::uint32_t(_mm256_movemask_ps(in)) & valid;
     hot[b].m.active = std::uint8_t(act_bits);
     hot[b].m.view = std::uint8_t(view_bits);
-    if (changed != nullptr) {
-      // The priorities of the lanes whose test disagrees with their state (the budgeted
-      // update's queues), computed here for all eight lanes at once.
-      const std::uint32_t d = (act_bits ^ hot[b].m.split) & valid;
-      if (d != 0) {
-        __m256 den = _mm256_sub_ps(_mm256_sqrt_ps(d2), r);
-        den = _mm256_max_ps(den, near);
-        alignas(32) float pk[8];
-        _mm256_store_ps(pk, _mm256_div_ps(_mm256_mul_ps(mu, scale), den));
-        for (std::uint32_t x = d; x != 0; x &= x - 1) {
-          const std::uint32_t l = std::uint32_t(__builtin_ctz(x));
-          changed->push_back({(view_bits >> l) & 1 ? pk[l] : -1.0f,
-                              (std::uint32_t(b) * Front::kLanes + l) |
-                                  (((hot[b].m.split >> l) & 1u) << 31)});
-        }
-      }
-    }
+    // Lanes whose test disagrees with their state (their priorities go to the budgeted update's
+    // queues), and whether a failing lane in view may raise the worst priority: the eight
+    // priorities (a square root and a division) are computed once, only for a block that needs
+    // them.
+    const std::uint32_t d = changed != nullptr ? (act_bits ^ hot[b].m.split) & valid : 0u;
     const std::uint32_t q = view_bits & ~act_bits;  // in view, the test failed
-    if (q == 0) continue;
-    const __m256 a = _mm256_add_ps(_mm256_mul_ps(mu, kw), r);
-    if ((std::uint32_t(_mm256_movemask_ps(_mm256_cmp_ps(_mm256_mul_ps(a, a), d2, _CMP_GT_OQ))) &
-         q) == 0)
-      continue;
+    bool candidate = false;
+    if (q != 0) {
+      const __m256 a = _mm256_add_ps(_mm256_mul_ps(mu, kw), r);
+      candidate =
+          (std::uint32_t(_mm256_movemask_ps(_mm256_cmp_ps(_mm256_mul_ps(a, a), d2, _CMP_GT_OQ))) &
+           q) != 0;
+    }
+    if (d == 0 && !candidate) continue;
     __m256 den = _mm256_sub_ps(_mm256_sqrt_ps(d2), r);
     den = _mm256_max_ps(den, near);  // den > near ? den : near, as the scalar test
     alignas(32) float p[8];
     _mm256_store_ps(p, _mm256_div_ps(_mm256_mul_ps(mu, scale), den));
+    for (std::uint32_t x = d; x != 0; x &= x - 1) {
+      const std::uint32_t l = std::uint32_t(__builtin_ctz(x));
+      changed->push_back({(view_bits >> l) & 1 ? p[l] : -1.0f,
+                          (std::uint32_t(b) * Front::kLanes + l) |
+                              (((hot[b].m.split >> l) & 1u) << 31)});
+    }
+    if (!candidate) continue;
     for (std::uint32_t l = 0; l < Front::kLanes; ++l)
       if (((q >> l) & 1) && p[l] > w) w = p[l];
     kw = _mm256_set1_ps(w > 0.0f ? c.scale / w * (1.0f + 0x1p-20f) : INFINITY);

@@ -541,7 +541,8 @@ float RoamView::Impl::converge_budgeted(double threshold, std::uint32_t cap) {
 }
 
 void RoamView::Impl::split_border() {
-  std::vector<std::uint32_t> work;
+  std::vector<std::uint32_t>& work = next_wave;  // free here (converge_all()'s), kept memory
+  work.clear();
   for (std::uint32_t e = 0; e < front.size(); ++e)
     if (!front.split(e) && (front.result(e) & kActive) && front.radius(e) >= Front::kBorderRadius)
       work.push_back(front.node(e));
