@@ -168,19 +168,19 @@ double BudgetController::update(double frame_ms, double dt_s) noexcept {
     state_.smoothed_ms += alpha * (filtered - state_.smoothed_ms);
   }
   const double rel = state_.smoothed_ms / desc_.target_ms - 1.0;
+  // rate: how far the quality level moves per second (gain x relative error).
   BudgetAction want = BudgetAction::kHold;
-  double e = 0;
+  double rate = 0;
   if (rel > desc_.deadband) {
     want = BudgetAction::kRaise;
-    e = std::min(rel - desc_.deadband, 2.0);
+    rate = desc_.raise_gain * std::min(rel - desc_.deadband, 2.0);
   } else if (rel < -desc_.deadband) {
     want = BudgetAction::kLower;
-    e = std::min(-rel - desc_.deadband, 1.0);
+    rate = desc_.lower_gain * std::min(-rel - desc_.deadband, 1.0);
   } else if (desc_.headroom_gain > 0 && rel < -desc_.deadband / 2) {
-    // Inside the band, in its lower half: spend the headroom slowly (lower_gain's place taken
-    // by headroom_gain below).
+    // Inside the band, in its lower half: spend the headroom slowly.
     want = BudgetAction::kLower;
-    e = -rel * desc_.headroom_gain / desc_.lower_gain;
+    rate = desc_.headroom_gain * -rel;
   }
   // Reversal hold: the opposite error must persist before the direction flips.
   if (want != BudgetAction::kHold && direction_ != BudgetAction::kHold && want != direction_) {
@@ -191,9 +191,9 @@ double BudgetController::update(double frame_ms, double dt_s) noexcept {
   }
   const double before = x_;
   if (want == BudgetAction::kRaise && !state_.at_max) {
-    x_ += desc_.raise_gain * e * dt;
+    x_ += rate * dt;
   } else if (want == BudgetAction::kLower && !state_.at_min) {
-    x_ -= desc_.lower_gain * e * dt;
+    x_ -= rate * dt;
   } else {
     want = BudgetAction::kHold;  // nothing to move (at a limit)
   }
