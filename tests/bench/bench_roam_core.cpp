@@ -20,11 +20,12 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <ctime>
 #include <string>
 #include <vector>
 
+#include "cli_util.h"
 #include "report/soar.h"
+#include "report/stats.h"
 #include "ridgeline/roam_view.h"
 #include "ridgeline/scenes.h"
 
@@ -39,16 +40,11 @@ using namespace ridgeline;
 
 namespace {
 
-double thread_cpu_ms() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
-}
+double thread_cpu_ms() { return cli::thread_cpu_ns() * 1e-6; }
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
+// The median as `ridge bench lod` and the report take it (0 when there is nothing).
+double median(const std::vector<double>& v) {
+  return v.empty() ? 0.0 : report::quantile(v, 0.5);
 }
 
 struct Sample {
