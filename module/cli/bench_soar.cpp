@@ -89,17 +89,20 @@ int run_bench_lod_soar(const SoarBenchArgs& a) {
     for (std::size_t k = 0; k < cams.size(); ++k) {
       const Camera& c = cams[k];
       const double kappa = kappa_of(c);
+      const long faults0 = thread_minor_faults();
       const double cpu0 = thread_cpu_ns();
       const auto t0 = Clock::now();
       const report::Soar::Frame f = soar.refine(c, kappa, strip);
       const double wall_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
       const double cpu_ms = (thread_cpu_ns() - cpu0) * 1e-6;
+      const long faults = thread_minor_faults() - faults0;
       // The same refinement without emitting: what the strip costs is the difference.
       const auto t1 = Clock::now();
       (void)soar.count(c, kappa);
       const double count_ms = std::chrono::duration<double, std::milli>(Clock::now() - t1).count();
       nlohmann::ordered_json fj = {{"update_ms", wall_ms},
                                    {"update_cpu_ms", cpu_ms},
+                                   {"page_faults", faults},
                                    {"refine_only_ms", count_ms},
                                    {"output_ms", 0.0},
                                    {"upload_bytes", strip.size() * sizeof(std::uint32_t)},

@@ -4,6 +4,7 @@
 #include <malloc.h>
 #endif
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <charconv>
@@ -167,6 +168,12 @@ double thread_cpu_ns() {
   timespec ts{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
   return double(ts.tv_sec) * 1e9 + double(ts.tv_nsec);
+}
+
+long thread_minor_faults() {
+  rusage u{};
+  getrusage(RUSAGE_THREAD, &u);
+  return u.ru_minflt;
 }
 
 }  // namespace ridgeline::cli

@@ -56,6 +56,10 @@ Status check_output_folder(const std::string& path, const std::string& what);
 /// CPU time of the calling thread, nanoseconds (CLOCK_THREAD_CPUTIME_ID): unlike wall time it
 /// does not count the time the thread waits for a core, which on a shared machine can dominate.
 double thread_cpu_ns();
+/// Minor page faults of the calling thread so far (getrusage): a fresh page costs the first
+/// write to it ~11 us on this project's virtual machines, so a first update's time is mostly
+/// its faults (docs/benchmarks.md).
+long thread_minor_faults();
 /// For benchmarks that time one piece of work per frame and measure it between frames: keeps
 /// the memory the measurement frees inside the process (glibc: no unmapping, no trimming).
 /// Otherwise a measurement that frees a large buffer unmaps it, which flushes the TLB, and the

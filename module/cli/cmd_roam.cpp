@@ -273,9 +273,11 @@ int run_bench_lod(const BenchLodArgs& a) {
       const Camera& c = (*frames)[k].camera;
       // CPU time of this thread as well as the wall time update() reports: on a shared machine
       // the difference is time the update was preempted, which no budget can keep.
+      const long faults0 = thread_minor_faults();
       const double cpu0 = thread_cpu_ns();
       auto st = v.update(c);
       const double cpu1 = thread_cpu_ns();
+      const long faults = thread_minor_faults() - faults0;
       if (!st) return report_error(st.error().message);
       // The output an engine uploads: the update keeps the patch buffers in step; what is left
       // is taking the dirty patches and their ranges.
@@ -288,6 +290,7 @@ int run_bench_lod(const BenchLodArgs& a) {
       const std::uint64_t visible = triangles_in_view(v, c);
       nlohmann::ordered_json f = {{"update_ms", st->update_ms},
                                   {"update_cpu_ms", cpu_ms},
+                                  {"page_faults", faults},
                                   {"output_ms", o_ms},
                                   {"output_cpu_ms", o_cpu},
                                   {"triangles", st->triangles},

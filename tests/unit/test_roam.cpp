@@ -16,6 +16,7 @@
 
 #include "ridgeline/roam_view.h"
 #include "roam/diamond.h"
+#include "roam/front.h"
 #include "roam_test_util.h"
 
 using namespace ridgeline;
@@ -783,4 +784,63 @@ TEST(Diamond, GeometryMatchesTheBintree) {
       ASSERT_TRUE((p0x == t.ax && p0z == t.az) || (p1x == t.ax && p1z == t.az))
           << "root " << root << " heap " << h;
     }
+}
+
+// The front's storage in fixed chunks: entries added and removed (the last moved into the hole)
+// across several chunk boundaries keep their data and state, the pass agrees with the test of one
+// entry, and trimming gives back the chunks a peak left.
+TEST(Front, ChunkedStorageKeepsEntriesAcrossChunks) {
+  struct Ref {
+    std::int32_t i, j;
+    float x, y, z, mu, r;
+    std::uint32_t node;
+    bool split;
+  };
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> pos(-500.0f, 500.0f), bound(0.0f, 4.0f);
+  roam::Front f;
+  std::vector<Ref> ref;
+  auto add = [&] {
+    const Ref e{std::int32_t(rng() % 4096), std::int32_t(rng() % 4096), pos(rng), pos(rng) * 0.1f,
+                pos(rng), bound(rng), bound(rng) * 8.0f, std::uint32_t(ref.size()),
+                (rng() & 1) != 0};
+    ASSERT_EQ(f.add(e.i, e.j, 4, 0, 3, e.x, e.y, e.z, e.mu, e.r, e.node, e.split, false),
+              ref.size());
+    ref.push_back(e);
+  };
+  auto remove = [&](std::uint32_t e) {
+    const std::uint32_t moved = f.remove(e);
+    ASSERT_EQ(moved, ref.size() - 1);
+    ref[e] = ref.back();
+    ref.pop_back();
+  };
+  const std::uint32_t chunk = roam::Front::kChunkBlocks * roam::Front::kLanes;
+  for (std::uint32_t k = 0; k < 3 * chunk + 77; ++k) add();
+  const std::size_t peak_bytes = f.memory_bytes();
+  for (std::uint32_t k = 0; k < 2 * chunk; ++k) remove(std::uint32_t(rng() % ref.size()));
+  for (std::uint32_t k = 0; k < 300; ++k) add();
+  ASSERT_EQ(f.size(), ref.size());
+  Camera cam;
+  cam.eye = {10.0, 80.0, -30.0};
+  cam.target = {40.0, 20.0, 70.0};
+  const roam::FrontCamera c = roam::FrontCamera::screen(cam, 1.0, 0, 0, 0, 1, 1, 5000);
+  f.evaluate(c);
+  for (std::uint32_t e = 0; e < f.size(); ++e) {
+    const Ref& r = ref[e];
+    ASSERT_EQ(f.ci(e), r.i) << e;
+    ASSERT_EQ(f.cj(e), r.j) << e;
+    ASSERT_EQ(f.node(e), r.node) << e;
+    ASSERT_EQ(f.split(e), r.split) << e;
+    ASSERT_EQ(f.y(e), r.y) << e;
+    ASSERT_EQ(f.mu(e), r.mu) << e;
+    ASSERT_EQ(f.radius(e), r.r) << e;
+    const std::uint8_t pass = f.result(e);
+    ASSERT_EQ(f.test_one(e, c), pass) << e;  // bit for bit, in whichever chunk
+  }
+  f.trim();
+  EXPECT_LT(f.memory_bytes(), peak_bytes);
+  // A spare chunk is kept; everything else beyond the entries in use is given back (four
+  // chunks at the peak, plus the array of their pointers).
+  const std::size_t chunk_bytes = peak_bytes / 4;
+  EXPECT_LE(f.memory_bytes(), ((ref.size() + chunk - 1) / chunk + 1) * chunk_bytes + 64);
 }

@@ -55,9 +55,10 @@ inline std::uint32_t world_test(float mu, float r, const FrontCamera& c, float* 
 }
 
 // The pass without vector instructions: the scalar test lane by lane.
-float screen_pass_scalar(Front::Hot* hot, std::size_t nb, const FrontCamera& c,
-                         std::vector<Front::Keyed>* changed) {
-  float worst = 0.0f;
+// Blocks [0, nb) of one chunk, whose first block is block `first` of the front; `worst` is the
+// largest failing priority in view so far (the chunks before).
+float screen_pass_scalar(Front::Hot* hot, std::size_t nb, std::uint32_t first,
+                         const FrontCamera& c, std::vector<Front::Keyed>* changed, float worst) {
   for (std::size_t b = 0; b < nb; ++b) {
     Front::Hot& h = hot[b];
     std::uint32_t act = 0, view = 0;
@@ -74,7 +75,7 @@ float screen_pass_scalar(Front::Hot* hot, std::size_t nb, const FrontCamera& c,
     for (std::uint32_t d = std::uint32_t(h.m.active ^ h.m.split) & h.m.valid; d != 0; d &= d - 1) {
       const std::uint32_t l = std::uint32_t(__builtin_ctz(d));
       changed->push_back({(h.m.view >> l) & 1 ? p[l] : -1.0f,
-                          (std::uint32_t(b) * Front::kLanes + l) |
+                          ((first + std::uint32_t(b)) * Front::kLanes + l) |
                               (((h.m.split >> l) & 1u) << 31)});
     }
   }
@@ -85,8 +86,10 @@ float screen_pass_scalar(Front::Hot* hot, std::size_t nb, const FrontCamera& c,
 // Eight lanes at a time, the same operations as screen_test() in the same order (no fused
 // multiply-adds). Writes only the masks.
 __attribute__((target("avx2"))) float screen_pass_avx2(Front::Hot* hot, std::size_t nb,
+                                                       std::uint32_t first,
                                                        const FrontCamera& c,
-                                                       std::vector<Front::Keyed>* changed) {
+                                                       std::vector<Front::Keyed>* changed,
+                                                       float w) {
   const __m256 ex = _mm256_set1_ps(c.ex), ey = _mm256_set1_ps(c.ey), ez = _mm256_set1_ps(c.ez);
   const __m256 kappa = _mm256_set1_ps(c.kappa), margin = _mm256_set1_ps(c.margin);
   const __m256 zero = _mm256_setzero_ps(), border = _mm256_set1_ps(Front::kBorderRadius);
@@ -101,8 +104,8 @@ __attribute__((target("avx2"))) float screen_pass_avx2(Front::Hot* hot, std::siz
   // passes (for d - r > near directly, and for d - r <= near because then mu K / w > near,
   // so mu K / w + r > d). Only blocks with a candidate compute priorities; w climbs to its
   // final value within the first blocks, so that is rare.
-  float w = 0.0f;
-  __m256 kw = _mm256_set1_ps(INFINITY);  // K / w, generous by 2^-20
+  __m256 kw = _mm256_set1_ps(w > 0.0f ? c.scale / w * (1.0f + 0x1p-20f)
+                                      : INFINITY);  // K / w, generous by 2^-20
   for (std::size_t b = 0; b < nb; ++b) {
     Front::Hot& h = hot[b];
     const __m256 dx = _mm256_sub_ps(_mm256_load_ps(h.x), ex);
@@ -152,7 +155,7 @@ __attribute__((target("avx2"))) float screen_pass_avx2(Front::Hot* hot, std::siz
     for (std::uint32_t x = d; x != 0; x &= x - 1) {
       const std::uint32_t l = std::uint32_t(__builtin_ctz(x));
       changed->push_back({(view_bits >> l) & 1 ? p[l] : -1.0f,
-                          (std::uint32_t(b) * Front::kLanes + l) |
+                          ((first + std::uint32_t(b)) * Front::kLanes + l) |
                               (((hot[b].m.split >> l) & 1u) << 31)});
     }
     if (!candidate) continue;
@@ -218,20 +221,17 @@ std::uint32_t Front::add(std::int32_t i, std::int32_t j, std::int32_t hu, std::i
                          std::uint32_t node, bool split, bool provisional) {
   const std::uint32_t e = n_++;
   const std::uint32_t l = e & 7;
-  if (l == 0 && (e >> 3) >= hot_.size()) {
-    // Grow by a quarter, not double: the front is most of a view's memory after the nodes.
-    if (hot_.size() == hot_.capacity()) {
-      const std::size_t cap = std::max<std::size_t>(128, hot_.size() + hot_.size() / 4);
-      hot_.reserve(cap);
-      cold_.reserve(cap * kLanes);
-    }
-    hot_.emplace_back();
+  if (l == 0) {
+    // A new block (zero bound and radius in its free lanes: never active), in a new chunk
+    // when the last one is full.
+    if (e / kChunkEntries >= chunks_.size()) chunks_.emplace_back(new Chunk);
+    block(e >> 3) = Hot{};
   }
-  Hot& h = hot_[e >> 3];
+  Hot& h = block(e >> 3);
   h.x[l] = x, h.y[l] = y, h.z[l] = z, h.mu[l] = mu, h.r[l] = r;
   // The half hypotenuse's kind: (s, 0), (0, -s), (-s, -s), (s, -s) (canonical: diamond.h).
   const std::uint32_t kind = hw == 0 ? 0u : hu == 0 ? 1u : hu < 0 ? 2u : 3u;
-  cold_.push_back({i, j, node, (t << 8) | (kind << 1) | (provisional ? 1u : 0u)});
+  cold(e) = {i, j, node, (t << 8) | (kind << 1) | (provisional ? 1u : 0u)};
   // valid, not active nor in view yet, split as given.
   const std::uint32_t w = word(h.m) & ~(kLaneBits << l);
   set_word(h.m, w | ((0x01000000u | std::uint32_t(split)) << l));
@@ -241,30 +241,29 @@ std::uint32_t Front::add(std::int32_t i, std::int32_t j, std::int32_t hu, std::i
 std::uint32_t Front::remove(std::uint32_t e) noexcept {
   const std::uint32_t last = --n_;
   const std::uint32_t a = e & 7, b = last & 7;
-  Hot& sh = hot_[last >> 3];
+  Hot& sh = block(last >> 3);
   if (e != last) {
-    Hot& dh = hot_[e >> 3];
+    Hot& dh = block(e >> 3);
     dh.x[a] = sh.x[b], dh.y[a] = sh.y[b], dh.z[a] = sh.z[b], dh.mu[a] = sh.mu[b], dh.r[a] = sh.r[b];
-    cold_[e] = cold_[last];
+    cold(e) = cold(last);
     const std::uint32_t moved = (word(sh.m) >> b) & kLaneBits;
     set_word(dh.m, (word(dh.m) & ~(kLaneBits << a)) | (moved << a));
   }
   // The freed lane: zero bound and radius (never active), outside every mask.
   sh.x[b] = sh.y[b] = sh.z[b] = sh.mu[b] = sh.r[b] = 0.0f;
   set_word(sh.m, word(sh.m) & ~(kLaneBits << b));
-  cold_.pop_back();
-  if (b == 0) hot_.pop_back();
   return last;
 }
 
-void Front::clear() noexcept {
-  n_ = 0;
-  hot_.clear();
-  cold_.clear();
+void Front::clear() noexcept { n_ = 0; }
+
+void Front::trim() noexcept {
+  const std::size_t used = (n_ + kChunkEntries - 1) / kChunkEntries;
+  while (chunks_.size() > used + 1) chunks_.pop_back();
 }
 
 void Front::set_result(std::uint32_t e, std::uint32_t bits) noexcept {
-  Masks& m = hot_[e >> 3].m;
+  Masks& m = block(e >> 3).m;
   const std::uint32_t l = e & 7;
   // bits: kActive (1) -> byte 1, kInView (2) -> byte 2.
   const std::uint32_t set = ((bits & kActive) << 8 | (bits & kInView) << 15) << l;
@@ -286,14 +285,23 @@ float Front::evaluate(const FrontCamera& c, std::vector<Keyed>* changed) {
     }
     return worst;
   }
+  float worst = 0.0f;
+  for (std::uint32_t first = 0; first < nb; first += kChunkBlocks) {
+    Hot* hot = chunks_[first >> kChunkShift]->hot;
+    const std::size_t n = std::min<std::size_t>(kChunkBlocks, nb - first);
 #ifdef RIDGELINE_FRONT_AVX2
-  if (have_avx2()) return screen_pass_avx2(hot_.data(), nb, c, changed);
+    if (have_avx2()) {
+      worst = screen_pass_avx2(hot, n, first, c, changed, worst);
+      continue;
+    }
 #endif
-  return screen_pass_scalar(hot_.data(), nb, c, changed);
+    worst = screen_pass_scalar(hot, n, first, c, changed, worst);
+  }
+  return worst;
 }
 
 std::uint8_t Front::test_one(std::uint32_t e, const FrontCamera& c, float* priority) noexcept {
-  const Hot& h = hot_[e >> 3];
+  const Hot& h = block(e >> 3);
   const std::uint32_t l = e & 7;
   const std::uint32_t t = c.world
                               ? world_test(h.mu[l], h.r[l], c, priority)
@@ -303,7 +311,7 @@ std::uint8_t Front::test_one(std::uint32_t e, const FrontCamera& c, float* prior
 }
 
 float Front::priority(std::uint32_t e, const FrontCamera& c) const noexcept {
-  const Hot& h = hot_[e >> 3];
+  const Hot& h = block(e >> 3);
   const std::uint32_t l = e & 7;
   float p = 0;
   if (c.world)
@@ -324,7 +332,7 @@ float Front::max_unsplit_priority(const FrontCamera& c) const noexcept {
 }
 
 std::size_t Front::memory_bytes() const noexcept {
-  return hot_.capacity() * sizeof(Hot) + cold_.capacity() * sizeof(Cold);
+  return chunks_.size() * sizeof(Chunk) + chunks_.capacity() * sizeof(chunks_[0]);
 }
 
 }  // namespace ridgeline::roam

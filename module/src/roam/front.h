@@ -14,10 +14,14 @@
 // the changes read (lattice indices, geometry, node, flags) is one 16-byte record per entry.
 // The pass writes nothing per entry: its results are two bytes per block (which lanes are
 // active, which in view), beside a byte of which lanes are split. So a pass streams 20 bytes per
-// entry, and an entry costs 40 bytes in all.
+// entry, and an entry costs 40 bytes in all. Blocks and records live in fixed chunks of 2,048
+// entries (80 KiB) that never move: growing copies nothing (a vector's growth copied the whole
+// front inside an update and faulted in a new copy), and the unused capacity is under one chunk
+// plus one spare.
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "memory_hints.h"
@@ -82,11 +86,14 @@ class Front {
   };
   static_assert(sizeof(Cold) == 16);
 
+  /// Blocks per chunk (a power of two).
+  static constexpr std::uint32_t kChunkBlocks = 256;
+
   std::uint32_t size() const noexcept { return n_; }
   std::uint32_t blocks() const noexcept { return (n_ + kLanes - 1) / kLanes; }
   bool split(std::uint32_t e) const noexcept { return (mask(e).split >> (e & 7)) & 1; }
   void set_split(std::uint32_t e, bool s) noexcept {
-    std::uint8_t& m = hot_[e >> 3].m.split;
+    std::uint8_t& m = block(e >> 3).m.split;
     m = s ? std::uint8_t(m | (1u << (e & 7))) : std::uint8_t(m & ~(1u << (e & 7)));
   }
   /// A detail vertex whose height is not known yet (its tile not resident): its sphere is
@@ -112,9 +119,9 @@ class Front {
   std::int32_t hw(std::uint32_t e) const noexcept {
     return ((cold(e).code >> 1) & 3) == 0 ? 0 : -(std::int32_t{1} << t(e));
   }
-  float y(std::uint32_t e) const noexcept { return hot_[e >> 3].y[e & 7]; }
-  float mu(std::uint32_t e) const noexcept { return hot_[e >> 3].mu[e & 7]; }
-  float radius(std::uint32_t e) const noexcept { return hot_[e >> 3].r[e & 7]; }
+  float y(std::uint32_t e) const noexcept { return block(e >> 3).y[e & 7]; }
+  float mu(std::uint32_t e) const noexcept { return block(e >> 3).mu[e & 7]; }
+  float radius(std::uint32_t e) const noexcept { return block(e >> 3).r[e & 7]; }
   /// kActive, kInView of the last evaluate() or test_one().
   std::uint8_t result(std::uint32_t e) const noexcept {
     const Masks& m = mask(e);
@@ -133,7 +140,7 @@ class Front {
                     std::uint32_t node, bool split, bool provisional);
   /// Rewrites an entry's data (after an edit or a tile's arrival).
   void set_data(std::uint32_t e, float y, float mu, float r) noexcept {
-    Hot& h = hot_[e >> 3];
+    Hot& h = block(e >> 3);
     h.y[e & 7] = y, h.mu[e & 7] = mu, h.r[e & 7] = r;
   }
   /// Removes entry `e` by moving the last entry into its place; returns the old index of the
@@ -141,6 +148,9 @@ class Front {
   std::uint32_t remove(std::uint32_t e) noexcept;
   /// Empties the front; keeps the memory.
   void clear() noexcept;
+  /// Frees the chunks beyond the one spare after those in use (the capacity a rebuild's peak
+  /// left).
+  void trim() noexcept;
 
   /// An entry whose test disagrees with its state, and its priority (-1 for a merge candidate
   /// out of view). `entry` carries kKeyedSplit when the entry is split (a merge candidate), so
@@ -164,15 +174,15 @@ class Front {
   /// Lanes of block b whose last test disagrees with their state (active and unsplit, or split
   /// and inactive).
   std::uint32_t changed(std::uint32_t b) const noexcept {
-    const Masks& m = hot_[b].m;
+    const Masks& m = block(b).m;
     return std::uint32_t((m.active ^ m.split) & m.valid);
   }
   /// Hints the caches to fetch what a change of entry e reads: its cold record and its lane
   /// of the block (three lines: height, bound, radius and the masks).
   void prefetch(std::uint32_t e) const noexcept {
     e = e < n_ ? e : 0;
-    detail::prefetch(cold_.data() + e);
-    const char* h = reinterpret_cast<const char*>(hot_.data() + (e >> 3));
+    detail::prefetch(&cold(e));
+    const char* h = reinterpret_cast<const char*>(&block(e >> 3));
     detail::prefetch(h);
     detail::prefetch(h + 64);
     detail::prefetch(h + 128);
@@ -182,14 +192,29 @@ class Front {
   std::size_t memory_bytes() const noexcept;
 
  private:
-  const Cold& cold(std::uint32_t e) const noexcept { return cold_[e]; }
-  Cold& cold(std::uint32_t e) noexcept { return cold_[e]; }
-  const Masks& mask(std::uint32_t e) const noexcept { return hot_[e >> 3].m; }
+  static constexpr std::uint32_t kChunkShift = 8;  // log2 kChunkBlocks
+  static_assert(kChunkBlocks == 1u << kChunkShift);
+  static constexpr std::uint32_t kChunkEntries = kChunkBlocks * kLanes;
+  /// What the pass streams, then the records (one allocation; the pass reads only `hot`).
+  struct Chunk {
+    Hot hot[kChunkBlocks];
+    Cold cold[kChunkEntries];
+  };
+  const Hot& block(std::uint32_t b) const noexcept {
+    return chunks_[b >> kChunkShift]->hot[b & (kChunkBlocks - 1)];
+  }
+  Hot& block(std::uint32_t b) noexcept {
+    return chunks_[b >> kChunkShift]->hot[b & (kChunkBlocks - 1)];
+  }
+  const Cold& cold(std::uint32_t e) const noexcept {
+    return chunks_[e / kChunkEntries]->cold[e % kChunkEntries];
+  }
+  Cold& cold(std::uint32_t e) noexcept { return chunks_[e / kChunkEntries]->cold[e % kChunkEntries]; }
+  const Masks& mask(std::uint32_t e) const noexcept { return block(e >> 3).m; }
   void set_result(std::uint32_t e, std::uint32_t bits) noexcept;
 
   std::uint32_t n_ = 0;
-  std::vector<Hot> hot_;
-  std::vector<Cold> cold_;
+  std::vector<std::unique_ptr<Chunk>> chunks_;
 };
 
 }  // namespace ridgeline::roam
