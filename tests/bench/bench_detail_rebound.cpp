@@ -149,8 +149,8 @@ int main(int argc, char** argv) {
       "}\n",
       levels, amplitude, threshold, height, size, workers, st.triangles,
       static_cast<unsigned long long>(frames + kFlight), static_cast<unsigned long long>(frames),
-      st.pending_splits, update_ms, streamed_ms,
-      static_cast<unsigned long long>(rebounded), f->triangles, f->pending_splits, fresh_ms,
+      st.pending_splits, update_ms, streamed_ms, static_cast<unsigned long long>(rebounded),
+      f->triangles, f->pending_splits, fresh_ms,
       double(st.triangles) / double(std::max<std::uint32_t>(1, f->triangles)), cs.resident_tiles,
       double(cs.resident_bytes) / double(1 << 20), double(st.memory_bytes) / double(1 << 20));
   return st.pending_splits == 0 && f->pending_splits == 0 ? 0 : 1;

@@ -9,6 +9,7 @@
 #include <glm/geometric.hpp>
 #include <map>
 #include <optional>
+#include <chrono>
 #include <random>
 #include <set>
 #include <thread>
@@ -801,8 +802,14 @@ TEST(Front, ChunkedStorageKeepsEntriesAcrossChunks) {
   roam::Front f;
   std::vector<Ref> ref;
   auto add = [&] {
-    const Ref e{std::int32_t(rng() % 4096), std::int32_t(rng() % 4096), pos(rng), pos(rng) * 0.1f,
-                pos(rng), bound(rng), bound(rng) * 8.0f, std::uint32_t(ref.size()),
+    const Ref e{std::int32_t(rng() % 4096),
+                std::int32_t(rng() % 4096),
+                pos(rng),
+                pos(rng) * 0.1f,
+                pos(rng),
+                bound(rng),
+                bound(rng) * 8.0f,
+                std::uint32_t(ref.size()),
                 (rng() & 1) != 0};
     ASSERT_EQ(f.add(e.i, e.j, 4, 0, 3, e.x, e.y, e.z, e.mu, e.r, e.node, e.split, false),
               ref.size());
@@ -836,6 +843,38 @@ TEST(Front, ChunkedStorageKeepsEntriesAcrossChunks) {
     ASSERT_EQ(f.radius(e), r.r) << e;
     const std::uint8_t pass = f.result(e);
     ASSERT_EQ(f.test_one(e, c), pass) << e;  // bit for bit, in whichever chunk
+  }
+  // Under a time budget the pass goes chunk by chunk: with the time already up, one chunk per
+  // call, resuming where the last call stopped, and the calls together test every entry once
+  // with the same results as the whole pass.
+  {
+    Camera moved = cam;
+    moved.eye = {-40.0, 60.0, 10.0};
+    const roam::FrontCamera c2 = roam::FrontCamera::screen(moved, 2.0, 0, 0, 0, 1, 1, 5000);
+    f.evaluate(c2);
+    std::vector<std::uint8_t> whole(f.size());
+    for (std::uint32_t e = 0; e < f.size(); ++e) whole[e] = f.result(e);
+    f.evaluate(c);  // other results again
+    std::uint32_t cursor = 1, tested = 0, total = 0;
+    const std::uint32_t chunks = (f.size() + chunk - 1) / chunk;
+    std::vector<roam::Front::Keyed> changed;
+    for (std::uint32_t k = 0; k < chunks; ++k) {
+      f.evaluate_until(c2, &changed, std::chrono::steady_clock::now(), &cursor, &tested);
+      EXPECT_EQ(cursor, (k + 2) % chunks);
+      EXPECT_LE(tested, chunk);
+      for (const roam::Front::Keyed& x : changed) {
+        const std::uint32_t e = x.entry & ~roam::Front::kKeyedSplit;
+        EXPECT_EQ(e / chunk, (k + 1) % chunks) << "a changed entry outside the chunk tested";
+        EXPECT_NE(bool(f.result(e) & roam::kActive), f.split(e));
+      }
+      total += tested;
+    }
+    EXPECT_EQ(total, f.size());
+    for (std::uint32_t e = 0; e < f.size(); ++e) ASSERT_EQ(f.result(e), whole[e]) << e;
+    // With time to spare, one call tests everything.
+    f.evaluate_until(c, &changed, std::chrono::steady_clock::now() + std::chrono::hours(1),
+                     &cursor, &tested);
+    EXPECT_EQ(tested, f.size());
   }
   f.trim();
   EXPECT_LT(f.memory_bytes(), peak_bytes);

@@ -57,8 +57,8 @@ inline std::uint32_t world_test(float mu, float r, const FrontCamera& c, float* 
 // The pass without vector instructions: the scalar test lane by lane.
 // Blocks [0, nb) of one chunk, whose first block is block `first` of the front; `worst` is the
 // largest failing priority in view so far (the chunks before).
-float screen_pass_scalar(Front::Hot* hot, std::size_t nb, std::uint32_t first,
-                         const FrontCamera& c, std::vector<Front::Keyed>* changed, float worst) {
+float screen_pass_scalar(Front::Hot* hot, std::size_t nb, std::uint32_t first, const FrontCamera& c,
+                         std::vector<Front::Keyed>* changed, float worst) {
   for (std::size_t b = 0; b < nb; ++b) {
     Front::Hot& h = hot[b];
     std::uint32_t act = 0, view = 0;
@@ -74,9 +74,9 @@ float screen_pass_scalar(Front::Hot* hot, std::size_t nb, std::uint32_t first,
     if (changed == nullptr) continue;
     for (std::uint32_t d = std::uint32_t(h.m.active ^ h.m.split) & h.m.valid; d != 0; d &= d - 1) {
       const std::uint32_t l = std::uint32_t(__builtin_ctz(d));
-      changed->push_back({(h.m.view >> l) & 1 ? p[l] : -1.0f,
-                          ((first + std::uint32_t(b)) * Front::kLanes + l) |
-                              (((h.m.split >> l) & 1u) << 31)});
+      changed->push_back(
+          {(h.m.view >> l) & 1 ? p[l] : -1.0f,
+           ((first + std::uint32_t(b)) * Front::kLanes + l) | (((h.m.split >> l) & 1u) << 31)});
     }
   }
   return worst;
@@ -86,8 +86,7 @@ float screen_pass_scalar(Front::Hot* hot, std::size_t nb, std::uint32_t first,
 // Eight lanes at a time, the same operations as screen_test() in the same order (no fused
 // multiply-adds). Writes only the masks.
 __attribute__((target("avx2"))) float screen_pass_avx2(Front::Hot* hot, std::size_t nb,
-                                                       std::uint32_t first,
-                                                       const FrontCamera& c,
+                                                       std::uint32_t first, const FrontCamera& c,
                                                        std::vector<Front::Keyed>* changed,
                                                        float w) {
   const __m256 ex = _mm256_set1_ps(c.ex), ey = _mm256_set1_ps(c.ey), ez = _mm256_set1_ps(c.ez);
@@ -154,9 +153,9 @@ __attribute__((target("avx2"))) float screen_pass_avx2(Front::Hot* hot, std::siz
     _mm256_store_ps(p, _mm256_div_ps(_mm256_mul_ps(mu, scale), den));
     for (std::uint32_t x = d; x != 0; x &= x - 1) {
       const std::uint32_t l = std::uint32_t(__builtin_ctz(x));
-      changed->push_back({(view_bits >> l) & 1 ? p[l] : -1.0f,
-                          ((first + std::uint32_t(b)) * Front::kLanes + l) |
-                              (((hot[b].m.split >> l) & 1u) << 31)});
+      changed->push_back(
+          {(view_bits >> l) & 1 ? p[l] : -1.0f, ((first + std::uint32_t(b)) * Front::kLanes + l) |
+                                                    (((hot[b].m.split >> l) & 1u) << 31)});
     }
     if (!candidate) continue;
     for (std::uint32_t l = 0; l < Front::kLanes; ++l)
@@ -255,7 +254,9 @@ std::uint32_t Front::remove(std::uint32_t e) noexcept {
   return last;
 }
 
-void Front::clear() noexcept { n_ = 0; }
+void Front::clear() noexcept {
+  n_ = 0;
+}
 
 void Front::trim() noexcept {
   const std::size_t used = (n_ + kChunkEntries - 1) / kChunkEntries;
@@ -286,17 +287,41 @@ float Front::evaluate(const FrontCamera& c, std::vector<Keyed>* changed) {
     return worst;
   }
   float worst = 0.0f;
-  for (std::uint32_t first = 0; first < nb; first += kChunkBlocks) {
-    Hot* hot = chunks_[first >> kChunkShift]->hot;
-    const std::size_t n = std::min<std::size_t>(kChunkBlocks, nb - first);
+  for (std::uint32_t k = 0; k * kChunkBlocks < nb; ++k) worst = pass_chunk(k, c, changed, worst);
+  return worst;
+}
+
+float Front::pass_chunk(std::uint32_t k, const FrontCamera& c, std::vector<Keyed>* changed,
+                        float worst) {
+  const std::uint32_t first = k * kChunkBlocks;
+  Hot* hot = chunks_[k]->hot;
+  const std::size_t n = std::min<std::size_t>(kChunkBlocks, blocks() - first);
 #ifdef RIDGELINE_FRONT_AVX2
-    if (have_avx2()) {
-      worst = screen_pass_avx2(hot, n, first, c, changed, worst);
-      continue;
-    }
+  if (have_avx2()) return screen_pass_avx2(hot, n, first, c, changed, worst);
 #endif
-    worst = screen_pass_scalar(hot, n, first, c, changed, worst);
+  return screen_pass_scalar(hot, n, first, c, changed, worst);
+}
+
+float Front::evaluate_until(const FrontCamera& c, std::vector<Keyed>* changed,
+                            std::chrono::steady_clock::time_point stop_at, std::uint32_t* cursor,
+                            std::uint32_t* tested) {
+  const std::uint32_t used = (blocks() + kChunkBlocks - 1) / kChunkBlocks;
+  if (c.world || used <= 1) {
+    *cursor = 0;
+    *tested = n_;
+    return evaluate(c, changed);
   }
+  if (changed != nullptr) changed->clear();
+  float worst = 0.0f;
+  std::uint32_t k = *cursor % used, count = 0;
+  *tested = 0;
+  for (;;) {
+    worst = pass_chunk(k, c, changed, worst);
+    *tested += std::min(n_ - k * kChunkEntries, kChunkEntries);
+    k = (k + 1) % used;
+    if (++count == used || std::chrono::steady_clock::now() >= stop_at) break;
+  }
+  *cursor = k;
   return worst;
 }
 

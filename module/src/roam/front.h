@@ -20,6 +20,7 @@
 // plus one spare.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -164,6 +165,14 @@ class Front {
   /// view whose test fails (0 when none). With `changed`, also lists the entries whose test
   /// disagrees with their state with their priorities, computed in the same pass.
   float evaluate(const FrontCamera& c, std::vector<Keyed>* changed = nullptr);
+  /// The same pass under a time budget: tests whole chunks, starting at chunk `*cursor` (taken
+  /// modulo the chunks in use) and wrapping around, and stops after the chunk during which
+  /// `stop_at` passed. The untested entries keep their last results. `*cursor` becomes the chunk
+  /// to start at next time; `*tested` the entries tested. Returns the largest failing priority
+  /// in view among the tested entries.
+  float evaluate_until(const FrontCamera& c, std::vector<Keyed>* changed,
+                       std::chrono::steady_clock::time_point stop_at, std::uint32_t* cursor,
+                       std::uint32_t* tested);
   /// Tests one entry (a new one, or one whose data changed) the same way, bit for bit; returns
   /// kActive | kInView bits. `priority`, when given, receives its priority.
   std::uint8_t test_one(std::uint32_t e, const FrontCamera& c, float* priority = nullptr) noexcept;
@@ -177,6 +186,8 @@ class Front {
     const Masks& m = block(b).m;
     return std::uint32_t((m.active ^ m.split) & m.valid);
   }
+  /// Hints the caches to fetch entry e's record (what node() and the geometry read).
+  void prefetch_record(std::uint32_t e) const noexcept { detail::prefetch(&cold(e < n_ ? e : 0)); }
   /// Hints the caches to fetch what a change of entry e reads: its cold record and its lane
   /// of the block (three lines: height, bound, radius and the masks).
   void prefetch(std::uint32_t e) const noexcept {
@@ -209,9 +220,13 @@ class Front {
   const Cold& cold(std::uint32_t e) const noexcept {
     return chunks_[e / kChunkEntries]->cold[e % kChunkEntries];
   }
-  Cold& cold(std::uint32_t e) noexcept { return chunks_[e / kChunkEntries]->cold[e % kChunkEntries]; }
+  Cold& cold(std::uint32_t e) noexcept {
+    return chunks_[e / kChunkEntries]->cold[e % kChunkEntries];
+  }
   const Masks& mask(std::uint32_t e) const noexcept { return block(e >> 3).m; }
   void set_result(std::uint32_t e, std::uint32_t bits) noexcept;
+  /// The screen pass over the blocks of chunk k in use.
+  float pass_chunk(std::uint32_t k, const FrontCamera& c, std::vector<Keyed>* changed, float worst);
 
   std::uint32_t n_ = 0;
   std::vector<std::unique_ptr<Chunk>> chunks_;

@@ -346,6 +346,44 @@ void RoamView::Impl::converge_all() {
   }
 }
 
+namespace {
+
+// Keeps `keep` of the items with the largest keys (all of them when there are no more), in any
+// order; returns the largest key dropped (0 when none). nth_element over all of them cost
+// ~30 ns an item (a mispredicted branch per comparison of random keys; and the out-of-view
+// merges, thousands of them, share one key): 0.1-0.4 ms for 5,000-15,000 candidates, most of
+// a 0.5 ms budget. Instead a cutoff comes from a sample of 256 keys, the items above it are
+// moved to the front (a branch nearly always taken the same way), then those equal to it, and
+// only when more than `keep` are above it are those selected exactly (by key alone).
+float keep_largest(std::vector<std::pair<float, std::uint32_t>>& v, std::size_t keep,
+                   std::vector<float>& sample) {
+  using Item = std::pair<float, std::uint32_t>;
+  const std::size_t n = v.size();
+  if (n <= keep) return 0.0f;
+  const std::size_t stride = std::max<std::size_t>(1, n / 256);
+  sample.clear();
+  for (std::size_t i = 0; i < n; i += stride) sample.push_back(v[i].first);
+  // The sample's key with keep's share of the sample above it, and a little more.
+  const std::size_t rank = std::min(sample.size() - 1, (keep * sample.size() + n - 1) / n + 2);
+  std::nth_element(sample.begin(), sample.begin() + std::ptrdiff_t(rank), sample.end(),
+                   std::greater<>());
+  const float cut = sample[rank];
+  auto above = std::partition(v.begin(), v.end(), [cut](const Item& x) { return x.first > cut; });
+  auto end = above;
+  if (std::size_t(above - v.begin()) < keep)  // then the ties, as many as fit
+    end = std::partition(above, v.end(), [cut](const Item& x) { return x.first == cut; });
+  end = v.begin() + std::ptrdiff_t(std::min<std::size_t>(keep, std::size_t(end - v.begin())));
+  if (std::size_t(above - v.begin()) > keep)  // a skewed sample: select among those above
+    std::nth_element(v.begin(), end, above,
+                     [](const Item& a, const Item& b) { return a.first > b.first; });
+  float dropped = 0.0f;
+  for (auto it = end; it != v.end(); ++it) dropped = std::max(dropped, it->first);
+  v.erase(end, v.end());
+  return dropped;
+}
+
+}  // namespace
+
 // Under a triangle cap or a time budget: the most important change first (D97's dual queues:
 // split the highest priority, merge the lowest; under a cap, trade a merge for a split while the
 // split matters more). Keys are this update's priorities; out-of-view diamonds merge first.
@@ -371,9 +409,9 @@ float RoamView::Impl::converge_budgeted(double threshold, std::uint32_t cap) {
     // The pass marked which entries are split, so the lists are sorted out by entry and only
     // the kept ones' nodes are read (a record each: reading them for all the candidates cost
     // up to 0.5 ms for 20,000 of them on a front the rest of the frame had evicted).
+    // Each kept candidate costs a read of its entry's record (its node), which the pass did not
+    // touch; the records are fetched ahead.
     const std::size_t keep = std::max<std::size_t>(1024, 4 * std::size_t(m.budget_ops));
-    splits.reserve(std::min(keep, m.keyed.size()));
-    merges.reserve(std::min(keep, m.keyed.size()));
     for (const Front::Keyed& k : m.keyed) {
       if (k.entry & Front::kKeyedSplit)
         merges.push_back({-k.key, k.entry & ~Front::kKeyedSplit});
@@ -381,13 +419,13 @@ float RoamView::Impl::converge_budgeted(double threshold, std::uint32_t cap) {
         splits.push_back({k.key, k.entry});
     }
     auto trim = [&](std::vector<Item>& v, bool is_split) {
-      if (v.size() > keep) {
-        std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(keep), v.end(), std::greater<>());
-        if (is_split)
-          for (std::size_t i = keep; i < v.size(); ++i) held_back = std::max(held_back, v[i].first);
-        v.resize(keep);
+      const float dropped = keep_largest(v, keep, m.key_sample);
+      if (is_split) held_back = std::max(held_back, dropped);
+      constexpr std::size_t kAhead = 16;
+      for (std::size_t i = 0; i < v.size(); ++i) {  // entry -> node
+        if (i + kAhead < v.size()) m.front.prefetch_record(v[i + kAhead].second);
+        v[i].second = m.front.node(v[i].second);
       }
-      for (Item& it : v) it.second = m.front.node(it.second);  // entry -> node
     };
     trim(splits, true);
     trim(merges, false);
@@ -657,8 +695,22 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
   }
 #endif
   // 2. The test (with the changes' priorities when a time budget alone orders them).
-  m.fresh_worst = m.front.evaluate(m.cam, m.has_deadline && cap == 0 ? &m.keyed : nullptr);
-  m.st.priority_updates += m.front.size();
+  if (m.has_deadline) {
+    // Under a time budget the pass takes about 40 % of it at most, in whole chunks, and the
+    // next update goes on where it stopped: on a large front far from convergence a whole pass
+    // with its change list took 0.3-0.4 ms of a 0.5 ms budget, leaving time for a few changes
+    // a frame, so the mesh fell further behind (more changes to list, a slower pass).
+    std::uint32_t tested = 0;
+    m.fresh_worst =
+        m.front.evaluate_until(m.cam, cap == 0 ? &m.keyed : nullptr,
+                               t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                        (m.deadline - t0) * Impl::kPassShare),
+                               &m.pass_cursor, &tested);
+    m.st.priority_updates += tested;
+  } else {
+    m.fresh_worst = m.front.evaluate(m.cam);
+    m.st.priority_updates += m.front.size();
+  }
   // Under a time budget the queues come from the pass's keyed list (or, with a cap, from the
   // front itself): the change lists are not needed, and collecting them reads every changed
   // entry's record before the first deadline check (0.2-0.4 ms on a 130,000-entry front that the

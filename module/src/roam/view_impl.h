@@ -56,11 +56,16 @@ struct RoamView::Impl {
   std::vector<roam::Front::Keyed> keyed;  // the pass's changed entries and priorities (budgets)
   using QueueItem = std::pair<float, std::uint32_t>;  // priority, node
   std::vector<QueueItem> split_queue, merge_queue;    // converge_budgeted()'s queues
+  std::vector<float> key_sample;                      // their cutoff's sample
   std::vector<std::uint32_t> fresh_nodes;             // nodes a budgeted change made or freed
   std::uint32_t budget_ops = 0;                       // changes the last budgeted update made
   bool has_deadline = false;
   std::chrono::steady_clock::time_point deadline;
   std::uint32_t clock_checks = 0;
+  // Under a time budget: the share of the budget the front's pass may take, and the chunk the
+  // next pass starts at (Front::evaluate_until()).
+  static constexpr double kPassShare = 0.4;
+  std::uint32_t pass_cursor = 0;
   // Under a triangle cap: the threshold the last update ended at (0: none yet).
   double cap_threshold = 0;
 
@@ -168,7 +173,8 @@ struct RoamView::Impl {
     static const long ops = std::getenv("ROAM_OPS") ? std::atol(std::getenv("ROAM_OPS")) : 0;
     if (ops > 0) return has_deadline && ++clock_checks > std::uint32_t(ops);
 #endif
-    if (!has_deadline || (++clock_checks & 7) != 0) return false;
+    // The clock is read at the first check and every eighth after it.
+    if (!has_deadline || (clock_checks++ & 7) != 0) return false;
     return std::chrono::steady_clock::now() >= deadline;
   }
 };
