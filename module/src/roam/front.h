@@ -14,8 +14,8 @@
 // the changes read (lattice indices, geometry, node, flags) is one 16-byte record per entry.
 // The pass writes nothing per entry: its results are two bytes per block (which lanes are
 // active, which in view), beside a byte of which lanes are split. So a pass streams 20 bytes per
-// entry, and an entry costs 40 bytes in all. Blocks and records live in fixed chunks of 2,048
-// entries (80 KiB) that never move: growing copies nothing (a vector's growth copied the whole
+// entry, and an entry costs 40 bytes in all. Blocks and records live in fixed chunks of 1,024
+// entries (40 KiB) that never move: growing copies nothing (a vector's growth copied the whole
 // front inside an update and faulted in a new copy), and the unused capacity is under one chunk
 // plus one spare.
 #pragma once
@@ -88,7 +88,7 @@ class Front {
   static_assert(sizeof(Cold) == 16);
 
   /// Blocks per chunk (a power of two).
-  static constexpr std::uint32_t kChunkBlocks = 256;
+  static constexpr std::uint32_t kChunkBlocks = 128;
 
   std::uint32_t size() const noexcept { return n_; }
   std::uint32_t blocks() const noexcept { return (n_ + kLanes - 1) / kLanes; }
@@ -203,7 +203,7 @@ class Front {
   std::size_t memory_bytes() const noexcept;
 
  private:
-  static constexpr std::uint32_t kChunkShift = 8;  // log2 kChunkBlocks
+  static constexpr std::uint32_t kChunkShift = 7;  // log2 kChunkBlocks
   static_assert(kChunkBlocks == 1u << kChunkShift);
   static constexpr std::uint32_t kChunkEntries = kChunkBlocks * kLanes;
   /// What the pass streams, then the records (one allocation; the pass reads only `hot`).
