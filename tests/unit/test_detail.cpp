@@ -32,7 +32,9 @@ Heightfield make_heightfield() {
   return std::move(hf).value();
 }
 
-std::shared_ptr<const Terrain> make_terrain() { return Terrain::create(make_heightfield()); }
+std::shared_ptr<const Terrain> make_terrain() {
+  return Terrain::create(make_heightfield());
+}
 
 DetailParams params(std::uint32_t levels, std::uint64_t seed, double amplitude, double gain) {
   DetailParams p;
@@ -459,6 +461,46 @@ TEST(DetailCache, AsynchronousDeliversTheSameTiles) {
     EXPECT_EQ(s.pending, 0u);
     EXPECT_GE(s.generated, keys.size());
     EXPECT_GT(s.generation_seconds, 0.0);
+  }
+}
+
+// request_many() (one lock for a frame's requests) behaves as request() one key at a time: in
+// every mode the same tiles become resident, the count it returns is the resident keys, and a
+// key asked for twice is queued once.
+TEST(DetailCache, RequestManyMatchesRequestOneByOne) {
+  auto f = make_field(5);
+  std::vector<DetailTileKey> keys = flight(5, 12);
+  keys.push_back(keys.front());  // a duplicate
+  for (std::uint32_t threads : {0u, 1u, 3u}) {
+    DetailCacheDesc d;
+    d.worker_threads = threads;
+    auto cache = DetailCache::create(f, d);
+    ASSERT_TRUE(cache.ok());
+    DetailCache& c = **cache;
+    std::size_t ready = 0;
+    for (int frame = 0; frame < 1000 && ready < keys.size(); ++frame) {
+      c.update();
+      ready = c.request_many(keys.data(), keys.size(), frame % 2 == 0);
+      std::size_t resident = 0;
+      for (const auto& k : keys) resident += c.try_get(k) ? 1 : 0;
+      if (threads == 0) {
+        EXPECT_EQ(ready, keys.size()) << "synchronous: every tile at once";
+      }
+      EXPECT_LE(ready, resident) << threads << " workers, frame " << frame;
+      if (ready < keys.size()) c.wait_idle(0.05);
+    }
+    ASSERT_EQ(ready, keys.size()) << threads << " workers";
+    c.update();
+    const auto snap = c.snapshot();
+    for (const auto& k : keys) {
+      const DetailTile* t = snap->find(k);
+      ASSERT_TRUE(t);
+      EXPECT_EQ(t->raw(64, 64), f->make_tile_chain(k)->raw(64, 64));
+    }
+    const DetailCacheStats s = c.stats();
+    EXPECT_EQ(s.pending, 0u);
+    // Every key generated once (its ancestors too, at most), the duplicate not again.
+    EXPECT_LE(s.generated, 4 * (keys.size() - 1));
   }
 }
 

@@ -306,6 +306,10 @@ class DetailCache {
   /// synchronous mode where it generates it and returns true. key.level must be 1..levels()
   /// (asserted; false past the assert).
   bool request(const DetailTileKey& key, bool urgent = false);
+  /// request() for each of `count` keys in order, taking the cache's lock once instead of once
+  /// per key (a view's ~1,000 requests a frame cost ~0.5 ms one by one, most of it the lock and
+  /// the wake-ups); returns how many were resident. The same result as the calls one by one.
+  std::size_t request_many(const DetailTileKey* keys, std::size_t count, bool urgent = false);
   /// Starts a frame: integrates generated tiles (at most `max_integrations`, 0 = all), evicts the
   /// least recently used tiles until the bytes are within budget, publishes a new snapshot.
   void update(std::size_t max_integrations = 0);

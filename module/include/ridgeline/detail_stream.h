@@ -111,6 +111,7 @@ class DetailStream {
   DetailCache* cache_;
   DetailViewRule rule_;
   std::vector<DetailTileNeed> tiles_;
+  std::vector<DetailTileKey> keys_;  // frame()'s request lists (kept memory)
   // Needed tiles missing at the end of the previous frame -> frames missing so far.
   std::unordered_map<DetailTileKey, std::uint64_t, DetailTileKeyHash> late_, next_late_;
   std::uint64_t worst_late_ = 0;

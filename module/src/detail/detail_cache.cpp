@@ -75,6 +75,24 @@ struct DetailCache::State {
   std::atomic<std::uint64_t> generation{0};
 
   void touch(Entry& e) { lru.splice(lru.begin(), lru, e.lru); }
+  /// Under the lock, asynchronous modes: what a request of `key` finds. Resident: marked used.
+  /// Otherwise pending from now on, and queued (first when urgent) unless it already was or was
+  /// generated as an ancestor (integrated at update()).
+  enum class Admit { kResident, kWaiting, kQueued };
+  Admit admit(const DetailTileKey& key, bool urgent) {
+    if (auto it = resident.find(key); it != resident.end()) {
+      touch(it->second);
+      return Admit::kResident;
+    }
+    if (pending.count(key)) return Admit::kWaiting;
+    pending.emplace(key, stats.frame);
+    if (done.count(key)) return Admit::kWaiting;
+    if (urgent)
+      queue.push_front(key);
+    else
+      queue.push_back(key);
+    return Admit::kQueued;
+  }
 
   // A tile already generated (resident or waiting for integration), or null. Holds mu.
   std::shared_ptr<const DetailTile> available(const DetailTileKey& key) {
@@ -249,13 +267,7 @@ bool DetailCache::request(const DetailTileKey& key, bool urgent) {
     s.publish(s.make_snapshot());
     return true;
   }
-  if (s.pending.count(key)) return false;
-  s.pending.emplace(key, s.stats.frame);
-  if (s.done.count(key)) return false;  // generated as an ancestor; integrated at update()
-  if (urgent)
-    s.queue.push_front(key);
-  else
-    s.queue.push_back(key);
+  if (s.admit(key, urgent) != State::Admit::kQueued) return false;
   lock.unlock();
   if (!s.executor) {
     s.work_cv.notify_one();
@@ -274,6 +286,32 @@ bool DetailCache::request(const DetailTileKey& key, bool urgent) {
     throw;
   }
   return false;
+}
+
+std::size_t DetailCache::request_many(const DetailTileKey* keys, std::size_t count, bool urgent) {
+  State& s = *state_;
+  if (s.synchronous || s.executor) {  // each generates or hands a job out: one by one
+    std::size_t resident = 0;
+    for (std::size_t k = 0; k < count; ++k) resident += request(keys[k], urgent) ? 1 : 0;
+    return resident;
+  }
+  std::size_t resident = 0, queued = 0;
+  {
+    std::lock_guard<std::mutex> lock(s.mu);
+    for (std::size_t k = 0; k < count; ++k) {
+      const DetailTileKey& key = keys[k];
+      RIDGELINE_ASSERT(key.level >= 1 && key.level <= field_->levels());
+      if (key.level < 1 || key.level > field_->levels()) continue;
+      const State::Admit a = s.admit(key, urgent);
+      resident += a == State::Admit::kResident ? 1 : 0;
+      queued += a == State::Admit::kQueued ? 1 : 0;
+    }
+  }
+  if (queued == 1)
+    s.work_cv.notify_one();
+  else if (queued > 1)
+    s.work_cv.notify_all();
+  return resident;
 }
 
 void DetailCache::update(std::size_t max_integrations) {
