@@ -252,11 +252,11 @@ bool DetailCache::request(const DetailTileKey& key, bool urgent) {
   if (key.level < 1 || key.level > field_->levels()) return false;  // fallback after the assert
   State& s = *state_;
   std::unique_lock<std::mutex> lock(s.mu);
-  if (auto it = s.resident.find(key); it != s.resident.end()) {
-    s.touch(it->second);
-    return true;
-  }
   if (s.synchronous) {
+    if (auto it = s.resident.find(key); it != s.resident.end()) {
+      s.touch(it->second);
+      return true;
+    }
     std::shared_ptr<const DetailTile> parent;
     const std::vector<DetailTileKey> keys = s.chain(key, parent);
     // Deepest ancestor first, the requested tile last: it ends most recently used, and the
@@ -267,7 +267,8 @@ bool DetailCache::request(const DetailTileKey& key, bool urgent) {
     s.publish(s.make_snapshot());
     return true;
   }
-  if (s.admit(key, urgent) != State::Admit::kQueued) return false;
+  if (const State::Admit a = s.admit(key, urgent); a != State::Admit::kQueued)
+    return a == State::Admit::kResident;
   lock.unlock();
   if (!s.executor) {
     s.work_cv.notify_one();

@@ -407,10 +407,9 @@ float RoamView::Impl::converge_budgeted(double threshold, std::uint32_t cap) {
     // the budget allows a few hundred changes: only the most important go in the queues (the
     // rest is found again by the next update's pass), so building them costs little.
     // The pass marked which entries are split, so the lists are sorted out by entry and only
-    // the kept ones' nodes are read (a record each: reading them for all the candidates cost
-    // up to 0.5 ms for 20,000 of them on a front the rest of the frame had evicted).
-    // Each kept candidate costs a read of its entry's record (its node), which the pass did not
-    // touch; the records are fetched ahead.
+    // the kept ones' nodes are read (a record each, which the pass did not touch, fetched
+    // ahead: reading them for all the candidates cost up to 0.5 ms for 20,000 of them on a
+    // front the rest of the frame had evicted).
     const std::size_t keep = std::max<std::size_t>(1024, 4 * std::size_t(m.budget_ops));
     for (const Front::Keyed& k : m.keyed) {
       if (k.entry & Front::kKeyedSplit)
