@@ -21,7 +21,7 @@ namespace {
 struct LodArgs {
   TerrainArgs terrain;
   std::string patch_exponent = "6", threshold, triangles, tolerance, budget_ms, mode = "coherent",
-              morph_window;
+              morph_window, morph_delay;
   std::string json_path;
 
   void add_to(CLI::App& app) {
@@ -45,8 +45,12 @@ struct LodArgs {
                   "also soar (the stateless SOAR comparator)")
         ->type_name("MODE");
     g->add_option("--morph-window", morph_window,
-                  "Geomorph window w, 0..4 (default 0.5; 0: no morph nesting)")
+                  "Geomorph window w, 0..4 (default 0.2; 0: no geomorphs, no morph nesting)")
         ->type_name("W");
+    g->add_option("--morph-delay", morph_delay,
+                  "Geomorph delay, 0..1 (default 0.1): a new vertex stays on its edge until its "
+                  "bound projects to (1 + delay) x the threshold")
+        ->type_name("D");
     app.add_option("--json", json_path, "Write the JSON to FILE instead of standard output")
         ->type_name("FILE");
     // Without any of the three there is nothing to tessellate for: a usage error (exit 2).
@@ -111,6 +115,11 @@ struct LodArgs {
       auto w = parse_finite(morph_window, "--morph-window");
       if (!w) return w.error();
       desc.morph_window = *w;
+    }
+    if (!morph_delay.empty()) {
+      auto d = parse_finite(morph_delay, "--morph-delay");
+      if (!d) return d.error();
+      desc.morph_delay = *d;
     }
     auto l = Landscape::create(*t, desc);
     if (!l) return l.error();

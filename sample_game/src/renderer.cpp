@@ -36,7 +36,8 @@ uniform vec3 u_eye_local;               // eye - patch origin (the geomorph's pa
 uniform vec4 u_uv;                      // material map: uv = u_uv.xy + a_pos.xz * u_uv.zw
 uniform float u_proj_scale;             // pixels per metre at unit distance (output pixels)
 uniform float u_morph_threshold;        // pixels: the view's RoamStats::morph_threshold
-uniform float u_morph_window;           // the landscape's morph_window()
+uniform float u_morph_window;           // the landscape's geomorph().window
+uniform float u_morph_delay;            // the landscape's geomorph().delay
 uniform int u_geomorph;
 uniform int u_cheap;
 uniform vec3 u_sun;
@@ -54,7 +55,7 @@ void main() {
   float y = a_pos.y;
   if (u_geomorph != 0)
     y = geomorph_height(a_pos, a_morph, u_eye_local, u_proj_scale, u_morph_threshold,
-                        u_morph_window);
+                        u_morph_window, u_morph_delay);
   vec3 rel = u_offset + vec3(a_pos.x, y, a_pos.z);
   float d = max(length(rel), 1e-3);
   v_nrm = a_nrm;
@@ -582,10 +583,11 @@ RenderStats Renderer::draw(Game& game, const RenderSettings& settings) {
   glUniformMatrix4fv(loc(terrain_prog_, "u_view_proj"), 1, GL_FALSE, glm::value_ptr(vp));
   glUniform1f(loc(terrain_prog_, "u_proj_scale"), float(ridgeline::projection_scale(cam)));
   // The geomorph's inputs (geomorph_glsl.h): the threshold the mesh corresponds to and the
-  // landscape's morph window.
+  // landscape's morph window and delay.
+  const ridgeline::Geomorph geomorph = game.active_view().landscape().geomorph();
   glUniform1f(loc(terrain_prog_, "u_morph_threshold"), float(game.morph_threshold()));
-  glUniform1f(loc(terrain_prog_, "u_morph_window"),
-              float(game.active_view().landscape().morph_window()));
+  glUniform1f(loc(terrain_prog_, "u_morph_window"), float(geomorph.window));
+  glUniform1f(loc(terrain_prog_, "u_morph_delay"), float(geomorph.delay));
   glUniform1i(loc(terrain_prog_, "u_geomorph"), settings.geomorph ? 1 : 0);
   glUniform1i(loc(terrain_prog_, "u_wireframe"), settings.wireframe ? 1 : 0);
   glUniform1i(loc(terrain_prog_, "u_cheap"), settings.cheap_fragments ? 1 : 0);

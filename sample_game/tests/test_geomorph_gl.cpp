@@ -2,7 +2,7 @@
 // ridgeline::morphed_height() on the CPU: the GLSL function runs on the real GL driver (Mesa
 // llvmpipe) through transform feedback, over the vertices of real ROAM meshes and over made-up
 // vertices that reach every branch (the clamp at both ends, patch corners, the data border, no
-// morph window). Exit 77 (ctest: skipped) when no OpenGL context can be made.
+// morph window, a delay). Exit 77 (ctest: skipped) when no OpenGL context can be made.
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/gl.h>
 #include <GL/glext.h>
@@ -26,7 +26,7 @@ namespace {
 
 using ridgeline::MeshVertex;
 
-// Evaluates geomorph_height() for each vertex with one eye (patch-local), k, tau and w, by
+// Evaluates geomorph_height() for each vertex with one eye (patch-local), k, tau, w and delta, by
 // transform feedback; returns the heights, or an empty vector with the error in `err`.
 class GpuGeomorph {
  public:
@@ -34,11 +34,11 @@ class GpuGeomorph {
     const std::string vs = std::string("#version 330 core\n") +
                            "layout(location = 0) in vec3 a_pos;\n"
                            "layout(location = 2) in vec3 a_morph;\n"
-                           "uniform vec3 u_eye; uniform float u_k, u_tau, u_w;\n"
+                           "uniform vec3 u_eye; uniform float u_k, u_tau, u_w, u_delta;\n"
                            "out float o_height;\n" +
                            game::kGeomorphGlsl +
                            "void main() {\n"
-                           "  o_height = geomorph_height(a_pos, a_morph, u_eye, u_k, u_tau, u_w);\n"
+                           "  o_height = geomorph_height(a_pos, a_morph, u_eye, u_k, u_tau, u_w, u_delta);\n"
                            "  gl_Position = vec4(0.0, 0.0, 0.0, 1.0);\n"
                            "}\n";
     const char* src = vs.c_str();
@@ -87,12 +87,13 @@ class GpuGeomorph {
   }
 
   std::vector<float> run(const std::vector<MeshVertex>& v, const glm::vec3& eye, float k, float tau,
-                         float w) {
+                         const ridgeline::Geomorph& g) {
     glUseProgram(prog_);
     glUniform3f(glGetUniformLocation(prog_, "u_eye"), eye.x, eye.y, eye.z);
     glUniform1f(glGetUniformLocation(prog_, "u_k"), k);
     glUniform1f(glGetUniformLocation(prog_, "u_tau"), tau);
-    glUniform1f(glGetUniformLocation(prog_, "u_w"), w);
+    glUniform1f(glGetUniformLocation(prog_, "u_w"), float(g.window));
+    glUniform1f(glGetUniformLocation(prog_, "u_delta"), float(g.delay));
     glBindVertexArray(vao_);
     glBindBuffer(GL_ARRAY_BUFFER, vbo_);
     glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(v.size() * sizeof(MeshVertex)), v.data(),
@@ -127,15 +128,17 @@ GpuGeomorph* g_gpu = nullptr;
 
 // Tolerance: the shader computes in float, the CPU in double from the same floats.
 void expect_same(const std::vector<MeshVertex>& v, const std::vector<float>& gpu,
-                 const glm::vec3& eye, double k, double tau, double w, int* morphing) {
+                 const glm::vec3& eye, double k, double tau, const ridgeline::Geomorph& g,
+                 int* morphing) {
   ASSERT_EQ(gpu.size(), v.size());
   for (std::size_t i = 0; i < v.size(); ++i) {
-    const float cpu = ridgeline::morphed_height(v[i], eye, k, tau, w);
+    const float cpu = ridgeline::morphed_height(v[i], eye, k, tau, g);
     const double tol = 1e-5 * (std::fabs(v[i].y) + std::fabs(v[i].morph_dy)) + 1e-5;
     ASSERT_NEAR(gpu[i], cpu, tol) << "vertex " << i << " y " << v[i].y << " dy " << v[i].morph_dy
                                   << " bound " << v[i].morph_bound << " radius "
-                                  << v[i].morph_radius << " tau " << tau << " w " << w;
-    const float t = ridgeline::morph_factor(v[i], eye, k, tau, w);
+                                  << v[i].morph_radius << " tau " << tau << " w " << g.window
+                                  << " delta " << g.delay;
+    const float t = ridgeline::morph_factor(v[i], eye, k, tau, g);
     if (t > 0.01f && t < 0.99f && std::fabs(v[i].morph_dy) > 0.01f) ++*morphing;
   }
 }
@@ -160,10 +163,10 @@ TEST(GeomorphGl, TheShaderMatchesMorphedHeightOnMadeUpVertices) {
   const glm::vec3 eyes[] = {{128, 120, 128}, {-300, 400, 50}, {60, 5, 200}};
   for (const glm::vec3& eye : eyes)
     for (double tau : {1.0, 2.0, 6.0})
-      for (double w : {0.5, 0.0, 2.0}) {
+      for (const ridgeline::Geomorph g : {ridgeline::Geomorph{0.5, 0.1}, ridgeline::Geomorph{0.0, 0.0},
+                                          ridgeline::Geomorph{2.0, 0.0}, ridgeline::Geomorph{0.3, 0.6}}) {
         const double k = 623.5;  // 720 px high, 60 degrees
-        expect_same(v, g_gpu->run(v, eye, float(k), float(tau), float(w)), eye, k, tau, w,
-                    &morphing);
+        expect_same(v, g_gpu->run(v, eye, float(k), float(tau), g), eye, k, tau, g, &morphing);
       }
   EXPECT_GT(morphing, 1000) << "vertices in the middle of their morph were compared";
 }
@@ -188,9 +191,10 @@ TEST(GeomorphGl, TheShaderMatchesMorphedHeightOnARoamMesh) {
   cam.target += glm::dvec3(20, 0, 30);
   const double k = ridgeline::projection_scale(cam);
   const double tau = stats->morph_threshold;
-  const double w = land.value()->morph_window();
+  const ridgeline::Geomorph g = land.value()->geomorph();
   ASSERT_GT(tau, 0);
-  ASSERT_GT(w, 0);
+  ASSERT_GT(g.window, 0);
+  ASSERT_GT(g.delay, 0);
   int morphing = 0;
   for (std::uint32_t p = 0; p < land.value()->patch_count(); ++p) {
     const ridgeline::PatchMesh& m = (*view)->patch_mesh(p);
@@ -198,8 +202,8 @@ TEST(GeomorphGl, TheShaderMatchesMorphedHeightOnARoamMesh) {
     // As the renderer: the eye minus the patch origin in double, then float.
     const glm::vec3 eye(float(cam.eye.x - m.origin_x), float(cam.eye.y - m.origin_y),
                         float(cam.eye.z - m.origin_z));
-    expect_same(m.vertices, g_gpu->run(m.vertices, eye, float(k), float(tau), float(w)), eye, k,
-                tau, w, &morphing);
+    expect_same(m.vertices, g_gpu->run(m.vertices, eye, float(k), float(tau), g), eye, k, tau, g,
+                &morphing);
   }
   EXPECT_GT(morphing, 20) << "mesh vertices in the middle of their morph were compared";
 }

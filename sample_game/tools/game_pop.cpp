@@ -94,7 +94,8 @@ int main(int argc, char** argv) {
   out["every"] = every;
   out["stride"] = stride;
   out["patch_exponent"] = patch_exponent;
-  out["morph_window"] = (*land)->morph_window();
+  out["morph_window"] = (*land)->geomorph().window;
+  out["morph_delay"] = (*land)->geomorph().delay;
   const std::string text = out.dump(2);
   std::printf("%s\n", text.c_str());
   if (!json_file.empty()) {

@@ -329,13 +329,21 @@ TEST(ReportRoamDrawn, UnmorphedIsTheTrueHeightAndAFreshSplitStartsOnItsEdge) {
   v.morph_bound = 1.0f;
   Camera c = look({0, 0, -1000}, {0, 0, 0});
   const glm::dvec3 w(0, 10, 0);
-  EXPECT_EQ(roam_drawn_y(v, w, c, 2.0, 0.5, false), 10.0);
-  EXPECT_EQ(roam_drawn_y(v, w, c, 0.0, 0.5, true), 10.0);  // no pixel threshold: no morph
+  const Geomorph g{0.5, 0.1};
+  EXPECT_EQ(roam_drawn_y(v, w, c, 2.0, g, false), 10.0);
+  EXPECT_EQ(roam_drawn_y(v, w, c, 0.0, g, true), 10.0);  // no pixel threshold: no morph
   // Far away the bound projects below the threshold: the vertex sits on the coarser edge.
-  EXPECT_DOUBLE_EQ(roam_drawn_y(v, w, c, 2.0, 0.5, true), 12.0);
+  EXPECT_DOUBLE_EQ(roam_drawn_y(v, w, c, 2.0, g, true), 12.0);
+  // Just past the threshold (ratio 1.05, inside the delay): still on the edge.
+  const double k = projection_scale(c);
+  c.eye = {0, 10, -k / (2.0 * 1.05)};
+  EXPECT_DOUBLE_EQ(roam_drawn_y(v, w, c, 2.0, g, true), 12.0);
+  // Ratio 1.35: half way through the window.
+  c.eye = {0, 10, -k / (2.0 * 1.35)};
+  EXPECT_NEAR(roam_drawn_y(v, w, c, 2.0, g, true), 11.0, 1e-5);
   // Close, the projected bound is over twice the threshold: the true height.
   c.eye = {0, 0, -1};
-  EXPECT_DOUBLE_EQ(roam_drawn_y(v, w, c, 2.0, 0.5, true), 10.0);
+  EXPECT_DOUBLE_EQ(roam_drawn_y(v, w, c, 2.0, g, true), 10.0);
 }
 
 // ---- SOAR -------------------------------------------------------------------------------

@@ -449,14 +449,17 @@ TEST(Roam, OutputBuffersMatchTheLeavesAndSeamsShareHeightBits) {
 // every vertex whose diamond's ratio (what the split test compares with 1) is at least 1 has the
 // two ends of the edge it splits at t = 1, at their true heights, so the vertex starts on its
 // parent edge as drawn; and at t = 0 it is drawn at that edge's midpoint (its morph offset).
-// Along a flyover at several thresholds and morph windows.
+// Along a flyover at several thresholds, morph windows and delays.
 TEST(Roam, AVertexStartsOnItsParentEdgeAsDrawn) {
-  for (const double w : {0.5, 1.0}) {
+  for (const Geomorph g : {Geomorph{}, Geomorph{0.5, 0.0}, Geomorph{1.0, 0.3}}) {
     auto hf = make_default_heightfield({.size = 257, .spacing = 2.0, .seed = 1337});
     ASSERT_TRUE(hf);
     auto l = Landscape::create(Terrain::create(std::move(hf).value()),
-                               {.patch_exponent = 5, .morph_window = w})
+                               {.patch_exponent = 5, .morph_window = g.window,
+                                .morph_delay = g.delay})
                  .value();
+    ASSERT_EQ(l->geomorph().window, g.window);
+    ASSERT_EQ(l->geomorph().delay, g.delay);
     for (const double tau : {1.0, 3.0}) {
       auto v = RoamView::create(l, {.threshold = tau}).value();
       std::size_t active = 0, ends = 0;
@@ -499,7 +502,7 @@ TEST(Roam, AVertexStartsOnItsParentEdgeAsDrawn) {
                                       << ij.second << ") splits is not drawn";
               const MeshVertex& end = *it->second;
               ends_y += end.y;
-              EXPECT_EQ(morph_factor(end, e, K, st->morph_threshold, l->morph_window()), 1.0f)
+              EXPECT_EQ(morph_factor(end, e, K, st->morph_threshold, g), 1.0f)
                   << "vertex (" << ij.first << ", " << ij.second << ") at ratio " << rho(*mv)
                   << ": an end of its edge is still morphing (ratio " << rho(end) << ")";
               ++ends;
@@ -509,7 +512,7 @@ TEST(Roam, AVertexStartsOnItsParentEdgeAsDrawn) {
           }
         }
       }
-      EXPECT_GT(active, 1000u) << "w " << w << " threshold " << tau;
+      EXPECT_GT(active, 1000u) << "w " << g.window << " delay " << g.delay << " threshold " << tau;
       EXPECT_EQ(ends, 2 * active);
     }
   }
@@ -580,6 +583,20 @@ TEST(Roam, BadSettingsAndCamerasAreRefused) {
   c.up = {0, 0, 1};
   EXPECT_TRUE(view->update(c));
   EXPECT_FALSE(Landscape::create(l->terrain_ptr(), {.patch_exponent = 1}));
+  for (const double w : {-0.1, 4.5, double(NAN), double(INFINITY)}) {
+    auto bad = Landscape::create(l->terrain_ptr(), {.morph_window = w});
+    ASSERT_FALSE(bad);
+    EXPECT_NE(bad.error().message.find("morph window"), std::string::npos);
+  }
+  for (const double d : {-0.1, 1.5, double(NAN)}) {
+    auto bad = Landscape::create(l->terrain_ptr(), {.morph_delay = d});
+    ASSERT_FALSE(bad);
+    EXPECT_NE(bad.error().message.find("morph delay"), std::string::npos);
+  }
+  // Without a window there is no morph, and no delay either.
+  auto flat = Landscape::create(l->terrain_ptr(), {.morph_window = 0, .morph_delay = 0.5});
+  ASSERT_TRUE(flat);
+  EXPECT_EQ(flat.value()->geomorph().delay, 0.0);
 }
 
 TEST(Landscape, ConstantTimeGeometryMatchesThePathWalk) {

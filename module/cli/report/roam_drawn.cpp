@@ -6,21 +6,21 @@
 namespace ridgeline::report {
 
 double roam_drawn_y(const MeshVertex& v, const glm::dvec3& world, const Camera& camera,
-                    double threshold_px, double morph_window, bool morph) {
+                    double threshold_px, const Geomorph& geomorph, bool morph) {
   if (!morph || !(threshold_px > 0)) return world.y;
   // The vertex shader's formula, morphed_height() of roam_view.h, with the eye in the patch's
   // local frame (the vertex's world position minus its local one is the patch origin).
   const glm::dvec3 origin = world - glm::dvec3(v.x, v.y, v.z);
   const glm::vec3 eye_local(camera.eye - origin);
   return origin.y + double(morphed_height(v, eye_local, projection_scale(camera), threshold_px,
-                                          morph_window));
+                                          geomorph));
 }
 
 RoamSnapshot RoamSnapshot::capture(RoamView& view) {
   RoamSnapshot s;
   s.threshold_px_ =
       view.settings().metric == ErrorMetric::kScreenPixels ? view.settings().threshold : 0.0;
-  s.morph_window_ = view.landscape().morph_window();
+  s.geomorph_ = view.landscape().geomorph();
   s.corners_.reserve(std::size_t(view.triangle_count()) * 3);
   const Landscape& l = view.landscape();
   for (std::uint32_t p = 0; p < l.patch_count(); ++p) {
@@ -38,7 +38,7 @@ DrawnMesh RoamSnapshot::draw(const MeshErrorMeter& meter, const Camera& camera, 
   out.corners.reserve(corners_.size());
   for (const Corner& c : corners_)
     out.corners.emplace_back((c.world.x - meter.origin_x()) / meter.spacing_x(),
-                             roam_drawn_y(c.vertex, c.world, camera, threshold_px_, morph_window_, morph),
+                             roam_drawn_y(c.vertex, c.world, camera, threshold_px_, geomorph_, morph),
                              (c.world.z - meter.origin_z()) / meter.spacing_z());
   return out;
 }

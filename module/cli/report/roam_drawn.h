@@ -16,12 +16,12 @@
 namespace ridgeline::report {
 
 /// World height at which a renderer draws patch vertex `v` of a mesh whose origin is at height
-/// `origin_y`, for `camera` at the view's threshold `threshold_px` and the landscape's morph
-/// window: the vertex shader's formula (morphed_height(), docs/roam.md, geomorphs) when `morph`
+/// `origin_y`, for `camera` at the view's threshold `threshold_px` and the landscape's geomorph
+/// parameters: the vertex shader's formula (morphed_height(), docs/roam.md, geomorphs) when `morph`
 /// and threshold_px > 0, else the vertex's true height. `world` is the vertex's unmorphed world
 /// position.
 double roam_drawn_y(const MeshVertex& v, const glm::dvec3& world, const Camera& camera,
-                    double threshold_px, double morph_window, bool morph);
+                    double threshold_px, const Geomorph& geomorph, bool morph);
 
 /// The patch meshes of a view as captured after one update: each drawn triangle's three vertices
 /// (the MeshVertex as the renderer holds it, and its world position). Drawing it for a camera
@@ -45,7 +45,7 @@ class RoamSnapshot {
   };
   std::vector<Corner> corners_;
   double threshold_px_ = 0;
-  double morph_window_ = 0;
+  Geomorph geomorph_;
 };
 
 }  // namespace ridgeline::report

@@ -17,11 +17,26 @@ struct LandscapeDesc {
   /// samples). Larger patches: fewer roots, bigger per-patch buffers, longer edits per patch.
   std::uint32_t patch_exponent = 6;
   /// Geomorph window w (docs/roam.md, "Geomorphs"): a vertex morphs from its edge to its true
-  /// height while its projected bound grows from the threshold to (1 + w) times it. To let every
-  /// vertex finish before a finer one can start (no pops), the morph bounds grow by a factor
-  /// sqrt(1 + w) per level up the hierarchy, which costs some triangles on smooth ground.
-  /// 0 turns that growth off (the morph bound is the error bound; geomorphs may then pop). 0..4.
-  double morph_window = 0.5;
+  /// height while its projected bound grows from (1 + morph_delay) times the threshold to
+  /// (1 + morph_delay + w) times it. To let every vertex finish before a finer one can start,
+  /// the morph bounds grow by a factor sqrt(1 + morph_delay + w) per level up the hierarchy,
+  /// which costs some triangles on smooth ground. 0 turns geomorphs and that growth off (the
+  /// morph bound is the error bound; vertices appear at their true heights). 0..4.
+  double morph_window = 0.2;
+  /// Geomorph delay delta: a new vertex stays on the edge it splits until its projected bound
+  /// exceeds (1 + delta) times the threshold. A diamond splits at the first update where its
+  /// ratio exceeds 1, which camera motion puts anywhere up to one frame's change of the ratio
+  /// beyond 1: the delay absorbs that step, so the vertex is born at t = 0 and does not pop.
+  /// The drawn mesh's error bound grows with it (docs/roam.md). 0..1; ignored when the window
+  /// is 0.
+  double morph_delay = 0.1;
+};
+
+/// What a vertex shader needs besides a MeshVertex to draw its geomorph (morph_factor() in
+/// roam_view.h; docs/roam.md, "Geomorphs"): the landscape's window and delay.
+struct Geomorph {
+  double window = 0.2;
+  double delay = 0.1;
 };
 
 /// A bintree triangle in global lattice coordinates: apex and the two ends of its hypotenuse,
@@ -37,8 +52,8 @@ struct DiamondBound {
   /// diamond over every lattice vertex under it, made nested (at least every descendant
   /// diamond's). What ErrorMetric::kWorldMetres compares with the tolerance.
   float error = 0;
-  /// Morph bound: the error bound grown by sqrt(1 + morph_window) per level up the hierarchy
-  /// (LandscapeDesc::morph_window). What the screen-pixel metric and geomorphs use.
+  /// Morph bound: the error bound grown by sqrt(1 + morph_delay + morph_window) per level up the
+  /// hierarchy (LandscapeDesc). What the screen-pixel metric and geomorphs use.
   float morph = 0;
   /// Radius of a sphere about the centre vertex at its true height that holds every lattice
   /// vertex under the diamond and every descendant's sphere (nested). FLT_MAX marks a diamond
@@ -96,7 +111,8 @@ class Landscape {
   const std::shared_ptr<const Terrain>& terrain_ptr() const noexcept { return terrain_; }
 
   std::uint32_t patch_exponent() const noexcept { return exponent_; }
-  double morph_window() const noexcept { return morph_window_; }
+  /// The geomorph parameters of LandscapeDesc (window and delay), for morph_factor().
+  Geomorph geomorph() const noexcept { return geomorph_; }
   /// Detail levels L of the terrain: lattice coordinates below are on the finest lattice
   /// (spacing / 2^L); a patch spans 2^(patch_exponent + L) of its cells.
   std::uint32_t detail_levels() const noexcept { return detail_; }
@@ -228,7 +244,8 @@ class Landscape {
 
   std::shared_ptr<const Terrain> terrain_;
   std::uint32_t exponent_ = 6, detail_ = 0, patches_x_ = 0, patches_z_ = 0;
-  double morph_window_ = 0.5, morph_growth_ = 1.0;  // growth = sqrt(1 + w) per level
+  Geomorph geomorph_;
+  double morph_growth_ = 1.0;  // sqrt(1 + delay + window) per level; 1 without geomorphs
   std::int64_t last_i_ = 0, last_j_ = 0;
   std::int64_t stored_w_ = 0, stored_h_ = 0;  // stored lattice vertices per row / column (padded)
   // Per stored vertex: its diamond's bounds (unused for patch corners), and without detail its

@@ -137,15 +137,15 @@ struct PatchMesh {
 /// Geomorph factor t in [0, 1] of a vertex (docs/roam.md, "Geomorphs"), what a vertex shader
 /// computes: with d the distance (metres) from the eye to the vertex at its true position, and
 /// rho = morph_bound * projection_scale / (threshold * max(d - morph_radius, 1e-6)),
-/// t = clamp((rho - 1) / morph_window, 0, 1) (1 when morph_window is 0). `eye` is in the same
-/// patch-local frame as the vertex. t is 0 when the vertex's diamond has just split (the vertex
-/// lies on the edge it splits, as drawn) and reaches 1 before any vertex finer than it can
-/// start to move.
+/// t = clamp((rho - 1 - g.delay) / g.window, 0, 1) (1 when the window is 0), g the landscape's
+/// geomorph(). `eye` is in the same patch-local frame as the vertex. t is 0 when the vertex's
+/// diamond has just split (the vertex lies on the edge it splits, as drawn) and reaches 1 before
+/// any vertex finer than it can start to move.
 float morph_factor(const MeshVertex& v, const glm::vec3& eye, double projection_scale,
-                   double threshold_px, double morph_window) noexcept;
+                   double threshold_px, const Geomorph& g) noexcept;
 /// The drawn (morphed) height of a vertex: y + (1 - t) * morph_dy.
 float morphed_height(const MeshVertex& v, const glm::vec3& eye, double projection_scale,
-                     double threshold_px, double morph_window) noexcept;
+                     double threshold_px, const Geomorph& g) noexcept;
 
 /// The ROAM mesh of one camera. Owns its bintree nodes, its front and its output buffers; reads
 /// the shared Landscape. Two cameras are two RoamViews over one Landscape.

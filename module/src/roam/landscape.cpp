@@ -557,14 +557,16 @@ Result<std::shared_ptr<const Landscape>> Landscape::create(std::shared_ptr<const
                      desc.patch_exponent)};
   if (!(desc.morph_window >= 0.0 && desc.morph_window <= 4.0))
     return Error{fmt("landscape: morph window %s; need 0..4", num(desc.morph_window).c_str())};
+  if (!(desc.morph_delay >= 0.0 && desc.morph_delay <= 1.0))
+    return Error{fmt("landscape: morph delay %s; need 0..1", num(desc.morph_delay).c_str())};
   const auto t0 = std::chrono::steady_clock::now();
   std::shared_ptr<Landscape> l(new Landscape());
   const Heightfield& hf = terrain->heightfield();
   l->terrain_ = std::move(terrain);
   l->exponent_ = desc.patch_exponent;
   l->detail_ = l->terrain_->detail_levels();
-  l->morph_window_ = desc.morph_window;
-  l->morph_growth_ = std::sqrt(1.0 + desc.morph_window);
+  l->geomorph_ = {desc.morph_window, desc.morph_window > 0.0 ? desc.morph_delay : 0.0};
+  l->morph_growth_ = std::sqrt(1.0 + l->geomorph_.delay + l->geomorph_.window);
   const std::int64_t p = std::int64_t{1} << l->exponent_;  // stored cells per patch
   l->patches_x_ = static_cast<std::uint32_t>((hf.width() - 1 + p - 1) / p);
   l->patches_z_ = static_cast<std::uint32_t>((hf.height() - 1 + p - 1) / p);

@@ -47,18 +47,17 @@ const char* stop_reason_name(StopReason r) noexcept {
 }
 
 float morph_factor(const MeshVertex& v, const glm::vec3& eye, double projection_scale,
-                   double threshold_px, double morph_window) noexcept {
-  if (!(morph_window > 0.0) || !(threshold_px > 0.0)) return 1.0f;
+                   double threshold_px, const Geomorph& g) noexcept {
+  if (!(g.window > 0.0) || !(threshold_px > 0.0)) return 1.0f;
   const double dx = double(v.x) - eye.x, dy = double(v.y) - eye.y, dz = double(v.z) - eye.z;
   const double d = std::sqrt(dx * dx + dy * dy + dz * dz) - double(v.morph_radius);
   const double rho = double(v.morph_bound) * projection_scale / (threshold_px * std::max(d, 1e-6));
-  return static_cast<float>(std::clamp((rho - 1.0) / morph_window, 0.0, 1.0));
+  return static_cast<float>(std::clamp((rho - 1.0 - g.delay) / g.window, 0.0, 1.0));
 }
 
 float morphed_height(const MeshVertex& v, const glm::vec3& eye, double projection_scale,
-                     double threshold_px, double morph_window) noexcept {
-  return v.y +
-         (1.0f - morph_factor(v, eye, projection_scale, threshold_px, morph_window)) * v.morph_dy;
+                     double threshold_px, const Geomorph& g) noexcept {
+  return v.y + (1.0f - morph_factor(v, eye, projection_scale, threshold_px, g)) * v.morph_dy;
 }
 
 // ---- creation and settings --------------------------------------------------------------------
