@@ -46,6 +46,22 @@ std::shared_ptr<const Landscape> make_landscape(std::uint32_t size, std::uint32_
   return l.value();
 }
 
+// A field whose size is not 2^k + 1, nor square (83 x 57 samples, 2 m apart): its last patches
+// extend past the samples.
+constexpr std::uint32_t kPaddedW = 83, kPaddedH = 57;
+std::shared_ptr<const Landscape> make_padded_landscape(std::uint32_t k) {
+  HeightfieldDesc d;
+  d.width = kPaddedW;
+  d.height = kPaddedH;
+  d.spacing_x = d.spacing_z = 2.0;
+  std::vector<float> h(std::size_t(d.width) * d.height);
+  for (std::uint32_t j = 0; j < d.height; ++j)
+    for (std::uint32_t i = 0; i < d.width; ++i)
+      h[i + j * d.width] = float(10 * std::sin(0.3 * i) * std::cos(0.21 * j) + 0.05 * i * j);
+  auto terrain = Terrain::create(Heightfield::create(d, h).value());
+  return Landscape::create(terrain, {.patch_exponent = k}).value();
+}
+
 // A leaf's projected bound as the tessellator defines it (landscape.h, docs/roam.md): its
 // diamond's morph bound projected at the distance from the eye to the diamond's bounding sphere
 // (centred at the diamond's vertex at its true height). Recomputed here in double precision from
@@ -296,6 +312,57 @@ TEST(Roam, CoherentAndRebuildConvergeToTheSameMesh) {
   EXPECT_EQ(coherent->mesh_hash(), rebuild->mesh_hash());
 }
 
+// A mesh made from the roots without a budget is built top down (build.cpp: patch by patch,
+// level by level, no front entry made and taken back per split). It must be the mesh the
+// incremental splits make (reached here under a generous time budget, which never builds), with
+// the same front, links and buffers (check_invariants()), on a landscape of many patches and on
+// one whose edge patches extend past the samples; and the coherent updates must carry on from it
+// as from the other, along a path with turns, in both metrics.
+TEST(Roam, TheTopDownBuildIsTheMeshTheSplitsMake) {
+  const std::shared_ptr<const Landscape> landscapes[] = {make_landscape(257, 4),
+                                                         make_padded_landscape(3)};
+  for (const auto& l : landscapes) {
+    for (const RoamSettings& base :
+         {RoamSettings{.threshold = 1.5},
+          RoamSettings{.metric = ErrorMetric::kWorldMetres, .threshold = 0.5}}) {
+      auto built = RoamView::create(l, base).value();
+      RoamSettings slow = base;
+      slow.budget_ms = 1e4;
+      auto split = RoamView::create(l, slow).value();
+      Camera c = camera_at({-10, 90, -20}, {150, 20, 120});
+      for (int k = 0; k < 12; ++k) {
+        auto a = built->update(c);
+        ASSERT_TRUE(a);
+        if (k == 0) {
+          EXPECT_TRUE(a->rebuilt);
+          EXPECT_EQ(a->forced_splits, 0u);
+          EXPECT_GT(a->splits, 100u);
+        } else {
+          EXPECT_FALSE(a->rebuilt) << "step " << k;  // the coherent updates carry on
+        }
+        std::optional<Result<RoamStats>> b;
+        for (int n = 0; n < 50; ++n) {
+          b = split->update(c);
+          ASSERT_TRUE(*b);
+          EXPECT_FALSE((*b)->rebuilt && n + k > 0);
+          if ((*b)->stop == StopReason::kConverged) break;
+        }
+        ASSERT_EQ((*b)->stop, StopReason::kConverged);
+        ASSERT_EQ(built->check_invariants(), "") << "step " << k;
+        ASSERT_EQ(split->check_invariants(), "") << "step " << k;
+        EXPECT_EQ(a->triangles, (*b)->triangles) << "step " << k;
+        EXPECT_EQ(a->front_size, (*b)->front_size) << "step " << k;
+        EXPECT_EQ(built->mesh_hash(), split->mesh_hash()) << "step " << k;
+        EXPECT_EQ(check_crack_free(*built), "");
+        // Forward and turning.
+        const glm::dvec3 step(9, -3, 7);
+        c.eye += step;
+        c.target += step + glm::dvec3(k % 3 == 0 ? 40 : 0, 0, k % 4 == 0 ? -30 : 0);
+      }
+    }
+  }
+}
+
 TEST(Roam, TriangleBudgetIsAHardCap) {
   auto l = make_landscape(257, 5);
   auto view = RoamView::create(l, {.threshold = 0.1, .max_triangles = 5000}).value();
@@ -522,17 +589,8 @@ TEST(Roam, AVertexStartsOnItsParentEdgeAsDrawn) {
 // no vertex beyond the last sample, and the drawn triangles' areas add up to the data's area, so
 // there is neither a gap nor an overhang; at a fine threshold and at the coarsest tolerance.
 TEST(Roam, MeshEndsExactlyOnTheDataBorder) {
-  HeightfieldDesc d;
-  d.width = 83;
-  d.height = 57;
-  d.spacing_x = d.spacing_z = 2.0;
-  std::vector<float> h(std::size_t(d.width) * d.height);
-  for (std::uint32_t j = 0; j < d.height; ++j)
-    for (std::uint32_t i = 0; i < d.width; ++i)
-      h[i + j * d.width] = float(10 * std::sin(0.3 * i) * std::cos(0.21 * j) + 0.05 * i * j);
-  auto terrain = Terrain::create(Heightfield::create(d, h).value());
-  auto l = Landscape::create(terrain, {.patch_exponent = 4}).value();
-  const double w = (d.width - 1) * 2.0, hz = (d.height - 1) * 2.0;
+  auto l = make_padded_landscape(4);
+  const double w = (kPaddedW - 1) * 2.0, hz = (kPaddedH - 1) * 2.0;
   // At a fine threshold, at the coarsest tolerance, and under a triangle cap far below what the
   // threshold asks for (the border's splits are forced: they go past the cap, as crack fixes do).
   const std::uint32_t roots = l->root_count();

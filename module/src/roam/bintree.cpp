@@ -243,6 +243,30 @@ std::uint32_t RoamView::Impl::split_triangle(std::uint32_t p, const LatticeTrian
   return c;
 }
 
+// Links after triangle p split into children c, c + 1 (its vertex slot v), pc the partner's
+// children (kNone on the border): each child's base is the parent's outer neighbour on that side;
+// across the split hypotenuse the children border the partner's children (c0.b is the partner's
+// c1, whose a links back; c1.a is the partner's c0, whose b links back). Every link a store: the
+// link words say which link of each neighbour points back.
+void RoamView::Impl::link_children(std::uint32_t p, std::uint32_t c, std::uint32_t pc,
+                                   std::uint32_t v) {
+  Node& x = nodes[p];
+  const std::uint32_t left = x.a(), right = x.b();
+  Node& n0 = nodes[c];
+  Node& n1 = nodes[c + 1];
+  n0.base() = left;
+  n0.a() = link_word(c + 1, 2);
+  n0.b() = pc != kNone ? link_word(pc + 1, 1) : kNone;
+  n1.base() = right;
+  n1.a() = pc != kNone ? link_word(pc, 2) : kNone;
+  n1.b() = link_word(c, 1);
+  relink(left, link_word(c, 0));
+  relink(right, link_word(c + 1, 0));
+  x.a() = c;
+  x.b() = v;
+  x.set_interior();
+}
+
 bool RoamView::Impl::split(std::uint32_t n, bool forced, std::vector<std::uint32_t>* queue) {
   // Make the base neighbour a diamond partner first (forced splits): it is coarser, and its
   // split gives n a partner sharing n's hypotenuse.
@@ -283,29 +307,8 @@ bool RoamView::Impl::split(std::uint32_t n, bool forced, std::vector<std::uint32
   }
   const std::uint32_t cT = split_triangle(T, tT, pT, vT);
   const std::uint32_t cB = B != kNone ? split_triangle(B, tB, pB, vB) : kNone;
-  // Links: each child's base is the parent's outer neighbour on that side; across the split
-  // hypotenuse the children border the partner's children (c0.b is the partner's c1, whose a
-  // links back; c1.a is the partner's c0, whose b links back). Every link a store: the link
-  // words say which link of each neighbour points back.
-  auto link = [&](std::uint32_t p, std::uint32_t c, std::uint32_t pc) {
-    Node& x = nodes[p];
-    const std::uint32_t left = x.a(), right = x.b();
-    Node& n0 = nodes[c];
-    Node& n1 = nodes[c + 1];
-    n0.base() = left;
-    n0.a() = link_word(c + 1, 2);
-    n0.b() = pc != kNone ? link_word(pc + 1, 1) : kNone;
-    n1.base() = right;
-    n1.a() = pc != kNone ? link_word(pc, 2) : kNone;
-    n1.b() = link_word(c, 1);
-    relink(left, link_word(c, 0));
-    relink(right, link_word(c + 1, 0));
-    x.a() = c;
-    x.b() = p == T ? vT : vB;
-    x.set_interior();
-  };
-  link(T, cT, cB);
-  if (B != kNone) link(B, cB, cT);
+  link_children(T, cT, cB, vT);
+  if (B != kNone) link_children(B, cB, cT, vB);
   triangles += B != kNone ? 2 : 1;
   // Front: the diamond is now split and mergeable; its parents' diamonds no longer are; the
   // children's diamonds join the front.

@@ -335,6 +335,12 @@ std::uint8_t Front::test_one(std::uint32_t e, const FrontCamera& c, float* prior
   return std::uint8_t(t);
 }
 
+std::uint8_t Front::test_values(float x, float y, float z, float mu, float r, const FrontCamera& c,
+                                float* priority) noexcept {
+  return std::uint8_t(c.world ? world_test(mu, r, c, priority)
+                              : screen_test(x, y, z, mu, r, c, priority));
+}
+
 float Front::priority(std::uint32_t e, const FrontCamera& c) const noexcept {
   const Hot& h = block(e >> 3);
   const std::uint32_t l = e & 7;

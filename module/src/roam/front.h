@@ -176,6 +176,10 @@ class Front {
   /// Tests one entry (a new one, or one whose data changed) the same way, bit for bit; returns
   /// kActive | kInView bits. `priority`, when given, receives its priority.
   std::uint8_t test_one(std::uint32_t e, const FrontCamera& c, float* priority = nullptr) noexcept;
+  /// The same test of a diamond that has no entry (yet): centre (x, y, z), bound mu, radius r,
+  /// as add() takes them. Bit for bit test_one()'s answer for the entry add() would make.
+  static std::uint8_t test_values(float x, float y, float z, float mu, float r,
+                                  const FrontCamera& c, float* priority = nullptr) noexcept;
   /// Largest priority of an entry in view that is left unsplit, not counting those that wait
   /// for a detail tile (active and provisional).
   float max_unsplit_priority(const FrontCamera& c) const noexcept;

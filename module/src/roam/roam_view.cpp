@@ -677,10 +677,14 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
     m.snapshot = m.cache->snapshot();
   }
   l.sync();
+  // A mesh made from the roots is built top down when nothing orders the changes (no time
+  // budget, no queues of a cap's first update): build.cpp.
+  const bool whole = !m.has_deadline && (cap == 0 || (capped && m.cap_threshold > 0.0));
   if (m.reset_pending || settings_.mode == RoamMode::kRebuild) {
     m.reset_pending = false;
     m.synced_version = l.version();
     m.reset();
+    if (whole) m.build();
   } else {
     m.pull_changes();
   }
@@ -721,6 +725,7 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
   if (settings_.mode == RoamMode::kCoherent && !m.st.rebuilt && (cap == 0 || capped) &&
       !m.has_deadline && m.to_merge.size() > std::max<std::size_t>(512, m.front.size() / 8)) {
     m.reset();
+    if (whole) m.build();
     m.fresh_worst = m.front.evaluate(m.cam);
     m.st.priority_updates += m.front.size();
     m.collect();
@@ -751,7 +756,10 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
   m.st.memory_bytes = m.nodes.memory_bytes() + m.front.memory_bytes() +
                       (m.to_merge.capacity() + m.to_split.capacity() + m.next_wave.capacity()) *
                           sizeof(std::uint32_t) +
-                      m.keyed.capacity() * sizeof(Front::Keyed);
+                      m.keyed.capacity() * sizeof(Front::Keyed) +
+                      (m.build_wave.capacity() + m.build_next.capacity() +
+                       m.build_split.capacity() + m.build_lonely.capacity()) *
+                          sizeof(Impl::BuildItem);
   m.st.output_bytes = m.out.memory_bytes();
   m.st.upload_bytes = m.out.take_upload_bytes();
   m.st.dirty_patches = m.out.dirty_patch_count();

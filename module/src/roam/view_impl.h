@@ -5,6 +5,7 @@
 //   patch_output.h  per-patch buffers the engine uploads, patched slot by slot
 //   bintree.cpp     split (with forced splits) and merge of diamonds, links, front and output
 //                   kept in step
+//   build.cpp       the mesh built from the roots in one top-down pass (first update, rebuilds)
 //   roam_view.cpp   the update's phases: edits, detail tiles, the test, merges, splits, budgets
 //   mesh_walk.cpp   walks from the roots: leaves, hash, measurement, invariants
 #pragma once
@@ -135,9 +136,27 @@ struct RoamView::Impl {
   /// first child.
   std::uint32_t split_triangle(std::uint32_t p, const LatticeTriangle& t, std::uint32_t patch,
                                std::uint32_t v);
+  /// Links after triangle p split into children c, c + 1 (new vertex slot v); pc: the
+  /// partner's children (kNone on the border).
+  void link_children(std::uint32_t p, std::uint32_t c, std::uint32_t pc, std::uint32_t v);
   /// A new leaf's entry: joins its partner's, or a new one (tested; to `queue` when active).
   void attach_leaf(std::uint32_t n, const LatticeTriangle& t, std::vector<std::uint32_t>* queue);
   void reset();
+  /// A diamond of build(): node T (its side set), partner B (kNone on the border or when
+  /// alone), centre and canonical half hypotenuse.
+  struct BuildItem {
+    std::uint32_t T, B;
+    std::int32_t ci, cj, hu, hw;
+    float y = 0, mu = 0, r = 0;  // a split diamond's entry data (kept for its entry)
+    bool prov = false;
+  };
+  /// After reset(): the mesh the camera's test asks for, built top down, level by level, with
+  /// the front and the output (build.cpp). Leaves to the update's pass only what the nesting
+  /// does not give (a detail tile to wait for, a rounding case).
+  void build();
+  void build_children(std::uint32_t c, const LatticeTriangle& t, std::vector<BuildItem>& wave,
+                      std::vector<BuildItem>& lonely);
+  std::vector<BuildItem> build_wave, build_next, build_split, build_lonely;
   bool split_candidate(std::uint32_t n) const;
   bool merge_candidate(std::uint32_t n) const;
 
