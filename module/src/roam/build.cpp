@@ -165,6 +165,10 @@ void RoamView::Impl::build() {
         if (children_leaves(d.T) && (d.B == kNone || children_leaves(d.B)))
           enter(d, d.y, d.mu, d.r, true, d.prov);
     }
+  // The lists are as long as the largest patch's levels (100-300 KiB near the eye): given back,
+  // not kept in the view's state between builds.
+  for (std::vector<BuildItem>* v : {&wave, &next, &splits, &lonely})
+    std::vector<BuildItem>().swap(*v);
   st.rebuilt = true;
 }
 

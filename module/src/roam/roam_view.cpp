@@ -756,10 +756,7 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
   m.st.memory_bytes = m.nodes.memory_bytes() + m.front.memory_bytes() +
                       (m.to_merge.capacity() + m.to_split.capacity() + m.next_wave.capacity()) *
                           sizeof(std::uint32_t) +
-                      m.keyed.capacity() * sizeof(Front::Keyed) +
-                      (m.build_wave.capacity() + m.build_next.capacity() +
-                       m.build_split.capacity() + m.build_lonely.capacity()) *
-                          sizeof(Impl::BuildItem);
+                      m.keyed.capacity() * sizeof(Front::Keyed);
   m.st.output_bytes = m.out.memory_bytes();
   m.st.upload_bytes = m.out.take_upload_bytes();
   m.st.dirty_patches = m.out.dirty_patch_count();

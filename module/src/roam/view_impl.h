@@ -156,7 +156,7 @@ struct RoamView::Impl {
   void build();
   void build_children(std::uint32_t c, const LatticeTriangle& t, std::vector<BuildItem>& wave,
                       std::vector<BuildItem>& lonely);
-  std::vector<BuildItem> build_wave, build_next, build_split, build_lonely;
+  std::vector<BuildItem> build_wave, build_next, build_split, build_lonely;  // empty between builds
   bool split_candidate(std::uint32_t n) const;
   bool merge_candidate(std::uint32_t n) const;
 
