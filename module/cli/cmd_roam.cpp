@@ -41,8 +41,8 @@ struct LodArgs {
     g->add_option("--budget-ms", budget_ms, "Time budget per update, milliseconds")
         ->type_name("MS");
     g->add_option("--mode", mode,
-                  "coherent (split/merge queues) or rebuild (split only, Turner); bench lod "
-                  "also soar (the stateless SOAR comparator)")
+                  "coherent (the mesh carried over, split and merged) or rebuild (built from the "
+                  "roots every update); bench lod also soar (the stateless SOAR comparator)")
         ->type_name("MODE");
     g->add_option("--morph-window", morph_window,
                   "Geomorph window w, 0..4 (default 0.2; 0: no geomorphs, no morph nesting)")

@@ -12,7 +12,7 @@ COLS = ["scene", "path", "kind", "value", "mode", "triangles", "ms", "ms_p99", "
 MODES = ["roam_coherent", "roam_rebuild", "soar", "uniform_grid", "cdlod"]
 COLORS = {"roam_coherent": "#9400d3", "roam_rebuild": "#009e73", "soar": "#d55e00",
           "uniform_grid": "#56b4e9", "cdlod": "#e69f00"}
-TITLES = {"roam_coherent": "ROAM coherent", "roam_rebuild": "ROAM rebuild (split only)",
+TITLES = {"roam_coherent": "ROAM coherent", "roam_rebuild": "ROAM rebuild (from the roots)",
           "soar": "SOAR (stateless)", "uniform_grid": "uniform grid", "cdlod": "CDLOD-like quadtree"}
 
 
