@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <numeric>
 
 #include "bench_soar.h"
 #include "cli_util.h"
@@ -276,7 +277,7 @@ int run_bench_lod(const BenchLodArgs& a) {
   nlohmann::ordered_json out_frames = nlohmann::ordered_json::array();
   std::vector<double> ms, cpu, out_ms, out_cpu, total_ms, total_cpu, tris, in_view, changes,
       max_err, rms_err, px_err, mem, out_mem, upload;
-  std::uint32_t time_stops = 0, rebuilds = 0;
+  std::uint32_t time_stops = 0, rebuilds = 0, compactions = 0;
   for (std::uint64_t rep = 0; rep < *repeat; ++rep) {
     for (std::size_t k = 0; k < frames->size(); ++k) {
       const Camera& c = (*frames)[k].camera;
@@ -311,6 +312,7 @@ int run_bench_lod(const BenchLodArgs& a) {
                                   {"front_size", st->front_size},
                                   {"upload_bytes", st->upload_bytes},
                                   {"dirty_patches", dirty.size()},
+                                  {"compacted_patches", st->compacted_patches},
                                   {"rebuilt", st->rebuilt},
                                   {"stopped_by", stop_reason_name(st->stop)},
                                   {"morph_threshold", st->morph_threshold}};
@@ -339,6 +341,7 @@ int run_bench_lod(const BenchLodArgs& a) {
       out_mem.push_back(double(st->output_bytes));
       upload.push_back(double(st->upload_bytes));
       time_stops += st->stop == StopReason::kTimeBudget;
+      compactions += st->compacted_patches;
       rebuilds += st->rebuilt;
     }
   }
@@ -365,6 +368,9 @@ int run_bench_lod(const BenchLodArgs& a) {
       {"triangles_in_view_median", percentile(in_view, 0.5)},
       {"changes_per_frame_median", percentile(changes, 0.5)},
       {"upload_bytes_median", percentile(upload, 0.5)},
+      {"upload_bytes_mean",
+       upload.empty() ? 0.0
+                      : std::accumulate(upload.begin(), upload.end(), 0.0) / double(upload.size())},
       {"upload_bytes_p99", percentile(upload, 0.99)},
       {"view_memory_bytes_median", percentile(mem, 0.5)},
       {"view_bytes_per_triangle", percentile(mem, 0.5) / tri_median},
@@ -376,6 +382,7 @@ int run_bench_lod(const BenchLodArgs& a) {
       {"max_screen_error_px_max", percentile(px_err, 1.0)},
       {"time_budget_stops", time_stops},
       {"rebuilds", rebuilds},
+      {"compacted_patches", compactions},
       {"bounds_build_ms", bounds_ms},
       {"bounds_bytes", bound_bytes},
       {"error_every", *every},

@@ -81,6 +81,10 @@ struct RoamStats {
   /// Bytes of vertex and index data this update changed: what an engine re-uploads (the dirty
   /// ranges of take_dirty_patches(), or whole buffers that were resized).
   std::uint64_t upload_bytes = 0;
+  /// Patches whose buffers this update compacted (renumbered in tree order and shrunk to fit,
+  /// resized: upload them whole) because their slots outnumbered their live triangles or vertices
+  /// more than 2 to 1 (docs/roam.md, "Output for an engine").
+  std::uint32_t compacted_patches = 0;
   /// Diamonds that should split but wait for a procedural-detail tile (requested, generated on the
   /// cache's workers): held at the coarser level, exempt from the converged bound, tested again
   /// at the next update. max_remaining_error does not count them.
@@ -128,7 +132,8 @@ struct PatchMesh {
   std::vector<std::uint32_t> indices;
   /// Vertex and triangle slots changed up to the last take_dirty_patches() (sorted, disjoint).
   std::vector<MeshRange> dirty_vertices, dirty_triangles;
-  /// The buffers were reallocated or compacted: upload them whole.
+  /// The buffers were reallocated, or compacted (every slot renumbered, the arrays shorter):
+  /// upload them whole.
   bool resized = false;
   std::uint32_t triangles = 0;  ///< triangles drawn (not degenerate)
   std::uint64_t version = 0;    ///< increases whenever this patch's mesh changes

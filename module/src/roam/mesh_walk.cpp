@@ -73,6 +73,14 @@ std::string RoamView::Impl::check() const {
     const Node& nd = m.nodes[n];
     const std::int64_t ci = (t.lx + t.rx) / 2, cj = (t.lz + t.rz) / 2;
     if (!leaf) {
+      // Its vertex slot holds its hypotenuse's midpoint in its patch's buffers.
+      const std::uint32_t patch = m.patch_of(t), v = nd.b();
+      if (v >= m.out.vertex_slots(patch) || !m.out.vertex_live(patch, v) ||
+          m.out.coord(patch, v) != std::array<std::int64_t, 2>{ci, cj}) {
+        err = fmt("node %u (root %u heap %llu): vertex slot %u of patch %u is not its midpoint", n,
+                  root, static_cast<unsigned long long>(heap), v, patch);
+        return;
+      }
       // An interior node's diamond has an entry exactly when it is mergeable.
       const bool has = nd.entry() != kNoEntry;
       if (has != m.mergeable(n)) {

@@ -5,6 +5,7 @@
 #include <cfloat>
 #include <glm/geometric.hpp>
 
+#include "ridgeline/log.h"
 #include "ridgeline/surface.h"
 #include "roam/diamond.h"
 #include "roam/landscape_access.h"
@@ -17,6 +18,7 @@ void PatchOutput::reset(const Landscape& land) {
   if (patches_.size() != np) patches_.assign(np, Patch{});
   dirty_list_.clear();
   stale_.clear();
+  pending_.clear();
   bytes_ = 0;
   const std::int64_t P = land.patch_cells();
   for (std::uint32_t p = 0; p < np; ++p) {
@@ -34,6 +36,8 @@ void PatchOutput::reset(const Landscape& land) {
     ++pt.mesh.version;
     pt.free_tris.clear();
     pt.free_verts = kNoSlot;
+    pt.live_verts = 0;
+    pt.pending = false;
     pt.tri_bits.clear();
     pt.vert_bits.clear();
     pt.hidden.clear();
@@ -100,6 +104,54 @@ std::uint32_t PatchOutput::grow_triangles(Patch& p) {
   p.mesh.indices.insert(p.mesh.indices.end(), 3, 0u);
   if ((slot >> 6) >= p.tri_bits.size()) p.tri_bits.push_back(0);
   return slot;
+}
+
+void PatchOutput::compact(std::uint32_t patch, const std::vector<std::uint32_t>& order,
+                          std::vector<std::uint32_t>& vmap) {
+  Patch& p = patches_[patch];
+  std::vector<MeshVertex> verts;
+  verts.reserve(p.live_verts);
+  vmap.assign(p.mesh.vertices.size(), kNoSlot);
+  for (std::uint32_t c = 0; c < 4; ++c) {  // the corners, never freed
+    vmap[c] = c;
+    verts.push_back(p.mesh.vertices[c]);
+  }
+  std::vector<std::uint32_t> indices;
+  indices.reserve(order.size() * 3);
+  std::unordered_map<std::uint32_t, std::array<std::uint32_t, 3>> hidden;
+  for (std::uint32_t old : order) {
+    std::array<std::uint32_t, 3> k = corners(patch, old);
+    for (std::uint32_t& v : k) {
+      if (vmap[v] == kNoSlot) {
+        vmap[v] = std::uint32_t(verts.size());
+        verts.push_back(p.mesh.vertices[v]);
+      }
+      v = vmap[v];
+    }
+    const std::uint32_t* ix = &p.mesh.indices[std::size_t(old) * 3];
+    if (ix[0] == ix[1]) {  // over the padding: degenerate, its corners aside
+      hidden.emplace(std::uint32_t(indices.size() / 3), k);
+      indices.insert(indices.end(), 3, 0u);
+    } else {
+      indices.insert(indices.end(), k.begin(), k.end());
+    }
+  }
+  // Every live vertex is a corner of a live triangle of its patch (a patch corner, or the
+  // midpoint of an ancestor's hypotenuse), so none is lost.
+  RIDGELINE_ASSERT(verts.size() == p.live_verts);
+  p.mesh.vertices = std::move(verts);
+  p.mesh.indices = std::move(indices);
+  p.hidden = std::move(hidden);
+  p.free_verts = kNoSlot;
+  std::vector<std::uint32_t>().swap(p.free_tris);
+  p.vert_bits.assign((p.mesh.vertices.size() + 63) / 64, 0);
+  p.vert_bits.shrink_to_fit();
+  p.tri_bits.assign((p.mesh.indices.size() / 3 + 63) / 64, 0);
+  p.tri_bits.shrink_to_fit();
+  p.grew = true;  // resized: uploaded whole
+  p.stale = true;
+  stale_.push_back(patch);
+  touch(patch);
 }
 
 void PatchOutput::refresh_vertex(std::uint32_t patch, std::uint32_t slot) {

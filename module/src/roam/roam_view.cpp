@@ -648,6 +648,55 @@ double RoamView::Impl::converge_capped(const Camera& camera, double threshold, s
   return tau;
 }
 
+// ---- output compaction
+// ---------------------------------------------------------------------------
+
+// A patch's slots are renumbered in the depth-first order of its two trees (child 0 first): the
+// leaves' order is a space-filling curve over the patch, so neighbouring triangles sit side by
+// side in the index buffer and share vertices nearby, what a GPU's vertex cache likes.
+void RoamView::Impl::compact_output(const std::chrono::steady_clock::time_point* until) {
+  std::vector<std::uint32_t>& pending = out.compact_pending();
+  std::size_t kept = 0;  // patches left listed for a later update, moved to the front
+  for (std::size_t q = 0; q < pending.size(); ++q) {
+    const std::uint32_t p = pending[q];
+    if (until != nullptr &&
+        std::chrono::steady_clock::now() +
+                std::chrono::nanoseconds(kCompactNsPerTriangle * out.live_triangles(p)) >
+            *until) {
+      pending[kept++] = p;
+      continue;
+    }
+    out.unlist_compact(p);
+    if (!out.oversized(p)) continue;  // grew back since it was listed
+    compact_nodes.clear();
+    compact_order.clear();
+    compact_stack.assign({2 * p + 1, 2 * p});
+    while (!compact_stack.empty()) {
+      const std::uint32_t n = compact_stack.back();
+      compact_stack.pop_back();
+      compact_nodes.push_back(n);
+      const Node& x = nodes[n];
+      if (x.leaf()) {
+        compact_order.push_back(x.slot());
+      } else {
+        compact_stack.push_back(x.a() + 1);
+        compact_stack.push_back(x.a());
+      }
+    }
+    out.compact(p, compact_order, compact_vmap);
+    std::uint32_t k = 0;
+    for (const std::uint32_t n : compact_nodes) {
+      Node& x = nodes[n];
+      if (x.leaf())
+        x.set_slot(k++);
+      else
+        x.b() = compact_vmap[x.b()];
+    }
+    ++st.compacted_patches;
+  }
+  pending.resize(kept);
+}
+
 // ---- the update
 // ------------------------------------------------------------------------------------
 
@@ -731,6 +780,13 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
     m.collect();
   }
 
+  if (m.has_deadline && !m.out.compact_pending().empty()) {
+    const auto until = std::chrono::steady_clock::now() +
+                       std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                           (m.deadline - t0) * Impl::kCompactShare);
+    m.compact_output(&until);
+  }
+
   // 3-4. Splits and merges.
   double reached_px = threshold;
   if (capped)
@@ -739,6 +795,10 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
     m.fresh_worst = m.converge_budgeted(threshold, cap);
   else
     m.converge_all();
+
+  // 5. Output: patches whose buffers hold many more slots than live triangles are compacted
+  // (under a time budget before the changes, in a share of the budget).
+  if (!m.has_deadline) m.compact_output(nullptr);
 
   // Statistics.
   m.st.triangles = m.triangles;
