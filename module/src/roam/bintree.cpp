@@ -36,13 +36,6 @@ RoamView::Impl::Impl(const Landscape& l)
 
 // ---- geometry -----------------------------------------------------------------------------------
 
-LatticeTriangle RoamView::Impl::diamond_triangle(std::int64_t i, std::int64_t j, std::int64_t hu,
-                                                 std::int64_t hw, std::uint32_t side) noexcept {
-  // sigma = +1 for side 1: A = c + sigma p, L = c + sigma h, R = c - sigma h, p = (-hw, hu).
-  const std::int64_t su = side ? hu : -hu, sw = side ? hw : -hw;
-  return {i - sw, j + su, i + su, j + sw, i - su, j - sw};
-}
-
 LatticeTriangle RoamView::Impl::leaf_triangle(std::uint32_t n) const {
   const Node& x = nodes[n];
   if (x.entry() == kNoEntry) {
@@ -54,27 +47,13 @@ LatticeTriangle RoamView::Impl::leaf_triangle(std::uint32_t n) const {
   return entry_triangle(x.entry(), x.side());
 }
 
-std::uint32_t RoamView::Impl::patch_of(const LatticeTriangle& t) const {
-  // The midpoint of the median from the apex to the hypotenuse's midpoint is inside the
-  // triangle, hence strictly inside its patch: floor((A + M) / 2P) per axis.
-  const std::int64_t px = (2 * t.ax + t.lx + t.rx) >> (K + 2);
-  const std::int64_t pz = (2 * t.az + t.lz + t.rz) >> (K + 2);
-  return std::uint32_t(px + pz * std::int64_t(px_count));
-}
-
 // ---- front entries
 // --------------------------------------------------------------------------------
 
-void RoamView::Impl::entry_data(std::int64_t i, std::int64_t j, float& y, float& mu, float& r,
-                                bool& provisional) const {
+void RoamView::Impl::entry_data_slow(std::int64_t i, std::int64_t j, float& y, float& mu, float& r,
+                                     bool& provisional) const {
   provisional = false;
-  DiamondBound b;
-  if (LandscapeAccess::bound_and_height(land, i, j, b, y)) {  // stored: one record, one read
-    mu = cam.world ? b.error : b.morph;
-    r = b.radius;
-    return;
-  }
-  b = LandscapeAccess::diamond(land, i, j);
+  const DiamondBound b = LandscapeAccess::diamond(land, i, j);
   mu = cam.world ? b.error : b.morph;
   r = b.radius;
   if (snapshot != nullptr) {

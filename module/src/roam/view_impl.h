@@ -23,6 +23,7 @@
 #include "ridgeline/roam_view.h"
 #include "roam/diamond.h"
 #include "roam/front.h"
+#include "roam/landscape_access.h"
 #include "roam/nodes.h"
 #include "roam/patch_output.h"
 
@@ -81,8 +82,14 @@ struct RoamView::Impl {
 
   // ---- geometry (diamond.h: a triangle from its diamond's centre, half hypotenuse and side) --
 
+  // (Inline: called per split, merge and built diamond from several files; out of line, the
+  // returned triangle went through memory and its 16-byte reloads missed store forwarding.)
   static LatticeTriangle diamond_triangle(std::int64_t i, std::int64_t j, std::int64_t hu,
-                                          std::int64_t hw, std::uint32_t side) noexcept;
+                                          std::int64_t hw, std::uint32_t side) noexcept {
+    // sigma = +1 for side 1: A = c + sigma p, L = c + sigma h, R = c - sigma h, p = (-hw, hu).
+    const std::int64_t su = side ? hu : -hu, sw = side ? hw : -hw;
+    return {i - sw, j + su, i + su, j + sw, i - su, j - sw};
+  }
   /// The triangle of side `side` of entry e's diamond.
   LatticeTriangle entry_triangle(std::uint32_t e, std::uint32_t side) const noexcept {
     return diamond_triangle(front.ci(e), front.cj(e), front.hu(e), front.hw(e), side);
@@ -90,7 +97,13 @@ struct RoamView::Impl {
   /// The lattice triangle of a leaf (from its entry, or its parent's for the finest level).
   LatticeTriangle leaf_triangle(std::uint32_t n) const;
   /// The patch holding a triangle.
-  std::uint32_t patch_of(const LatticeTriangle& t) const;
+  std::uint32_t patch_of(const LatticeTriangle& t) const noexcept {
+    // The midpoint of the median from the apex to the hypotenuse's midpoint is inside the
+    // triangle, hence strictly inside its patch: floor((A + M) / 2P) per axis.
+    const std::int64_t px = (2 * t.ax + t.lx + t.rx) >> (K + 2);
+    const std::int64_t pz = (2 * t.az + t.lz + t.rz) >> (K + 2);
+    return std::uint32_t(px + pz * std::int64_t(px_count));
+  }
   /// True when every corner of t lies on or past the last sampled row or column: t is over the
   /// padding (not drawn).
   bool padding(const LatticeTriangle& t) const noexcept {
@@ -109,8 +122,22 @@ struct RoamView::Impl {
   void remove_entry(std::uint32_t e);
   /// Recomputes an entry's bounds and position from the landscape.
   void refresh_entry(std::uint32_t e);
+  /// A diamond's entry data: its centre's height, its bound (morph, or error in the tolerance
+  /// mode) and radius, and whether it is provisional (its detail tile is not resident).
   void entry_data(std::int64_t i, std::int64_t j, float& y, float& mu, float& r,
-                  bool& provisional) const;
+                  bool& provisional) const {
+    DiamondBound b;
+    if (roam::LandscapeAccess::bound_and_height(land, i, j, b, y)) {  // stored: one read
+      mu = cam.world ? b.error : b.morph;
+      r = b.radius;
+      provisional = false;
+      return;
+    }
+    entry_data_slow(i, j, y, mu, r, provisional);
+  }
+  /// entry_data() of a vertex without a stored record (procedural detail, outside the data).
+  void entry_data_slow(std::int64_t i, std::int64_t j, float& y, float& mu, float& r,
+                       bool& provisional) const;
   /// Tests a new entry now (counted, and its priority kept for the remaining error).
   std::uint8_t test_new(std::uint32_t e);
 
