@@ -10,7 +10,9 @@
 #   SOAR: refinement + emission of the whole triangle strip, from scratch every frame
 #
 # Rows: at equal whole-landscape triangle counts (--triangles N --threshold 0: ROAM's cap; SOAR's
-# one kappa whose median count over the path is closest to N), and both at --threshold 1.
+# one kappa whose median count over the path is closest to N), and both at --threshold 1. Each
+# row twice: with nothing between frames (warm caches) and with 64 MiB of other memory read and
+# written before each frame (--flush-mb 64: the rest of a game's frame evicting the terrain).
 # Usage: scripts/bench_roam_vs_soar.sh [OUT.json]   (default docs/benchmarks/roam_vs_soar.json)
 # ROUNDS=N (default 3).
 set -euo pipefail
@@ -29,17 +31,17 @@ noise=(--heightmap "$work/noise1025.png" --spacing 1 --height-scale 0.005
        --path "$work/noise1025_circle.json" --warmup 60 --error-every 10)
 
 rm -f "$work/vs_soar.jsonl"
-run() {  # ROW MODE ROUND ARGS...
-  local row=$1 mode=$2 round=$3; shift 3
-  local f="$work/vs_soar_${row}_${mode}_${round}.json"
-  "$ridge" bench lod "${noise[@]}" --mode "$mode" "$@" --json "$f" ||
+run() {  # ROW FLUSH_MB MODE ROUND ARGS...
+  local row=$1 flush=$2 mode=$3 round=$4; shift 4
+  local f="$work/vs_soar_${row}_${flush}_${mode}_${round}.json"
+  "$ridge" bench lod "${noise[@]}" --mode "$mode" --flush-mb "$flush" "$@" --json "$f" ||
     { echo "bench_roam_vs_soar.sh: $row $mode failed" >&2; exit 1; }
-  python3 - "$f" "$row" "$mode" "$round" "$(cut -d' ' -f1 /proc/loadavg)" \
+  python3 - "$f" "$row" "$flush" "$mode" "$round" "$(cut -d' ' -f1 /proc/loadavg)" \
     >> "$work/vs_soar.jsonl" <<'PY'
 import json, sys
 s = json.load(open(sys.argv[1]))["summary"]
-print(json.dumps({"row": sys.argv[2], "mode": sys.argv[3], "round": int(sys.argv[4]),
-                  "load": float(sys.argv[5]), "summary": s}))
+print(json.dumps({"row": sys.argv[2], "flush_mb": float(sys.argv[3]), "mode": sys.argv[4],
+                  "round": int(sys.argv[5]), "load": float(sys.argv[6]), "summary": s}))
 PY
 }
 for row in n5250 n20800 n53000 t1; do
@@ -47,9 +49,11 @@ for row in n5250 n20800 n53000 t1; do
     t1) args=(--threshold 1) ;;
     *) args=(--triangles "${row#n}" --threshold 0) ;;
   esac
-  for ((k = 0; k < rounds; ++k)); do
-    run "$row" coherent "$k" "${args[@]}"
-    run "$row" soar "$k" "${args[@]}"
+  for flush in 0 64; do
+    for ((k = 0; k < rounds; ++k)); do
+      run "$row" "$flush" coherent "$k" "${args[@]}"
+      run "$row" "$flush" soar "$k" "${args[@]}"
+    done
   done
 done
 
@@ -79,9 +83,9 @@ import json, statistics, sys
 runs = [json.loads(l) for l in open(sys.argv[1])]
 med = statistics.median
 rows = []
-for row in dict.fromkeys(r["row"] for r in runs):
-    c = [r for r in runs if r["row"] == row and r["mode"] == "coherent"]
-    s = [r for r in runs if r["row"] == row and r["mode"] == "soar"]
+for row, flush in dict.fromkeys((r["row"], r["flush_mb"]) for r in runs):
+    c = [r for r in runs if (r["row"], r["flush_mb"]) == (row, flush) and r["mode"] == "coherent"]
+    s = [r for r in runs if (r["row"], r["flush_mb"]) == (row, flush) and r["mode"] == "soar"]
     def m(rs, key):
         v = [r["summary"][key] for r in rs if r["summary"].get(key) is not None]
         return med(v) if v else None
@@ -91,6 +95,7 @@ for row in dict.fromkeys(r["row"] for r in runs):
                  a["summary"]["update_plus_output_cpu_ms_median"] for a, b in zip(c, s)]
     rows.append({
         "row": row,
+        "flush_mb": flush,
         "roam_update_plus_output_ms": m(c, "update_plus_output_ms_median"),
         "roam_update_plus_output_cpu_ms": m(c, "update_plus_output_cpu_ms_median"),
         "roam_update_ms": m(c, "update_ms_median"),
@@ -124,7 +129,7 @@ if core and os.path.exists(core):
     d["bench_roam_core"] = [json.loads(l) for l in open(core)]
     json.dump(d, open(sys.argv[2], "w"), indent=1)
 for r in rows:
-    print(f'{r["row"]:>7}: ROAM {r["roam_update_plus_output_ms"]:.3f} ms, SOAR '
+    print(f'{r["row"]:>7} flush {r["flush_mb"]:>3g} MiB: ROAM {r["roam_update_plus_output_ms"]:.3f} ms, SOAR '
           f'{r["soar_refine_and_emit_ms"]:.3f} ms, SOAR/ROAM {r["soar_over_roam_wall"]:.2f} (wall) '
           f'{r["soar_over_roam_cpu"]:.2f} (cpu); triangles {r["roam_triangles"]:.0f} / '
           f'{r["soar_triangles"]:.0f}; RMS {r["roam_rms_error_m"]:.3f} / {r["soar_rms_error_m"]:.3f} m')

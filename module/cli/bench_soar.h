@@ -18,6 +18,7 @@ struct SoarBenchArgs {
   const std::vector<io::PathFrame>* frames = nullptr;
   std::string threshold, triangles, budget_ms;
   std::uint64_t error_every = 1, error_stride = 1, warmup = 0, repeat = 1;
+  double flush_mb = 0;  ///< --flush-mb: other memory touched before each refinement
   std::string json_path;
 };
 

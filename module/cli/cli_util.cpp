@@ -164,6 +164,14 @@ void keep_freed_memory() {
 #endif
 }
 
+void OtherWork::touch() noexcept {
+  unsigned s = 0;
+  for (std::size_t k = 0; k < bytes_.size(); k += 64) s += bytes_[k]++;
+  // Kept, so the loop is not optimised away.
+  sink_ += s;
+  asm volatile("" : : "r"(sink_) : "memory");
+}
+
 double thread_cpu_ns() {
   timespec ts{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);

@@ -67,6 +67,20 @@ long thread_minor_faults();
 /// the benchmark, not of the work timed. Applies to every mode alike.
 void keep_freed_memory();
 
+/// The rest of a game's frame, for benchmarks that time one piece of work per frame: touch()
+/// reads and writes one byte in every cache line of `mib` MiB of other memory, so the next
+/// timed frame finds the caches holding that memory instead of the terrain's. Every mode of a
+/// benchmark calls it at the same place (0 MiB: nothing).
+class OtherWork {
+ public:
+  explicit OtherWork(double mib) : bytes_(std::size_t(mib * 1048576.0), 1) {}
+  void touch() noexcept;
+
+ private:
+  std::vector<unsigned char> bytes_;
+  unsigned sink_ = 0;
+};
+
 /// Installs a log sink that prints the library's info, warning and error messages to stderr.
 void install_log_sink();
 

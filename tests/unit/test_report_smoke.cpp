@@ -196,6 +196,7 @@ TEST(BenchLodSoar, RunsOnTheNoiseFieldAndRefusesBadInput) {
   const json s = json::parse(slurp(dir + "/soar.json"))["summary"];
   EXPECT_EQ(s["mode"], "soar");
   EXPECT_EQ(s["frames"], 360);
+  EXPECT_EQ(s["flush_mb"], 0.0);
   for (const char* f :
        {"update_ms_median", "update_cpu_ms_median", "triangles_median", "triangles_in_view_median",
         "rms_error_median", "max_error_max", "output_ms_median", "upload_bytes_median"})
@@ -212,7 +213,10 @@ TEST(BenchLodSoar, RunsOnTheNoiseFieldAndRefusesBadInput) {
       {" --mode soar", "--threshold"},
       {" --mode soar --triangles 0", "--triangles"},
       {" --mode soar --threshold -1", "--threshold"},
-      {" --mode soar --threshold 2 --error-stride 0", "--error-stride"}};
+      {" --mode soar --threshold 2 --error-stride 0", "--error-stride"},
+      {" --mode soar --threshold 2 --flush-mb -1", "--flush-mb"},
+      {" --threshold 2 --flush-mb nan", "--flush-mb"},
+      {" --threshold 2 --flush-mb 5000", "--flush-mb"}};
   for (const auto& [flags, word] : bad) {
     const int rc = std::system((ridge + " bench lod" + terrain + flags + " 2> " + log).c_str());
     EXPECT_NE(rc, 0) << flags;
