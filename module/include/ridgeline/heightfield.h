@@ -153,8 +153,8 @@ class Heightfield {
 /// per cell (0 grass; 1 rock on cliffs, slope > 0.8; 2 sand in the lowest 12 % of the height
 /// range; 3 snow in the highest 20 %; 4 mud in patches of flat low ground; 5 gravel on slopes
 /// 0.55 .. 0.8), from slope, height and noise.
-/// Deterministic: the same bytes on every machine. Benchmark figures quoted with
-/// `--default-terrain` depend on exactly these parameters.
+/// Deterministic: the same bytes on every machine. Benchmark figures quoted for the default
+/// terrain depend on exactly these parameters.
 struct DefaultTerrainParams {
   std::uint32_t size = 1025;
   double spacing = 2.0;

@@ -27,7 +27,7 @@ enum class RoamMode {
 /// What the threshold measures.
 enum class ErrorMetric {
   kScreenPixels,  ///< projected bound in pixels for the current camera; frustum culled (default)
-  kWorldMetres,   ///< bound in metres, view independent, whole terrain, no culling (--tolerance)
+  kWorldMetres,   ///< bound in metres, view independent, whole terrain, no culling
 };
 
 /// Settings a game may change between any two updates.
