@@ -1048,34 +1048,48 @@ TEST(Front, ChunkedStorageKeepsEntriesAcrossChunks) {
 
 // The storage of the node and front arrays: address space reserved once, pages committed as the
 // array grows, given back on request, zero when committed again; a request past the range is
-// refused like a failed allocation, and what was committed stays usable.
+// refused like a failed allocation, and what was committed stays usable. A destroyed
+// reservation's range and pages go to the next reservation of the same size.
 TEST(Reservation, GrowsInPlaceGivesBackAndRefusesPastItsRange) {
-  roam::Reservation r;
-  EXPECT_EQ(r.data(), nullptr);
-  constexpr std::size_t kStep = 64 << 10, kMax = 64 << 20;
-  r.grow_to(1, kStep, kMax);
-  ASSERT_NE(r.data(), nullptr);
-  EXPECT_EQ(r.committed(), kStep);
-  auto* bytes = static_cast<unsigned char*>(r.data());
-  const void* base = r.data();
-  for (std::size_t k = 0; k < kStep; ++k) ASSERT_EQ(bytes[k], 0) << k;  // fresh pages: zero
-  std::memset(bytes, 0xab, kStep);
-  r.grow_to(5 * kStep + 1, kStep, kMax);
-  EXPECT_EQ(r.data(), base) << "the array moved";
-  EXPECT_EQ(r.committed(), 6 * kStep);
-  EXPECT_EQ(bytes[kStep - 1], 0xab);
-  EXPECT_EQ(bytes[6 * kStep - 1], 0);
-  std::memset(bytes, 0xcd, 6 * kStep);
-  r.shrink_to(kStep + 1);  // keeps whole pages
-  EXPECT_GE(r.committed(), kStep + 1);
-  EXPECT_LT(r.committed(), 2 * kStep);
-  r.grow_to(3 * kStep, kStep, kMax);
-  EXPECT_EQ(bytes[kStep], 0xcd);                // kept
-  EXPECT_EQ(bytes[3 * kStep - 1], 0);           // given back, then fresh
-  EXPECT_THROW(r.grow_to(kMax + 1, kStep, kMax), std::bad_alloc);
-  EXPECT_EQ(r.committed(), 3 * kStep);
-  EXPECT_EQ(bytes[0], 0xcd);
-  r.grow_to(kMax, kStep, kMax);  // up to the last byte of the range
-  bytes[kMax - 1] = 1;
-  EXPECT_EQ(r.committed(), kMax);
+  constexpr std::size_t kStep = 64 << 10, kMax = (64 << 20) + (12 << 10);  // a size of its own
+  const void* base = nullptr;
+  {
+    roam::Reservation r;
+    EXPECT_EQ(r.data(), nullptr);
+    r.grow_to(1, kStep, kMax);
+    ASSERT_NE(r.data(), nullptr);
+    EXPECT_GE(r.committed(), kStep);  // more when an earlier run of this test left its range
+    auto* bytes = static_cast<unsigned char*>(r.data());
+    base = r.data();
+    std::memset(bytes, 0xab, kStep);
+    r.grow_to(5 * kStep + 1, kStep, kMax);
+    EXPECT_EQ(r.data(), base) << "the array moved";
+    EXPECT_GE(r.committed(), 6 * kStep);
+    EXPECT_EQ(bytes[kStep - 1], 0xab);
+    std::memset(bytes, 0xcd, 6 * kStep);
+    r.shrink_to(kStep + 1);  // keeps whole pages
+    EXPECT_GE(r.committed(), kStep + 1);
+    EXPECT_LT(r.committed(), 2 * kStep);
+    r.grow_to(3 * kStep, kStep, kMax);
+    EXPECT_EQ(r.committed(), 3 * kStep);
+    EXPECT_EQ(bytes[kStep], 0xcd);       // kept
+    EXPECT_EQ(bytes[3 * kStep - 1], 0);  // given back, then fresh
+    EXPECT_THROW(r.grow_to(kMax + 1, kStep, kMax), std::bad_alloc);
+    EXPECT_EQ(r.committed(), 3 * kStep);
+    EXPECT_EQ(bytes[0], 0xcd);
+    r.grow_to(kMax, kStep, kMax);  // up to the last byte of the range
+    bytes[kMax - 1] = 1;
+    EXPECT_EQ(r.committed(), kMax);
+    r.shrink_to(4 * kStep);
+    bytes[4 * kStep - 1] = 0xef;
+  }
+  // The next reservation of that size gets the range back with its pages (no new faults);
+  // another size gets a range of its own.
+  roam::Reservation again, other;
+  again.grow_to(kStep, kStep, kMax);
+  EXPECT_EQ(again.data(), base);
+  EXPECT_EQ(again.committed(), 4 * kStep);
+  EXPECT_EQ(static_cast<unsigned char*>(again.data())[4 * kStep - 1], 0xef);
+  other.grow_to(kStep, kStep, kMax + kStep);
+  EXPECT_NE(other.data(), base);
 }
