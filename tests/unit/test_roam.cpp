@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <new>
 #include <functional>
 #include <glm/geometric.hpp>
 #include <map>
@@ -18,6 +19,7 @@
 #include "ridgeline/roam_view.h"
 #include "roam/diamond.h"
 #include "roam/front.h"
+#include "roam/reserved.h"
 #include "roam_test_util.h"
 
 using namespace ridgeline;
@@ -936,7 +938,7 @@ TEST(Diamond, GeometryMatchesTheBintree) {
     }
 }
 
-// The front's storage in fixed chunks: entries added and removed (the last moved into the hole)
+// The front's storage, chunk by chunk: entries added and removed (the last moved into the hole)
 // across several chunk boundaries keep their data and state, the pass agrees with the test of one
 // entry, and trimming gives back the chunks a peak left.
 TEST(Front, ChunkedStorageKeepsEntriesAcrossChunks) {
@@ -1033,12 +1035,61 @@ TEST(Front, ChunkedStorageKeepsEntriesAcrossChunks) {
   EXPECT_LE(f.memory_bytes(), ((ref.size() + chunk - 1) / chunk + 1) * chunk_bytes + 64);
   // Growing again past what was given back: the entries in use are intact and the new ones
   // read back as written.
+  const std::size_t kept = ref.size();
   for (std::uint32_t k = 0; k < 2 * chunk; ++k) add();
   EXPECT_GE(f.memory_bytes(), peak_bytes - chunk_bytes);
   for (std::uint32_t e = 0; e < f.size(); ++e) {
-    ASSERT_EQ(f.ci(e), ref[e].i) << e;
+    ASSERT_EQ(f.ci(e), ref[e].i) << e << " (" << kept << " kept)";
     ASSERT_EQ(f.mu(e), ref[e].mu) << e;
     ASSERT_EQ(f.node(e), ref[e].node) << e;
     ASSERT_EQ(f.split(e), ref[e].split) << e;
   }
+}
+
+// The storage of the node and front arrays: address space reserved once, pages committed as the
+// array grows, given back on request, zero when committed again; a request past the range is
+// refused like a failed allocation, and what was committed stays usable. A destroyed
+// reservation's range and pages go to the next reservation of the same size.
+TEST(Reservation, GrowsInPlaceGivesBackAndRefusesPastItsRange) {
+  constexpr std::size_t kStep = 64 << 10, kMax = (64 << 20) + (12 << 10);  // a size of its own
+  const void* base = nullptr;
+  {
+    roam::Reservation r;
+    EXPECT_EQ(r.data(), nullptr);
+    r.grow_to(1, kStep, kMax);
+    ASSERT_NE(r.data(), nullptr);
+    EXPECT_GE(r.committed(), kStep);  // more when an earlier run of this test left its range
+    auto* bytes = static_cast<unsigned char*>(r.data());
+    base = r.data();
+    std::memset(bytes, 0xab, kStep);
+    r.grow_to(5 * kStep + 1, kStep, kMax);
+    EXPECT_EQ(r.data(), base) << "the array moved";
+    EXPECT_GE(r.committed(), 6 * kStep);
+    EXPECT_EQ(bytes[kStep - 1], 0xab);
+    std::memset(bytes, 0xcd, 6 * kStep);
+    r.shrink_to(kStep + 1);  // keeps whole pages
+    EXPECT_GE(r.committed(), kStep + 1);
+    EXPECT_LT(r.committed(), 2 * kStep);
+    r.grow_to(3 * kStep, kStep, kMax);
+    EXPECT_EQ(r.committed(), 3 * kStep);
+    EXPECT_EQ(bytes[kStep], 0xcd);       // kept
+    EXPECT_EQ(bytes[3 * kStep - 1], 0);  // given back, then fresh
+    EXPECT_THROW(r.grow_to(kMax + 1, kStep, kMax), std::bad_alloc);
+    EXPECT_EQ(r.committed(), 3 * kStep);
+    EXPECT_EQ(bytes[0], 0xcd);
+    r.grow_to(kMax, kStep, kMax);  // up to the last byte of the range
+    bytes[kMax - 1] = 1;
+    EXPECT_EQ(r.committed(), kMax);
+    r.shrink_to(4 * kStep);
+    bytes[4 * kStep - 1] = 0xef;
+  }
+  // The next reservation of that size gets the range back with its pages (no new faults);
+  // another size gets a range of its own.
+  roam::Reservation again, other;
+  again.grow_to(kStep, kStep, kMax);
+  EXPECT_EQ(again.data(), base);
+  EXPECT_EQ(again.committed(), 4 * kStep);
+  EXPECT_EQ(static_cast<unsigned char*>(again.data())[4 * kStep - 1], 0xef);
+  other.grow_to(kStep, kStep, kMax + kStep);
+  EXPECT_NE(other.data(), base);
 }

@@ -223,7 +223,7 @@ std::uint32_t Front::add(std::int32_t i, std::int32_t j, std::int32_t hu, std::i
   if (l == 0) {
     // A new block (zero bound and radius in its free lanes: never active), in a new chunk
     // when the last one is full.
-    if (e / kChunkEntries >= chunks_.size()) chunks_.emplace_back(new Chunk);
+    if (e >= capacity_) grow();
     block(e >> 3) = Hot{};
   }
   Hot& h = block(e >> 3);
@@ -258,9 +258,27 @@ void Front::clear() noexcept {
   n_ = 0;
 }
 
+void Front::grow() {
+  // Entries never outnumber the nodes (NodePool::kMaxNodes): each is a diamond with a node.
+  constexpr std::size_t kMaxEntries = std::size_t{1} << 28;
+  const std::size_t n = std::size_t(capacity_) + kChunkEntries;
+  hot_mem_.grow_to(n / kLanes * sizeof(Hot), kChunkBlocks * sizeof(Hot),
+                   kMaxEntries / kLanes * sizeof(Hot));
+  cold_mem_.grow_to(n * sizeof(Cold), kChunkEntries * sizeof(Cold), kMaxEntries * sizeof(Cold));
+  hot_ = static_cast<Hot*>(hot_mem_.data());
+  cold_ = static_cast<Cold*>(cold_mem_.data());
+  capacity_ = std::uint32_t(n);
+}
+
 void Front::trim() noexcept {
-  const std::size_t used = (n_ + kChunkEntries - 1) / kChunkEntries;
-  while (chunks_.size() > used + 1) chunks_.pop_back();
+  // Whole chunks: a chunk's blocks and records are whole pages.
+  static_assert(kChunkBlocks * sizeof(Hot) % 4096 == 0 && kChunkEntries * sizeof(Cold) % 4096 == 0);
+  const std::size_t keep = ((n_ + kChunkEntries - 1) / kChunkEntries + 1) * kChunkEntries;
+  if (keep >= capacity_) return;
+  hot_mem_.shrink_to(keep / kLanes * sizeof(Hot));
+  cold_mem_.shrink_to(keep * sizeof(Cold));
+  capacity_ = std::uint32_t(std::min(hot_mem_.committed() / sizeof(Hot) * kLanes,
+                                     cold_mem_.committed() / sizeof(Cold)));
 }
 
 void Front::set_result(std::uint32_t e, std::uint32_t bits) noexcept {
@@ -294,7 +312,7 @@ float Front::evaluate(const FrontCamera& c, std::vector<Keyed>* changed) {
 float Front::pass_chunk(std::uint32_t k, const FrontCamera& c, std::vector<Keyed>* changed,
                         float worst) {
   const std::uint32_t first = k * kChunkBlocks;
-  Hot* hot = chunks_[k]->hot;
+  Hot* hot = hot_ + std::size_t(first);
   const std::size_t n = std::min<std::size_t>(kChunkBlocks, blocks() - first);
 #ifdef RIDGELINE_FRONT_AVX2
   if (have_avx2()) return screen_pass_avx2(hot, n, first, c, changed, worst);
@@ -363,7 +381,7 @@ float Front::max_unsplit_priority(const FrontCamera& c) const noexcept {
 }
 
 std::size_t Front::memory_bytes() const noexcept {
-  return chunks_.size() * sizeof(Chunk) + chunks_.capacity() * sizeof(chunks_[0]);
+  return hot_mem_.committed() + cold_mem_.committed();
 }
 
 }  // namespace ridgeline::roam

@@ -14,10 +14,11 @@
 // the changes read (lattice indices, geometry, node, flags) is one 16-byte record per entry.
 // The pass writes nothing per entry: its results are two bytes per block (which lanes are
 // active, which in view), beside a byte of which lanes are split. So a pass streams 20 bytes per
-// entry, and an entry costs 40 bytes in all. Blocks and records live in fixed chunks of 1,024
-// entries (40 KiB) that never move: growing copies nothing (a vector's growth copied the whole
-// front inside an update and faulted in a new copy), and the unused capacity is under one chunk
-// plus one spare.
+// entry, and an entry costs 40 bytes in all. Blocks and records are two arrays
+// that grow in place, a chunk of 1,024 entries (40 KiB) at a time, in address space reserved once
+// (reserved.h): growing copies nothing (a vector's growth copied the whole front inside an update
+// and faulted in a new copy), an entry's address is base + index, and the unused capacity is
+// under one chunk plus one spare.
 #pragma once
 
 #include <chrono>
@@ -26,6 +27,7 @@
 #include <vector>
 
 #include "memory_hints.h"
+#include "roam/reserved.h"
 #include "ridgeline/camera.h"
 
 namespace ridgeline::roam {
@@ -210,30 +212,24 @@ class Front {
   static constexpr std::uint32_t kChunkShift = 7;  // log2 kChunkBlocks
   static_assert(kChunkBlocks == 1u << kChunkShift);
   static constexpr std::uint32_t kChunkEntries = kChunkBlocks * kLanes;
-  /// What the pass streams, then the records (one allocation; the pass reads only `hot`).
-  struct Chunk {
-    Hot hot[kChunkBlocks];
-    Cold cold[kChunkEntries];
-  };
-  const Hot& block(std::uint32_t b) const noexcept {
-    return chunks_[b >> kChunkShift]->hot[b & (kChunkBlocks - 1)];
-  }
-  Hot& block(std::uint32_t b) noexcept {
-    return chunks_[b >> kChunkShift]->hot[b & (kChunkBlocks - 1)];
-  }
-  const Cold& cold(std::uint32_t e) const noexcept {
-    return chunks_[e / kChunkEntries]->cold[e % kChunkEntries];
-  }
-  Cold& cold(std::uint32_t e) noexcept {
-    return chunks_[e / kChunkEntries]->cold[e % kChunkEntries];
-  }
+  const Hot& block(std::uint32_t b) const noexcept { return hot_[b]; }
+  Hot& block(std::uint32_t b) noexcept { return hot_[b]; }
+  const Cold& cold(std::uint32_t e) const noexcept { return cold_[e]; }
+  Cold& cold(std::uint32_t e) noexcept { return cold_[e]; }
   const Masks& mask(std::uint32_t e) const noexcept { return block(e >> 3).m; }
   void set_result(std::uint32_t e, std::uint32_t bits) noexcept;
   /// The screen pass over the blocks of chunk k in use.
   float pass_chunk(std::uint32_t k, const FrontCamera& c, std::vector<Keyed>* changed, float worst);
 
+  /// Room for one more chunk of entries.
+  void grow();
+
   std::uint32_t n_ = 0;
-  std::vector<std::unique_ptr<Chunk>> chunks_;
+  std::uint32_t capacity_ = 0;  // entries with committed room (whole chunks)
+  // What the pass streams (blocks), and the records, each one array that grows in place.
+  Reservation hot_mem_, cold_mem_;
+  Hot* hot_ = nullptr;
+  Cold* cold_ = nullptr;
 };
 
 }  // namespace ridgeline::roam

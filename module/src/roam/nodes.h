@@ -1,13 +1,13 @@
-// Bintree node storage of a RoamView: 24-byte nodes in fixed chunks, allocated in sibling pairs.
+// Bintree node storage of a RoamView: 24-byte nodes in one array that grows in place, allocated in
+// sibling pairs.
 #pragma once
 
 #include <cstdint>
-#include <memory>
 #include <new>
 #include <type_traits>
-#include <vector>
 
 #include "memory_hints.h"
+#include "roam/reserved.h"
 
 namespace ridgeline::roam {
 
@@ -71,21 +71,21 @@ struct Node {
 static_assert(sizeof(Node) == 24, "docs/roam.md quotes the node size");
 static_assert(std::is_trivially_destructible_v<Node>);
 
-/// Nodes in fixed chunks that never move (growing never copies nodes inside an update: a
-/// vector's doubling did, 5-15 ms spikes under a time budget), handed out and taken back in
-/// sibling pairs. A new chunk is raw memory: nodes are constructed as they are handed out, so
-/// its pages fault in a few at a time.
+/// Nodes in one reserved range of address space (reserved.h) that never moves: growing copies
+/// no node inside an update (a vector's doubling did: 5-15 ms spikes under a time budget), and
+/// node i is at base + i (no chunk to look up). Pages are committed 384 KiB at a time as nodes
+/// are handed out, in sibling pairs. At most kMaxNodes (2^28, ~134 million triangles' worth);
+/// past it, or when the system refuses the pages, alloc_pair() throws std::bad_alloc like any
+/// allocation.
 class NodePool {
  public:
-  Node& operator[](std::uint32_t i) noexcept { return chunks_[i >> kShift].get()[i & kMask]; }
-  const Node& operator[](std::uint32_t i) const noexcept {
-    return chunks_[i >> kShift].get()[i & kMask];
-  }
+  static constexpr std::uint32_t kMaxNodes = 1u << 28;
+  static_assert(kMaxNodes <= kIndexMask);
+
+  Node& operator[](std::uint32_t i) noexcept { return base_[i]; }
+  const Node& operator[](std::uint32_t i) const noexcept { return base_[i]; }
   /// Hints the caches to fetch node i (node 0 for kNone or any other index out of range).
-  void prefetch(std::uint32_t i) const noexcept {
-    i = i < size_ ? i : 0;
-    detail::prefetch(&chunks_[i >> kShift].get()[i & kMask]);
-  }
+  void prefetch(std::uint32_t i) const noexcept { detail::prefetch(base_ + (i < size_ ? i : 0)); }
   /// Nodes handed out so far (live or free).
   std::uint32_t size() const noexcept { return size_; }
 
@@ -95,42 +95,40 @@ class NodePool {
     std::uint32_t c;
     if (free_ != kNone) {
       c = free_;
-      free_ = (*this)[c].parent;  // a free pair's first node links to the next free pair
-      prefetch(free_);            // the next allocation reads it
+      free_ = base_[c].parent;  // a free pair's first node links to the next free pair
+      prefetch(free_);          // the next allocation reads it
     } else {
       c = size_;
-      if (((size_ + 1) >> kShift) >= chunks_.size())
-        chunks_.emplace_back(static_cast<Node*>(::operator new(sizeof(Node) << kShift)));
+      if (std::size_t(size_ + 2) * sizeof(Node) > mem_.committed()) grow();
       size_ += 2;
     }
-    ::new (&(*this)[c]) Node{};
-    ::new (&(*this)[c + 1]) Node{};
+    ::new (&base_[c]) Node{};
+    ::new (&base_[c + 1]) Node{};
     return c;
   }
   void free_pair(std::uint32_t first) {
-    (*this)[first].parent = free_;
+    base_[first].parent = free_;
     free_ = first;
   }
 
   /// Forgets every node; the first `count` (an even number) are handed out again,
-  /// default-constructed. Chunks are kept, so a rebuild faults in no new pages.
+  /// default-constructed. The pages are kept, so a rebuild faults in no new ones.
   void reset(std::uint32_t count) {
     free_ = kNone;
     size_ = 0;
     while (size_ < count) (void)alloc_pair();
   }
 
-  std::size_t memory_bytes() const noexcept {
-    return chunks_.size() * (sizeof(Node) << kShift) + chunks_.capacity() * sizeof(chunks_[0]);
-  }
+  std::size_t memory_bytes() const noexcept { return mem_.committed(); }
 
  private:
-  static constexpr std::uint32_t kShift = 14;  // 16k nodes, 384 KiB per chunk
-  static constexpr std::uint32_t kMask = (1u << kShift) - 1;
-  struct FreeChunk {
-    void operator()(Node* p) const noexcept { ::operator delete(p); }
-  };
-  std::vector<std::unique_ptr<Node, FreeChunk>> chunks_;
+  static constexpr std::size_t kStep = sizeof(Node) << 14;  // 16k nodes, 384 KiB
+  void grow() {
+    mem_.grow_to(std::size_t(size_ + 2) * sizeof(Node), kStep, std::size_t(kMaxNodes) * sizeof(Node));
+    base_ = static_cast<Node*>(mem_.data());
+  }
+  Reservation mem_;
+  Node* base_ = nullptr;
   std::uint32_t free_ = kNone;  // first node of the last freed pair (a list through `parent`)
   std::uint32_t size_ = 0;
 };
