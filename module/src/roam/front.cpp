@@ -221,8 +221,8 @@ std::uint32_t Front::add(std::int32_t i, std::int32_t j, std::int32_t hu, std::i
   const std::uint32_t e = n_++;
   const std::uint32_t l = e & 7;
   if (l == 0) {
-    // A new block (zero bound and radius in its free lanes: never active), in a new chunk
-    // when the last one is full.
+    // A new block (zero bound and radius in its free lanes: never active), with room for a
+    // chunk more when the last one is full.
     if (e >= capacity_) grow();
     block(e >> 3) = Hot{};
   }

@@ -151,8 +151,8 @@ class Front {
   std::uint32_t remove(std::uint32_t e) noexcept;
   /// Empties the front; keeps the memory.
   void clear() noexcept;
-  /// Frees the chunks beyond the one spare after those in use (the capacity a rebuild's peak
-  /// left).
+  /// Gives back the pages of the chunks beyond the one spare after those in use (the capacity a
+  /// rebuild's peak left).
   void trim() noexcept;
 
   /// An entry whose test disagrees with its state, and its priority (-1 for a merge candidate

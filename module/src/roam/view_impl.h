@@ -1,6 +1,7 @@
 // Private: the state of one RoamView and the operations its update is made of.
 //
-//   nodes.h         bintree nodes (24 bytes) in fixed chunks, sibling pairs
+//   nodes.h         bintree nodes (24 bytes) in one array that grows in place, sibling pairs
+//   reserved.h      address space reserved once, committed as the node and front arrays grow
 //   front.h         the split and merge front: every diamond that may change, tested per update
 //   patch_output.h  per-patch buffers the engine uploads, patched slot by slot
 //   bintree.cpp     split (with forced splits) and merge of diamonds, links, front and output
