@@ -4,6 +4,7 @@
 // (kappa mu + r)^2 > d^2, with nested bounds and spheres, plus view culling of the sphere against
 // the side planes and the far distance.
 #include "roam/front.h"
+#include "roam/nodes.h"
 
 #include <algorithm>
 #include <bit>
@@ -259,15 +260,22 @@ void Front::clear() noexcept {
 }
 
 void Front::grow() {
-  // Entries never outnumber the nodes (NodePool::kMaxNodes): each is a diamond with a node.
-  constexpr std::size_t kMaxEntries = std::size_t{1} << 28;
+  // Entries never outnumber the nodes: each is a diamond with a node.
+  constexpr std::size_t kMaxEntries = NodePool::kMaxNodes;
   const std::size_t n = std::size_t(capacity_) + kChunkEntries;
   hot_mem_.grow_to(n / kLanes * sizeof(Hot), kChunkBlocks * sizeof(Hot),
                    kMaxEntries / kLanes * sizeof(Hot));
   cold_mem_.grow_to(n * sizeof(Cold), kChunkEntries * sizeof(Cold), kMaxEntries * sizeof(Cold));
   hot_ = static_cast<Hot*>(hot_mem_.data());
   cold_ = static_cast<Cold*>(cold_mem_.data());
-  capacity_ = std::uint32_t(n);
+  set_capacity();
+}
+
+void Front::set_capacity() noexcept {
+  // What both arrays hold (more than asked when a destroyed view's range was taken over: trim()
+  // gives that back).
+  capacity_ = std::uint32_t(std::min(hot_mem_.committed() / sizeof(Hot) * kLanes,
+                                     cold_mem_.committed() / sizeof(Cold)));
 }
 
 void Front::trim() noexcept {
@@ -277,8 +285,7 @@ void Front::trim() noexcept {
   if (keep >= capacity_) return;
   hot_mem_.shrink_to(keep / kLanes * sizeof(Hot));
   cold_mem_.shrink_to(keep * sizeof(Cold));
-  capacity_ = std::uint32_t(std::min(hot_mem_.committed() / sizeof(Hot) * kLanes,
-                                     cold_mem_.committed() / sizeof(Cold)));
+  set_capacity();
 }
 
 void Front::set_result(std::uint32_t e, std::uint32_t bits) noexcept {

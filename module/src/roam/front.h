@@ -223,6 +223,7 @@ class Front {
 
   /// Room for one more chunk of entries.
   void grow();
+  void set_capacity() noexcept;
 
   std::uint32_t n_ = 0;
   std::uint32_t capacity_ = 0;  // entries with committed room (whole chunks)

@@ -119,6 +119,13 @@ class NodePool {
     while (size_ < count) (void)alloc_pair();
   }
 
+  /// Gives back the pages beyond the nodes handed out plus one spare step (what a range taken
+  /// over from a destroyed view had committed beyond this view's needs).
+  void trim() noexcept {
+    const std::size_t keep = (std::size_t(size_) * sizeof(Node) / kStep + 2) * kStep;
+    if (mem_.committed() > keep) mem_.shrink_to(keep);
+  }
+
   std::size_t memory_bytes() const noexcept { return mem_.committed(); }
 
  private:

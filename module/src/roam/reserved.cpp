@@ -53,14 +53,14 @@ Reservation::~Reservation() {
 
 void Reservation::grow_to(std::size_t bytes, std::size_t step, std::size_t max_bytes) {
   if (bytes <= committed_) return;
+  const std::size_t range = round_up(max_bytes, page_size());
   if (base_ == nullptr) {
     // A destroyed reservation of the same size, the one with the most pages committed.
     std::lock_guard<std::mutex> lock(spare_mutex);
     std::vector<Spare>& v = spares();
-    const std::size_t want = round_up(max_bytes, page_size());
     auto best = v.end();
     for (auto it = v.begin(); it != v.end(); ++it)
-      if (it->reserved == want && (best == v.end() || it->committed > best->committed)) best = it;
+      if (it->reserved == range && (best == v.end() || it->committed > best->committed)) best = it;
     if (best != v.end()) {
       base_ = best->base;
       reserved_ = best->reserved;
@@ -73,7 +73,7 @@ void Reservation::grow_to(std::size_t bytes, std::size_t step, std::size_t max_b
     // Address space only: not counted against memory until committed (PROT_NONE, no reserve).
     // A process limited in address space (ulimit -v) gets a smaller range.
     constexpr std::size_t kFloor = std::size_t{64} << 20;
-    for (std::size_t r = round_up(max_bytes, page_size());; r /= 2) {
+    for (std::size_t r = range;; r /= 2) {
       void* p = mmap(nullptr, r, PROT_NONE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
       if (p != MAP_FAILED) {
         base_ = p;

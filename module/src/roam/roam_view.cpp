@@ -813,6 +813,7 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
                              ? std::max(threshold, double(remaining))
                              : threshold;
   m.front.trim();
+  m.nodes.trim();
   m.st.memory_bytes = m.nodes.memory_bytes() + m.front.memory_bytes() +
                       (m.to_merge.capacity() + m.to_split.capacity() + m.next_wave.capacity()) *
                           sizeof(std::uint32_t) +
