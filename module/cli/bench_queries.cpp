@@ -46,7 +46,7 @@ struct Ray {
 }  // namespace
 
 nlohmann::json bench_queries(const Terrain& terrain, const BenchQueriesOptions& options) {
-  const Heightfield& hf = terrain.heightfield();
+  const WorldInfo& hf = terrain.info();
   const std::size_t n = std::max<std::size_t>(options.points, 1);
   const int reps = std::max(options.repetitions, 1);
   std::mt19937_64 rng(options.seed);
@@ -55,10 +55,10 @@ nlohmann::json bench_queries(const Terrain& terrain, const BenchQueriesOptions& 
   // Uniformly random points over the whole terrain.
   std::vector<glm::dvec2> points(n);
   for (auto& p : points)
-    p = {hf.origin_x() + unit(rng) * hf.extent_x(), hf.origin_z() + unit(rng) * hf.extent_z()};
+    p = {hf.origin_x + unit(rng) * hf.extent_x(), hf.origin_z + unit(rng) * hf.extent_z()};
 
-  const double top = hf.height_offset() + double(hf.max_local()) + 1.0;
-  const double bottom = hf.height_offset() + double(hf.min_local()) - 1.0;
+  const double top = hf.height_offset + double(hf.max_local) + 1.0;
+  const double bottom = hf.height_offset + double(hf.min_local) - 1.0;
 
   // Vertical rays: straight down from above the highest sample, unbounded length.
   std::vector<Ray> vertical(n);
@@ -71,12 +71,12 @@ nlohmann::json bench_queries(const Terrain& terrain, const BenchQueriesOptions& 
   constexpr double kCells = 256.0;
   constexpr double kTwoPi = 6.283185307179586;
   for (auto& r : slanted) {
-    const double u = (0.25 + 0.5 * unit(rng)) * (hf.width() - 1.0);
-    const double v = (0.25 + 0.5 * unit(rng)) * (hf.height() - 1.0);
+    const double u = (0.25 + 0.5 * unit(rng)) * (hf.width - 1.0);
+    const double v = (0.25 + 0.5 * unit(rng)) * (hf.height - 1.0);
     const double a = kTwoPi * unit(rng);
-    r.origin = {hf.origin_x() + u * hf.spacing_x(), top, hf.origin_z() + v * hf.spacing_z()};
-    r.direction = {kCells * std::cos(a) * hf.spacing_x(), bottom - top,
-                   kCells * std::sin(a) * hf.spacing_z()};
+    r.origin = {hf.origin_x + u * hf.spacing_x, top, hf.origin_z + v * hf.spacing_z};
+    r.direction = {kCells * std::cos(a) * hf.spacing_x, bottom - top,
+                   kCells * std::sin(a) * hf.spacing_z};
     r.max_distance = glm::length(r.direction);
   }
 
@@ -131,9 +131,10 @@ nlohmann::json bench_queries(const Terrain& terrain, const BenchQueriesOptions& 
       if (!std::isnan(h)) batched_checksum += h, ++hits_batched;
   }
 
-  const double samples = double(hf.width()) * hf.height();
-  const std::size_t height_bytes = hf.local_heights().size() * sizeof(float);
-  const std::size_t hierarchy_bytes = terrain.ray_hierarchy_bytes();
+  const double samples = double(hf.width) * hf.height;
+  // The pages' bytes: heights (2 or 4 bytes a sample plus aprons), materials and the ray
+  // pyramid inside each page.
+  const std::size_t height_bytes = terrain.world_stats().resident_bytes;
   nlohmann::json j;
   j["height_ns"] = median(t_height.wall);
   j["batched_height_ns"] = median(t_batched.wall);
@@ -147,12 +148,11 @@ nlohmann::json bench_queries(const Terrain& terrain, const BenchQueriesOptions& 
                      {"sample_ns", median(t_sample.cpu)},
                      {"vertical_ray_ns", median(t_vertical.cpu)},
                      {"slanted_ray_ns", median(t_slanted.cpu)}};
-  j["bytes_per_sample"] = double(height_bytes + hierarchy_bytes) / samples;
-  j["height_bytes"] = height_bytes;
-  j["ray_hierarchy_bytes"] = hierarchy_bytes;
+  j["bytes_per_sample"] = double(height_bytes) / samples;
+  j["page_bytes"] = height_bytes;
   j["memory_bytes"] = terrain.memory_bytes();
-  j["width"] = hf.width();
-  j["height"] = hf.height();
+  j["width"] = hf.width;
+  j["height"] = hf.height;
   j["points"] = n;
   j["repetitions"] = reps;
   j["seed"] = options.seed;

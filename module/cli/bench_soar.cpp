@@ -51,18 +51,14 @@ int run_bench_lod_soar(const SoarBenchArgs& a) {
   // The vertex data (heights, nested errors and radii) of the finest lattice: the preprocess,
   // reported apart like ROAM's bounds.
   const auto t_pre = Clock::now();
-  if (std::max(t.fine_width(), t.fine_height()) > std::int64_t{report::Soar::kMaxSide})
-    return report_error("--mode soar: the finest lattice is " + std::to_string(t.fine_width()) +
-                        " x " + std::to_string(t.fine_height()) +
+  if (std::max(t.surface().lattice().vertices_x, t.surface().lattice().vertices_z) > std::int64_t{report::Soar::kMaxSide})
+    return report_error("--mode soar: the finest lattice is " + std::to_string(t.surface().lattice().vertices_x) +
+                        " x " + std::to_string(t.surface().lattice().vertices_z) +
                         " vertices; the comparator takes at most " +
                         std::to_string(report::Soar::kMaxSide) + " per side");
-  std::shared_ptr<const Heightfield> fine;
-  if (t.detail_levels() > 0) {
-    auto hf = report::finest_lattice(t);
-    if (!hf) return report_error(hf.error().message);
-    fine = std::make_shared<const Heightfield>(std::move(*hf));
-  }
-  const Heightfield& lattice = fine ? *fine : t.heightfield();
+  auto fine = report::finest_lattice(t);
+  if (!fine) return report_error(fine.error().message);
+  const Heightfield& lattice = *fine;
   const report::Soar soar(lattice);
   const double preprocess_ms =
       std::chrono::duration<double, std::milli>(Clock::now() - t_pre).count();

@@ -32,11 +32,11 @@ int run_bench_queries(const BenchQueriesArgs& a) {
   nlohmann::json j = bench_queries(**terrain, options);
   if (!j.is_object()) j = {{"result", j}};
   if (!j.contains("terrain")) {
-    const Heightfield& hf = (*terrain)->heightfield();
+    const WorldInfo& hf = (*terrain)->info();
     j["terrain"] = {{"source", a.terrain.source()},
-                    {"width", hf.width()},
-                    {"height", hf.height()},
-                    {"spacing", {hf.spacing_x(), hf.spacing_z()}}};
+                    {"width", hf.width},
+                    {"height", hf.height},
+                    {"spacing", {hf.spacing_x, hf.spacing_z}}};
   }
   if (auto s = write_json(j, a.json_path); !s) return report_error(s.message());
   return 0;

@@ -114,10 +114,10 @@ Result<Flight> make_flight(const BenchDetailArgs& a, const Terrain& terrain) {
     fl.description = {{"path", a.path}, {"frames", fl.frames.size()}};
     return fl;
   }
-  const Heightfield& hf = terrain.heightfield();
-  const double mid_z = hf.origin_z() + 0.5 * hf.extent_z();
-  std::vector<double> from = {hf.origin_x() + 0.05 * hf.extent_x(), mid_z};
-  std::vector<double> to = {hf.origin_x() + 0.95 * hf.extent_x(), mid_z};
+  const WorldInfo& hf = terrain.info();
+  const double mid_z = hf.origin_z + 0.5 * hf.extent_z();
+  std::vector<double> from = {hf.origin_x + 0.05 * hf.extent_x(), mid_z};
+  std::vector<double> to = {hf.origin_x + 0.95 * hf.extent_x(), mid_z};
   if (!a.from.empty()) {
     auto v = parse_finite_list(a.from, "--from", 2, 2);
     if (!v) return v.error();
@@ -208,9 +208,9 @@ int run_bench_detail(const BenchDetailArgs& a) {
   if (!t) return report_error(t.error().message);
   const double load_ms = std::chrono::duration<double, std::milli>(Clock::now() - field_t0).count();
   const std::shared_ptr<const Terrain> terrain = *t;
-  const Heightfield& hf = terrain->heightfield();
-  if (!terrain->detail()) return report_error("the terrain has no detail field");
-  const std::shared_ptr<const DetailField> field(terrain, terrain->detail());
+  const WorldInfo& hf = terrain->info();
+  if (!terrain->surface().detail()) return report_error("the terrain has no detail field");
+  const std::shared_ptr<const DetailField> field(terrain, terrain->surface().detail());
   // Heights, materials, ray pyramid and the detail field's shape map.
   const std::size_t base_bytes = terrain->memory_bytes();
 
@@ -315,16 +315,16 @@ int run_bench_detail(const BenchDetailArgs& a) {
   }
   const double wall_s = std::chrono::duration<double>(Clock::now() - wall0).count();
   const DetailCacheStats cs = (*cache)->stats();
-  const std::uint64_t virtual_samples_x = (std::uint64_t{hf.width()} - 1) << field->levels();
-  const std::uint64_t virtual_samples_z = (std::uint64_t{hf.height()} - 1) << field->levels();
-  const double spacing = std::max(hf.spacing_x(), hf.spacing_z());
+  const std::uint64_t virtual_samples_x = (std::uint64_t{hf.width} - 1) << field->levels();
+  const std::uint64_t virtual_samples_z = (std::uint64_t{hf.height} - 1) << field->levels();
+  const double spacing = std::max(hf.spacing_x, hf.spacing_z);
   const std::size_t n = flight->frames.size();
 
   nlohmann::ordered_json j;
   j["terrain"] = {{"source", a.terrain.source()},
-                  {"width", hf.width()},
-                  {"height", hf.height()},
-                  {"spacing_m", {hf.spacing_x(), hf.spacing_z()}},
+                  {"width", hf.width},
+                  {"height", hf.height},
+                  {"spacing_m", {hf.spacing_x, hf.spacing_z}},
                   {"extent_m", {hf.extent_x(), hf.extent_z()}},
                   {"memory_bytes", terrain->memory_bytes()}};
   j["detail"] = {{"levels", params->levels},

@@ -108,25 +108,25 @@ int run_bench_deform(const BenchDeformArgs& a) {
   auto terrain = a.terrain.load_terrain();
   if (!terrain) return report_error(terrain.error().message);
   Terrain& t = **terrain;
-  const Heightfield& hf = t.heightfield();
+  const WorldInfo& hf = t.info();
   auto land = Landscape::create(*terrain, {.patch_exponent = static_cast<std::uint32_t>(*k)});
   if (!land) return report_error(land.error().message);
   // One view converged for a camera above the middle, looking across: the edits land in its
   // mesh, so the cost includes refreshing and requeueing view nodes and marking patches dirty.
   auto view = RoamView::create(*land, {.threshold = 2.0});
   if (!view) return report_error(view.error().message);
-  const double cx = hf.origin_x() + 0.5 * hf.extent_x(), cz = hf.origin_z() + 0.5 * hf.extent_z();
+  const double cx = hf.origin_x + 0.5 * hf.extent_x(), cz = hf.origin_z + 0.5 * hf.extent_z();
   Camera cam;
-  cam.eye = {cx, hf.height_offset() + hf.max_local() + 100.0, hf.origin_z()};
-  cam.target = {cx, hf.height_offset(), cz};
+  cam.eye = {cx, hf.height_offset + hf.max_local + 100.0, hf.origin_z};
+  cam.target = {cx, hf.height_offset, cz};
   if (auto s = (*view)->converge(cam); !s) return report_error(s.error().message);
 
   std::mt19937_64 rng(*seed);
   nlohmann::ordered_json rows = nlohmann::ordered_json::array();
   for (double radius : *radii) {
     if (!(radius > 0)) return report_error("--radii: every radius must be > 0");
-    std::uniform_real_distribution<double> ux(hf.origin_x(), hf.origin_x() + hf.extent_x());
-    std::uniform_real_distribution<double> uz(hf.origin_z(), hf.origin_z() + hf.extent_z());
+    std::uniform_real_distribution<double> ux(hf.origin_x, hf.origin_x + hf.extent_x());
+    std::uniform_real_distribution<double> uz(hf.origin_z, hf.origin_z + hf.extent_z());
     std::vector<double> ms, edit_cpu, update_cpu, both_cpu, both_wall, samples;
     for (std::uint64_t n = 0; n < *count; ++n) {
       Edit e;
@@ -168,7 +168,7 @@ int run_bench_deform(const BenchDeformArgs& a) {
   nlohmann::ordered_json j = {
       {"benchmark", "deform"},
       {"source", a.terrain.source()},
-      {"spacing", {hf.spacing_x(), hf.spacing_z()}},
+      {"spacing", {hf.spacing_x, hf.spacing_z}},
       {"patch_exponent", *k},
       {"what",
        "per crater at a random position: Terrain::apply_edit alone (wall: median_ms; CPU), then "

@@ -42,15 +42,15 @@ Result<Json> run_scene(Scene& sc, const Options& o, const std::vector<Setting>& 
                        std::string& csv_out) {
   const auto t0 = Clock::now();
   std::string csv;
-  const Heightfield& hf = sc.terrain->heightfield();
+  const WorldInfo& hf = sc.terrain->info();
   Json j = {{"name", sc.name},
             {"source", sc.source},
-            {"samples", {hf.width(), hf.height()}},
-            {"spacing_m", {hf.spacing_x(), hf.spacing_z()}},
-            {"origin_m", {hf.origin_x(), hf.origin_z()}},
+            {"samples", {hf.width, hf.height}},
+            {"spacing_m", {hf.spacing_x, hf.spacing_z}},
+            {"origin_m", {hf.origin_x, hf.origin_z}},
             {"height_range_m",
-             {hf.height_offset() + hf.min_local(), hf.height_offset() + hf.max_local()}},
-            {"filled_samples", hf.filled_samples()},
+             {hf.height_offset + hf.min_local, hf.height_offset + hf.max_local}},
+            {"filled_samples", hf.filled_samples},
             {"loader", sc.loader},
             {"loader_messages", sc.messages}};
   if (sc.fine) {

@@ -189,8 +189,8 @@ int run_mesh(const MeshArgs& a) {
   // Every finest-lattice vertex up to 4M of them; beyond (detail, huge fields) a fixed
   // stratified sample of every k-th vertex per axis (docs/surface.md, "Error and budgets"),
   // reported as measured_stride.
-  const Landscape& land = (*view)->landscape();
-  const double verts = double(land.last_i() + 1) * double(land.last_j() + 1);
+  const SurfaceLattice& at = (*view)->landscape().terrain().surface().lattice();
+  const double verts = double(at.vertices_x) * double(at.vertices_z);
   const auto stride = static_cast<std::uint32_t>(std::max(1.0, std::ceil(std::sqrt(verts / 4e6))));
   const auto err = (*view)->measure_error(c, stride);
   io::GltfExportOptions go;
@@ -202,7 +202,7 @@ int run_mesh(const MeshArgs& a) {
   j["bounds_build_ms"] = bounds_ms;
   j["bounds_bytes_per_sample"] =
       double(bound_bytes) /
-      double(std::uint64_t{l.terrain().heightfield().width()} * l.terrain().heightfield().height());
+      double(std::uint64_t{l.terrain().info().width} * l.terrain().info().height);
   j["measured_max_error_m"] = err.max_m;
   j["measured_rms_error_m"] = err.rms_m;
   j["measured_max_error_px"] = err.max_px;
@@ -224,16 +224,20 @@ struct BenchLodArgs {
 // are drawn (not padding): the triangles a renderer that culls per triangle would draw.
 std::uint64_t triangles_in_view(const RoamView& v, const Camera& c) {
   const Frustum f(c);
-  const Landscape& l = v.landscape();
-  const double off = l.terrain().heightfield().height_offset();
+  const Surface& s = v.landscape().terrain().surface();
+  const SurfaceLattice& at = s.lattice();
+  const double off = at.height_offset;
   std::uint64_t n = 0;
   v.for_each_leaf([&](std::uint32_t, std::uint64_t, const LatticeTriangle& t) {
     const Landscape::LatticeBox b = Landscape::box_of(t);
-    if (b.i0 >= l.last_i() || b.j0 >= l.last_j()) return;  // padding, not drawn
-    const double ha = l.lattice_height(t.ax, t.az), hl = l.lattice_height(t.lx, t.lz),
-                 hr = l.lattice_height(t.rx, t.rz);
-    const glm::dvec3 lo(l.world_x(b.i0), off + std::min({ha, hl, hr}), l.world_z(b.j0));
-    const glm::dvec3 hi(l.world_x(b.i1), off + std::max({ha, hl, hr}), l.world_z(b.j1));
+    if (b.i0 >= at.vertices_x - 1 || b.j0 >= at.vertices_z - 1) return;  // padding, not drawn
+    const double ha = double(float(s.vertex_height(t.ax, t.az))),
+                 hl = double(float(s.vertex_height(t.lx, t.lz))),
+                 hr = double(float(s.vertex_height(t.rx, t.rz)));
+    const glm::dvec3 lo(at.origin_x + double(b.i0) * at.spacing_x, off + std::min({ha, hl, hr}),
+                        at.origin_z + double(b.j0) * at.spacing_z);
+    const glm::dvec3 hi(at.origin_x + double(b.i1) * at.spacing_x, off + std::max({ha, hl, hr}),
+                        at.origin_z + double(b.j1) * at.spacing_z);
     n += f.classify_box(lo, hi) != Frustum::Cull::kOut;
   });
   return n;

@@ -24,9 +24,10 @@ DrawnMesh leaves_mesh(const RoamView& view) {
   const Landscape& l = view.landscape();
   DrawnMesh out;
   out.corners.reserve(std::size_t(view.triangle_count()) * 3);
+  const Surface& s = l.terrain().surface();
+  const double offset = l.terrain().info().height_offset;
   auto corner = [&](std::int64_t i, std::int64_t j) {
-    return glm::dvec3(double(i), l.terrain().heightfield().height_offset() + l.lattice_height(i, j),
-                      double(j));
+    return glm::dvec3(double(i), offset + double(float(s.vertex_height(i, j))), double(j));
   };
   view.for_each_leaf([&](std::uint32_t, std::uint64_t, const LatticeTriangle& t) {
     out.add(corner(t.ax, t.az), corner(t.lx, t.lz), corner(t.rx, t.rz));
@@ -36,24 +37,26 @@ DrawnMesh leaves_mesh(const RoamView& view) {
 
 MeshErrorMeter::MeshErrorMeter(const Terrain& terrain, std::uint32_t stride)
     : terrain_(&terrain), stride_(std::max<std::uint32_t>(stride, 1)) {
-  const double f = double(std::uint64_t{1} << terrain.detail_levels());
-  init(terrain.heightfield(), terrain.fine_width(), terrain.fine_height(), f);
+  const SurfaceLattice& at = terrain.surface().lattice();
+  init(at.vertices_x, at.vertices_z, at.spacing_x, at.spacing_z, at.origin_x, at.origin_z,
+       at.height_offset);
 }
 
 MeshErrorMeter::MeshErrorMeter(const Heightfield& hf, std::uint32_t stride)
     : heightfield_(&hf), stride_(std::max<std::uint32_t>(stride, 1)) {
-  init(hf, hf.width(), hf.height(), 1.0);
+  init(hf.width(), hf.height(), hf.spacing_x(), hf.spacing_z(), hf.origin_x(), hf.origin_z(),
+       hf.height_offset());
 }
 
-void MeshErrorMeter::init(const Heightfield& hf, std::int64_t width, std::int64_t height,
-                          double subdivision) {
+void MeshErrorMeter::init(std::int64_t width, std::int64_t height, double sx, double sz,
+                          double ox, double oz, double offset) {
   width_ = width;
   height_ = height;
-  spacing_x_ = hf.spacing_x() / subdivision;
-  spacing_z_ = hf.spacing_z() / subdivision;
-  origin_x_ = hf.origin_x();
-  origin_z_ = hf.origin_z();
-  offset_ = hf.height_offset();
+  spacing_x_ = sx;
+  spacing_z_ = sz;
+  origin_x_ = ox;
+  origin_z_ = oz;
+  offset_ = offset;
   nx_ = sampled(width_, stride_);
   nz_ = sampled(height_, stride_);
   surface_.assign(std::size_t(nx_) * nz_, 0.0);
@@ -64,7 +67,7 @@ void MeshErrorMeter::read(std::uint32_t k0, std::uint32_t l0, std::uint32_t k1, 
   for (std::uint32_t l = l0; l <= l1; ++l)
     for (std::uint32_t k = k0; k <= k1; ++k) {
       const std::int64_t i = std::int64_t(k) * stride_, j = std::int64_t(l) * stride_;
-      const double local = terrain_ ? terrain_->fine_local_height(i, j)
+      const double local = terrain_ ? terrain_->surface().vertex_height(i, j)
                                     : double(heightfield_->local(static_cast<std::uint32_t>(i),
                                                                  static_cast<std::uint32_t>(j)));
       surface_[k + std::size_t(l) * nx_] = offset_ + local;

@@ -1,36 +1,57 @@
-// Terrain (terrain.h): the surface, the ray hierarchy over it and the edit transaction's state
-// (version, change log), composed. The queries are the surface's (surface/point_queries.cpp) and
-// the ray hierarchy's (surface/ray_hierarchy.cpp); the transaction is in edit/edit.cpp.
+// Terrain (terrain.h): the surface over its pages, the ray and box queries, residency, and the
+// edit transaction's state (version, change log), composed. The point queries are the surface's
+// (surface/point_queries.cpp), rays and boxes surface/ray_queries.cpp, the transaction
+// edit/edit.cpp.
 #include "ridgeline/terrain.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "edit/edit_layer.h"
 #include "edit/edit_log.h"
 #include "format.h"
 #include "ridgeline/detail.h"
-#include "surface/ray_hierarchy.h"
+#include "surface/ray_queries.h"
+#include "world/page_store.h"
 
 namespace ridgeline {
 
-Terrain::Terrain(Heightfield heightfield, std::shared_ptr<const DetailField> detail,
-                 std::unique_ptr<DetailCache> cache)
-    : surface_(std::move(heightfield), std::move(detail), std::move(cache)),
-      rays_(std::make_unique<RayHierarchy>(surface_.heightfield())),
+Terrain::Terrain(std::shared_ptr<world::PageStore> store,
+                 std::shared_ptr<const DetailField> detail, std::unique_ptr<DetailCache> cache)
+    : surface_(std::move(store), std::move(detail), std::move(cache)),
       log_(std::make_unique<ChangeLog>()),
-      base_hash_(surface_.heights_hash()) {}
+      base_hash_(surface_.info().content_hash) {}
 
 Terrain::Terrain(const Terrain& o, Surface::CloneTag tag)
     : surface_(o.surface_, tag),
-      rays_(std::make_unique<RayHierarchy>(*o.rays_)),
       log_(std::make_unique<ChangeLog>(*o.log_)),
       base_hash_(o.base_hash_),
       edit_version_(o.edit_version_) {}
 
 Terrain::~Terrain() = default;
 
-std::shared_ptr<Terrain> Terrain::create(Heightfield heightfield) {
-  return std::shared_ptr<Terrain>(new Terrain(std::move(heightfield), nullptr, nullptr));
+namespace {
+
+WorldInfo info_of(const Heightfield& hf, bool u16) {
+  WorldInfo i;
+  i.width = hf.width(), i.height = hf.height();
+  i.spacing_x = hf.spacing_x(), i.spacing_z = hf.spacing_z();
+  i.origin_x = hf.origin_x(), i.origin_z = hf.origin_z();
+  i.height_offset = hf.height_offset(), i.height_scale = hf.height_scale();
+  i.format = u16 ? SampleFormat::kU16 : SampleFormat::kF32;
+  i.min_local = hf.min_local(), i.max_local = hf.max_local();
+  i.has_materials = hf.has_materials();
+  i.filled_samples = hf.filled_samples();
+  i.name = "terrain";
+  return i;
+}
+
+}  // namespace
+
+Result<std::shared_ptr<Terrain>> Terrain::create(Heightfield heightfield) {
+  auto store =
+      world::PageStore::from_heightfield(heightfield, info_of(heightfield, world::fits_u16(heightfield)));
+  return std::shared_ptr<Terrain>(new Terrain(std::move(store), nullptr, nullptr));
 }
 
 Result<std::shared_ptr<Terrain>> Terrain::create(Heightfield heightfield,
@@ -50,34 +71,107 @@ Result<std::shared_ptr<Terrain>> Terrain::create(Heightfield heightfield,
   if (!field) return field.error();
   auto c = DetailCache::create(*field, cache);
   if (!c) return c.error();
-  return std::shared_ptr<Terrain>(
-      new Terrain(std::move(heightfield), std::move(*field), std::move(*c)));
+  auto store =
+      world::PageStore::from_heightfield(heightfield, info_of(heightfield, world::fits_u16(heightfield)));
+  return std::shared_ptr<Terrain>(new Terrain(std::move(store), std::move(*field), std::move(*c)));
+}
+
+Result<std::shared_ptr<Terrain>> Terrain::open(std::shared_ptr<const PageSource> source,
+                                               const WorldCacheDesc& cache) {
+  auto store = world::PageStore::open(std::move(source), cache);
+  if (!store) return store.error();
+  return std::shared_ptr<Terrain>(new Terrain(std::move(*store), nullptr, nullptr));
 }
 
 std::shared_ptr<Terrain> Terrain::clone() const {
   return std::shared_ptr<Terrain>(new Terrain(*this, Surface::CloneTag{}));
 }
 
+EditLayer& Terrain::edit_layer() noexcept { return *surface_.edits_; }
+const EditLayer& Terrain::edit_layer() const noexcept { return *surface_.edits_; }
+
 std::optional<RayHit> Terrain::raycast(const glm::dvec3& origin, const glm::dvec3& direction,
                                        double max_distance) const noexcept {
-  return rays_->raycast(surface_, origin, direction, max_distance);
+  return RayQueries::raycast(surface_, origin, direction, max_distance);
 }
 
 std::size_t Terrain::triangles_in_box(const Box& box, std::vector<SurfaceTriangle>& out,
                                       std::size_t max_triangles) const {
-  return rays_->triangles_in_box(surface_, box, out, max_triangles);
+  return RayQueries::triangles_in_box(surface_, box, out, max_triangles);
 }
 
 std::string Terrain::check_invariants() const {
-  return rays_->compare(RayHierarchy(surface_.heightfield()));
+  return RayQueries::check(*surface_.store_);
 }
 
 std::size_t Terrain::memory_bytes() const noexcept {
-  return sizeof(*this) - sizeof(Surface) + surface_.memory_bytes() + rays_->memory_bytes();
+  return sizeof(*this) - sizeof(Surface) + surface_.memory_bytes() +
+         surface_.edits_->memory_bytes();
 }
 
-std::size_t Terrain::ray_hierarchy_bytes() const noexcept {
-  return rays_->memory_bytes();
+// ---- residency ---------------------------------------------------------------------------------
+
+namespace {
+
+// The level-0 pages under the xz range of `b` (empty for an invalid box or one off the data).
+std::vector<PageKey> pages_under(const world::PageStore& s, const Box& b) {
+  std::vector<PageKey> keys;
+  for (int a = 0; a < 3; ++a)
+    if (!std::isfinite(b.min[a]) || !std::isfinite(b.max[a]) || !(b.min[a] <= b.max[a]))
+      return keys;
+  const WorldInfo& i = s.info();
+  const double u0 = (b.min.x - i.origin_x) / i.spacing_x, u1 = (b.max.x - i.origin_x) / i.spacing_x;
+  const double v0 = (b.min.z - i.origin_z) / i.spacing_z, v1 = (b.max.z - i.origin_z) / i.spacing_z;
+  const double umax = double(i.width - 1), vmax = double(i.height - 1);
+  if (u1 < 0.0 || v1 < 0.0 || u0 > umax || v0 > vmax) return keys;
+  const world::PageGrid& g = s.grid();
+  const PageKey a = g.page_of(0, std::int64_t(std::clamp(u0, 0.0, umax)),
+                              std::int64_t(std::clamp(v0, 0.0, vmax)));
+  const PageKey c = g.page_of(0, std::int64_t(std::clamp(u1, 0.0, umax)),
+                              std::int64_t(std::clamp(v1, 0.0, vmax)));
+  for (std::int32_t pz = a.pz; pz <= c.pz; ++pz)
+    for (std::int32_t px = a.px; px <= c.px; ++px) keys.push_back({0, px, pz});
+  return keys;
 }
+
+}  // namespace
+
+RegionPin& RegionPin::operator=(RegionPin&& o) noexcept {
+  if (this != &o) {
+    reset();
+    store_ = std::move(o.store_);
+    keys_ = std::move(o.keys_);
+  }
+  return *this;
+}
+
+void RegionPin::reset() noexcept {
+  if (store_) store_->unpin(keys_);
+  store_.reset();
+  keys_.clear();
+}
+
+RegionPin Terrain::pin(const Box& region) const {
+  RegionPin p;
+  const world::PageStore& s = *surface_.store_;
+  if (!s.paged()) return p;
+  p.keys_ = pages_under(s, region);
+  s.pin(p.keys_);
+  p.store_ = surface_.store_;
+  return p;
+}
+
+void Terrain::prefetch(const Box& region) const {
+  const world::PageStore& s = *surface_.store_;
+  if (!s.paged()) return;
+  const std::vector<PageKey> keys = pages_under(s, region);
+  s.request(keys, false);
+}
+
+void Terrain::update_pages() const { surface_.store_->update(); }
+
+WorldStats Terrain::world_stats() const { return surface_.store_->stats(); }
+
+bool Terrain::paged() const noexcept { return surface_.store_->paged(); }
 
 }  // namespace ridgeline

@@ -64,11 +64,11 @@ Result<std::unique_ptr<Game>> Game::create(const GameOptions& options) {
     g->terrain_ = std::move(*t);
     ridgeline::DetailViewRule rule;
     rule.pixels = options.detail_stream_pixels;
-    auto stream = ridgeline::DetailStream::create(g->terrain_->surface(), *g->terrain_->detail_cache(), rule);
+    auto stream = ridgeline::DetailStream::create(g->terrain_->surface(), *g->terrain_->surface().detail_cache(), rule);
     if (!stream) return Error{"game: " + stream.error().message};
     g->stream_.emplace(std::move(*stream));
   } else {
-    g->terrain_ = ridgeline::Terrain::create(std::move(*hf));
+    g->terrain_ = ridgeline::Terrain::create(std::move(*hf)).value();
   }
   auto land = ridgeline::Landscape::create(g->terrain_, {.patch_exponent = options.patch_exponent});
   if (!land) return Error{land.error().message};
@@ -160,9 +160,9 @@ std::vector<std::string> Game::model_names() const {
 }
 
 void Game::clamp_to_terrain(VehicleEntry& e) {
-  const auto& hf = terrain_->heightfield();
-  const double x0 = hf.origin_x() + 3, z0 = hf.origin_z() + 3;
-  const double x1 = hf.origin_x() + hf.extent_x() - 3, z1 = hf.origin_z() + hf.extent_z() - 3;
+  const ridgeline::WorldInfo& hf = terrain_->info();
+  const double x0 = hf.origin_x + 3, z0 = hf.origin_z + 3;
+  const double x1 = hf.origin_x + hf.extent_x() - 3, z1 = hf.origin_z + hf.extent_z() - 3;
   const glm::dvec3 p = e.body.position();
   if (p.x < x0 || p.x > x1 || p.z < z0 || p.z > z1) {
     // The edge of the world: the vehicle is stopped and put back inside.
@@ -347,7 +347,7 @@ ViewFrame Game::update_view(double frame_ms) {
     if (f) detail_frame_ = *f;
   }
   auto r = v.update(cam);
-  ridgeline::DetailCache* cache = terrain_->detail_cache();
+  ridgeline::DetailCache* cache = terrain_->surface().detail_cache();
   // Prefill: wait for the tiles the splits asked for and go on refining, so the mesh does not
   // depend on when tiles arrive (bounded: each round completes the chains that waited).
   double tess_ms = r ? r->update_ms : 0;
@@ -390,7 +390,7 @@ void Game::set_budget(const BudgetSettings& b) {
 }
 
 std::optional<ridgeline::DetailCacheStats> Game::detail_stats() const {
-  if (const ridgeline::DetailCache* c = terrain_->detail_cache()) return c->stats();
+  if (const ridgeline::DetailCache* c = terrain_->surface().detail_cache()) return c->stats();
   return std::nullopt;
 }
 

@@ -335,7 +335,7 @@ int g_stats(lua_State* L) {
   set_number(L, "tess_ms", v.stats.update_ms);
   set_number(L, "craters", double(g.crater_count()));
   set_number(L, "script_errors", double(runner_of(L).error_count()));
-  if (const ridgeline::DetailCache* cache = g.terrain_ptr()->detail_cache()) {
+  if (const ridgeline::DetailCache* cache = g.terrain_ptr()->surface().detail_cache()) {
     const ridgeline::DetailCacheStats s = cache->stats();
     set_number(L, "tiles_resident", double(s.resident_tiles));
     set_number(L, "tiles_pending", double(s.pending));

@@ -90,7 +90,7 @@ void Panel::draw(Game& game, RenderSettings& settings, const PanelInput& in, dou
     const std::uint64_t gen = ds->generated - last_generated_;
     last_generated_ = ds->generated;
     ImGui::Text("detail: %u levels, tiles resident %zu, pending %zu, generated %llu this frame",
-                game.terrain().detail_levels(), ds->resident_tiles, ds->pending,
+                game.terrain().surface().detail_levels(), ds->resident_tiles, ds->pending,
                 static_cast<unsigned long long>(gen));
     ImGui::Text("  %.1f MB, %.0f tiles/s, %u splits waiting for tiles",
                 double(ds->resident_bytes) / 1048576.0, ds->generated_per_second,

@@ -265,13 +265,15 @@ ridgeline::Status Renderer::make_target(Target& t, int w, int h) {
 void Renderer::make_material_texture(const ridgeline::Terrain& terrain) {
   // One texel per stored cell (its centre at the cell's centre): the material's albedo, grass
   // tinted by height as the ground gets higher (meadow, dry grass), and a little grain.
-  const ridgeline::Heightfield& hf = terrain.heightfield();
-  const std::uint32_t w = hf.width() - 1, h = hf.height() - 1;
+  const ridgeline::WorldInfo& hf = terrain.info();
+  const ridgeline::Surface& surface = terrain.surface();
+  const int L = int(surface.detail_levels());
+  const std::uint32_t w = hf.width - 1, h = hf.height - 1;
   float lo = 1e30f, hi = -1e30f;
-  for (std::uint32_t j = 0; j < hf.height(); j += 4)
-    for (std::uint32_t i = 0; i < hf.width(); i += 4) {
-      lo = std::min(lo, hf.local(i, j));
-      hi = std::max(hi, hf.local(i, j));
+  for (std::uint32_t j = 0; j < hf.height; j += 4)
+    for (std::uint32_t i = 0; i < hf.width; i += 4) {
+      lo = std::min(lo, surface.stored_height(i, j));
+      hi = std::max(hi, surface.stored_height(i, j));
     }
   const float range = std::max(hi - lo, 1.0f);
   auto smooth = [](float a, float b, float x) {
@@ -282,11 +284,12 @@ void Renderer::make_material_texture(const ridgeline::Terrain& terrain) {
   std::vector<std::uint8_t> rgb(std::size_t(w) * h * 3);
   for (std::uint32_t j = 0; j < h; ++j)
     for (std::uint32_t i = 0; i < w; ++i) {
-      const std::uint8_t id = hf.material(i, j);
+      const std::uint8_t id =
+          surface.cell_material(std::int64_t(i) << L, std::int64_t(j) << L);
       const Material& m = material(id);
       glm::vec3 c(m.albedo[0], m.albedo[1], m.albedo[2]);
       if (id == 0) {
-        const float t = (hf.local(i, j) - lo) / range;
+        const float t = (surface.stored_height(i, j) - lo) / range;
         c = glm::mix(c, meadow, smooth(0.15f, 0.35f, t));
         c = glm::mix(c, dry, smooth(0.45f, 0.65f, t));
       }
@@ -305,10 +308,10 @@ void Renderer::make_material_texture(const ridgeline::Terrain& terrain) {
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  material_uv_[0] = float(hf.origin_x());
-  material_uv_[1] = float(hf.origin_z());
-  material_uv_[2] = float(1.0 / (hf.spacing_x() * w));
-  material_uv_[3] = float(1.0 / (hf.spacing_z() * h));
+  material_uv_[0] = float(hf.origin_x);
+  material_uv_[1] = float(hf.origin_z);
+  material_uv_[2] = float(1.0 / (hf.spacing_x * w));
+  material_uv_[3] = float(1.0 / (hf.spacing_z * h));
 }
 
 ridgeline::Result<std::unique_ptr<Renderer>> Renderer::create(Game& game, int width, int height) {

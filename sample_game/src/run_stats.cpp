@@ -176,7 +176,7 @@ ridgeline::Status RunStats::write(const std::string& path, const std::string& mo
         {"triangles", double(capped) / n},
         {"time", double(timed) / n}}},
       {"frame_time_breakdown_ms", breakdown},
-      {"detail_levels", game.terrain().detail_levels()},
+      {"detail_levels", game.terrain().surface().detail_levels()},
       {"detail_tiles_resident_max", resident_max},
       {"detail_tiles_pending_max", pending_max},
       {"detail_tiles_generated", generated_last - generated_first},

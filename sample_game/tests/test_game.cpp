@@ -263,8 +263,8 @@ TEST(Game, TheDefaultWorldCarriesDetailBelowTheStoredSpacingNearTheVehicles) {
   auto made = Game::create(o);
   ASSERT_TRUE(made.ok()) << made.error().message;
   Game& g = **made;
-  ASSERT_GE(g.terrain().detail_levels(), 1u);
-  ASSERT_NE(g.terrain().detail_cache(), nullptr);
+  ASSERT_GE(g.terrain().surface().detail_levels(), 1u);
+  ASSERT_NE(g.terrain().surface().detail_cache(), nullptr);
   ASSERT_TRUE(g.load_script(kScripts + "/default.lua").ok());
   for (int f = 0; f < 30; ++f) g.step();
   const auto vf = g.update_view(0);
@@ -276,8 +276,8 @@ TEST(Game, TheDefaultWorldCarriesDetailBelowTheStoredSpacingNearTheVehicles) {
   EXPECT_GT(ds->resident_tiles, 0u);
   // Leaves within 30 m of the followed vehicle whose longest edge is shorter than the stored
   // spacing: the mesh refines into the detail there.
-  const auto& hf = g.terrain().heightfield();
-  const double fine = hf.spacing_x() / double(1u << g.terrain().detail_levels());
+  const ridgeline::Heightfield hf = g.terrain().surface().to_heightfield().value();
+  const double fine = hf.spacing_x() / double(1u << g.terrain().surface().detail_levels());
   const glm::dvec3 p = g.vehicles().begin()->second.body.position();
   std::size_t near = 0, below = 0;
   g.active_view().for_each_leaf([&](std::uint32_t, std::uint64_t,
@@ -302,7 +302,7 @@ TEST(Game, TheDefaultWorldCarriesDetailBelowTheStoredSpacingNearTheVehicles) {
 
 TEST(Game, TheDefaultWorldHasAMaterialMap) {
   auto g = make_game();
-  const auto& hf = g->terrain().heightfield();
+  const ridgeline::Heightfield hf = g->terrain().surface().to_heightfield().value();
   ASSERT_TRUE(hf.has_materials());
   std::size_t count[256] = {};
   for (std::uint32_t j = 0; j + 1 < hf.height(); ++j)
@@ -327,7 +327,7 @@ std::shared_ptr<ridgeline::Terrain> slope_terrain(double slope, std::uint8_t rig
   std::vector<std::uint8_t> m(128 * 128);
   for (std::uint32_t j = 0; j < 128; ++j)
     for (std::uint32_t i = 0; i < 128; ++i) m[i + j * 128] = i < 64 ? 0 : right;
-  return ridgeline::Terrain::create(ridgeline::Heightfield::create(d, v, m).value());
+  return ridgeline::Terrain::create(ridgeline::Heightfield::create(d, v, m).value()).value();
 }
 
 }  // namespace

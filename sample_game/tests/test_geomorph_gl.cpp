@@ -174,7 +174,7 @@ TEST(GeomorphGl, TheShaderMatchesMorphedHeightOnMadeUpVertices) {
 TEST(GeomorphGl, TheShaderMatchesMorphedHeightOnARoamMesh) {
   auto hf = ridgeline::make_default_heightfield({.size = 257, .spacing = 2.0, .seed = 11});
   ASSERT_TRUE(hf);
-  auto terrain = ridgeline::Terrain::create(std::move(hf).value());
+  auto terrain = ridgeline::Terrain::create(std::move(hf).value()).value();
   auto land = ridgeline::Landscape::create(terrain, {.patch_exponent = 5});
   ASSERT_TRUE(land) << land.error().message;
   auto view = ridgeline::RoamView::create(land.value(), {.threshold = 2.0});

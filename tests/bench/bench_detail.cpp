@@ -26,10 +26,10 @@ int main(int argc, char** argv) {
   const int reps = argc > 1 ? std::max(3, std::atoi(argv[1])) : 31;
   auto hf = make_default_heightfield();
   if (!hf) return 1;
-  auto terrain = Terrain::create(std::move(hf).value());
+  auto terrain = Terrain::create(std::move(hf).value()).value();
   DetailParams params;
   params.levels = 12;
-  auto field = DetailField::create(terrain->heightfield(), params);
+  auto field = DetailField::create(terrain->surface().to_heightfield().value(), params);
   if (!field) {
     std::fprintf(stderr, "%s\n", field.error().message.c_str());
     return 1;

@@ -82,7 +82,7 @@ int main(int argc, char** argv) {
   auto land = Landscape::create(t, {});
   if (!land) return usage(land.error().message.c_str());
 
-  const double mid = 0.5 * (size - 1) * t->heightfield().spacing_x();
+  const double mid = 0.5 * (size - 1) * t->info().spacing_x;
   const auto ground = [&](double x, double z) { return t->height(x, z).value_or(0.0); };
   Camera cam;
   cam.eye = {mid, ground(mid, mid) + height, mid};
@@ -108,7 +108,7 @@ int main(int argc, char** argv) {
     rebounded += s->rebounded;
   }
   for (; frames < 5000; ++frames) {
-    t->detail_cache()->wait_idle(30.0);
+    t->surface().detail_cache()->wait_idle(30.0);
     auto s = (*streamed)->update(cam);
     if (!s) return usage(s.error().message.c_str());
     st = *s;
@@ -118,7 +118,7 @@ int main(int argc, char** argv) {
       break;
   }
   const double streamed_ms = ms_since(s0);
-  const DetailCacheStats cs = t->detail_cache()->stats();
+  const DetailCacheStats cs = t->surface().detail_cache()->stats();
 
   // The floor: a new view over the same resident tiles, converged in one update.
   auto fresh = RoamView::create(*land, {.threshold = threshold});

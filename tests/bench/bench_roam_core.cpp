@@ -103,7 +103,7 @@ int main(int argc, char** argv) {
 
   auto hf = scenes::noise_field();
   if (!hf) return usage(hf.error().message.c_str());
-  const std::shared_ptr<const Terrain> terrain = Terrain::create(std::move(*hf));
+  const std::shared_ptr<const Terrain> terrain = Terrain::create(std::move(*hf)).value();
   const std::vector<Camera> cams = scenes::noise_circle();
   const bool do_roam = only != "soar", do_soar = only != "roam";
 
@@ -150,7 +150,7 @@ int main(int argc, char** argv) {
   std::unique_ptr<report::Soar> soar;
   double path_kappa = INFINITY;
   if (do_soar) {
-    soar = std::make_unique<report::Soar>(terrain->heightfield());
+    soar = std::make_unique<report::Soar>(terrain->surface().to_heightfield().value());
     if (triangles > 0) path_kappa = soar->match(cams, triangles, cams.size() / 60).kappa;
   }
   auto kappa_of = [&](const Camera& c) {

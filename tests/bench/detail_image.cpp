@@ -29,14 +29,14 @@ constexpr double kExaggeration = 4;  // vertical exaggeration of the shading
 std::shared_ptr<const Terrain> make_world() {
   auto hf = scenes::flight_world();
   if (!hf) return nullptr;
-  return Terrain::create(std::move(hf).value());
+  return Terrain::create(std::move(hf).value()).value();
 }
 
 // Height of the level-`level` surface at (x, z) from a resident tile: the piecewise-linear
 // interpolation (diagonal rule) of base + detail at the lattice vertices.
 double level_height(const Terrain& base, const DetailField& f, const DetailTile& tile, double x,
                     double z) {
-  const Heightfield& hf = base.heightfield();
+  const Heightfield hf = base.surface().to_heightfield().value();
   const std::uint32_t l = tile.key().level;
   const double sx = std::ldexp(hf.spacing_x(), -int(l)), sz = std::ldexp(hf.spacing_z(), -int(l));
   const double u = (x - hf.origin_x()) / sx, v = (z - hf.origin_z()) / sz;
@@ -85,7 +85,7 @@ void render_panel(const Terrain& base, const DetailField& f, const DetailSnapsho
                   const std::vector<DetailTileNeed>& tiles, const Camera& cam,
                   const DetailViewRule& rule, double width_m, bool stored_only,
                   std::vector<std::uint8_t>& rgb, int stride, int x0) {
-  const Heightfield& hf = base.heightfield();
+  const Heightfield hf = base.surface().to_heightfield().value();
   const double px = width_m / kPanel;
   std::vector<Pixel> img(std::size_t(kPanel) * kPanel);
   auto needed = [&](const DetailTileKey& k) {
@@ -174,7 +174,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%s\n", detailed.error().message.c_str());
     return 1;
   }
-  const DetailField& f = *(*detailed)->detail();
+  const DetailField& f = *(*detailed)->surface().detail();
   // The camera: on the flight's line (z = 50 km), over the steepest ground among a few places
   // (where the shape field lets the detail show most), 50 m up, heading east, 1280 x 720
   // pixels, 60 degrees: the benchmark's camera and request rule.
@@ -188,7 +188,7 @@ int main(int argc, char** argv) {
   cam.eye = {best_x, *terrain->height(best_x, z) + 50, z};
   cam.target = {best_x + 200, cam.eye.y - 30, z};
   DetailViewRule rule;
-  DetailCache& cache = *(*detailed)->detail_cache();
+  DetailCache& cache = *(*detailed)->surface().detail_cache();
   auto stream = DetailStream::create((*detailed)->surface(), cache, rule);
   auto st = stream->frame(cam);
   if (!st || st->needed_resident != st->needed) {

@@ -17,8 +17,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   DefaultTerrainParams p;
   p.size = 33;
   p.spacing = 8;
-  auto terrain = Terrain::create(std::move(make_default_heightfield(p)).value());
-  const Heightfield& hf = terrain->heightfield();
+  auto terrain = Terrain::create(std::move(make_default_heightfield(p)).value()).value();
+  const Heightfield hf = terrain->surface().to_heightfield().value();
   const double extent = hf.extent_x() > hf.extent_z() ? hf.extent_x() : hf.extent_z();
   for (const Edit& e : *edits) {
     if (!validate_edit(e)) __builtin_trap();  // parse_edits let through an invalid edit

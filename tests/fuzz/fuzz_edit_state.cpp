@@ -18,7 +18,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   DefaultTerrainParams p;
   p.size = 33;
   p.spacing = 8;
-  auto terrain = Terrain::create(std::move(make_default_heightfield(p)).value());
+  auto terrain = Terrain::create(std::move(make_default_heightfield(p)).value()).value();
   std::string bytes(reinterpret_cast<const char*>(data), size);
   if (size >= 8 && (data[0] & 1) == 0) {
     std::uint64_t h = 1469598103934665603ull;

@@ -22,7 +22,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (hf) {
     // A heightfield that was created must answer queries over its whole extent.
     const double w = hf->width(), h = hf->height();
-    auto terrain = Terrain::create(std::move(*hf));
+    auto terrain = Terrain::create(std::move(*hf)).value();
     for (double x = -1; x <= w; x += 0.75)
       for (double z = -1; z <= h; z += 1.25) (void)terrain->height(x, z);
   }

@@ -78,7 +78,7 @@ int main(int argc, char** argv) {
   tp.spacing = 2048.0 / (a.size - 1);
   auto hf = make_default_heightfield(tp);
   if (!hf) fail(a, 0, hf.error().message);
-  std::shared_ptr<Terrain> terrain = Terrain::create(std::move(*hf));
+  std::shared_ptr<Terrain> terrain = Terrain::create(std::move(*hf)).value();
   auto landscape = Landscape::create(terrain);
   if (!landscape) fail(a, 0, landscape.error().message);
   RoamSettings settings;
@@ -87,7 +87,7 @@ int main(int argc, char** argv) {
   auto view_r = RoamView::create(*landscape, settings);
   if (!view_r) fail(a, 0, view_r.error().message);
   RoamView& view = **view_r;
-  const Heightfield& field = terrain->heightfield();
+  const Heightfield field = terrain->surface().to_heightfield().value();
   const double ext_x = field.extent_x(), ext_z = field.extent_z();
 
   std::mt19937_64 rng(a.seed);
@@ -201,7 +201,7 @@ int main(int argc, char** argv) {
       double plane = 0;
       bool inside = true;
       for (int k = 0; k < 3; ++k) {
-        const double want = ls.lattice_height(vi[k], vj[k]) + off;
+        const double want = double(float(ls.terrain().surface().vertex_height(vi[k], vj[k]))) + off;
         plane += want / 3;
         const auto got = terrain->height(ox + vi[k] * sx, oz + vj[k] * sz);
         if (!got) {

@@ -8,8 +8,52 @@
 #include <vector>
 
 #include "ridgeline/roam_view.h"
+#include "ridgeline/surface.h"
 
 namespace ridgeline::test {
+
+// World x / z of a finest-lattice index of a landscape's terrain.
+inline double world_x(const Landscape& l, std::int64_t i) {
+  const SurfaceLattice& at = l.terrain().surface().lattice();
+  return at.origin_x + double(i) * at.spacing_x;
+}
+inline double world_z(const Landscape& l, std::int64_t j) {
+  const SurfaceLattice& at = l.terrain().surface().lattice();
+  return at.origin_z + double(j) * at.spacing_z;
+}
+// Height of finest-lattice vertex (i, j) relative to the height offset, as the mesh draws it.
+inline float lattice_height(const Landscape& l, std::int64_t i, std::int64_t j) {
+  return float(l.terrain().surface().vertex_height(i, j));
+}
+
+// Exact (not nested) error of a node of the stored levels against the stored lattice, brute
+// force: the largest |sample - plane| over every sample inside its triangle (0 for nodes below
+// the stored levels and for triangles wholly over the padding).
+inline float exact_error(const Landscape& l, std::uint32_t root, std::uint64_t heap) {
+  const int level = 63 - __builtin_clzll(heap);
+  if (level >= int(l.base_level())) return 0.0f;
+  LatticeTriangle t = l.triangle(root, heap);
+  const int d = int(l.detail_levels());
+  t = {t.ax >> d, t.az >> d, t.lx >> d, t.lz >> d, t.rx >> d, t.rz >> d};
+  const Surface& s = l.terrain().surface();
+  const std::int64_t wi = s.info().width - 1, hj = s.info().height - 1;
+  const Landscape::LatticeBox b = Landscape::box_of(t);
+  if (b.i0 >= wi || b.j0 >= hj) return 0.0f;
+  const double ha = s.stored_height(t.ax, t.az), hl = s.stored_height(t.lx, t.lz),
+               hr = s.stored_height(t.rx, t.rz);
+  const double w = double((t.lx - t.ax) * (t.rz - t.az) - (t.lz - t.az) * (t.rx - t.ax));
+  double worst = 0;
+  for (std::int64_t j = b.j0; j <= b.j1; ++j)
+    for (std::int64_t i = b.i0; i <= b.i1; ++i) {
+      const double wr = double((t.lx - t.ax) * (j - t.az) - (t.lz - t.az) * (i - t.ax)) / w;
+      const double wa = double((t.rx - t.lx) * (j - t.lz) - (t.rz - t.lz) * (i - t.lx)) / w;
+      const double wl = 1 - wr - wa;
+      if (wr < -1e-12 || wa < -1e-12 || wl < -1e-12) continue;
+      const double plane = wa * ha + wl * hl + wr * hr;
+      worst = std::max(worst, std::abs(double(s.stored_height(i, j)) - plane));
+    }
+  return float(worst);
+}
 
 inline Camera camera_at(glm::dvec3 eye, glm::dvec3 target, double fov = 60.0) {
   Camera c;

@@ -33,7 +33,7 @@ Heightfield make_heightfield() {
 }
 
 std::shared_ptr<const Terrain> make_terrain() {
-  return Terrain::create(make_heightfield());
+  return Terrain::create(make_heightfield()).value();
 }
 
 DetailParams params(std::uint32_t levels, std::uint64_t seed, double amplitude, double gain) {
@@ -154,7 +154,7 @@ TEST(Detail, LevelZeroAndParentSamplesKeepTheirValues) {
   }
   // The finest lattice at a base sample is the stored height exactly.
   auto t = make_detailed(5);
-  const Heightfield& hf = t->heightfield();
+  const Heightfield hf = t->surface().to_heightfield().value();
   for (std::uint32_t j = 0; j < hf.height(); j += 7)
     for (std::uint32_t i = 0; i < hf.width(); i += 5)
       EXPECT_EQ(t->surface().vertex_height(std::int64_t{i} << 5, std::int64_t{j} << 5),
@@ -373,7 +373,7 @@ TEST(Detail, HeightsAreBasePlusDetail) {
   auto base = make_terrain();  // the same samples without detail
   auto t = make_detailed(4);   // with f's detail
   const Surface& s = t->surface();
-  const double offset = t->heightfield().height_offset();
+  const double offset = t->info().height_offset;
   std::mt19937_64 rng(4);
   std::uniform_int_distribution<std::int64_t> idx(0, 64 << 4);
   for (int n = 0; n < 500; ++n) {

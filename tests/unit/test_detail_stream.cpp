@@ -54,7 +54,7 @@ std::shared_ptr<const Terrain> make_detailed() {
 
 // The terrain's detail field, keeping the terrain alive (for caches of its own).
 std::shared_ptr<const DetailField> field_of(const std::shared_ptr<const Terrain>& t) {
-  return std::shared_ptr<const DetailField>(t, t->detail());
+  return std::shared_ptr<const DetailField>(t, t->surface().detail());
 }
 
 DetailCacheDesc cache_desc(std::size_t budget_bytes, std::uint32_t workers) {
@@ -77,8 +77,8 @@ Camera camera_at(double x, double z, double y, double heading_x = 1, double head
 std::set<std::tuple<std::uint32_t, int, int, bool>> brute_force(const Terrain& terrain,
                                                                 const Camera& c,
                                                                 const DetailViewRule& rule) {
-  const Heightfield& hf = terrain.heightfield();
-  const DetailField& f = *terrain.detail();
+  const Heightfield hf = terrain.surface().to_heightfield().value();
+  const DetailField& f = *terrain.surface().detail();
   auto vertical = [&](double lo, double hi) { return std::max({0.0, c.eye.y - hi, lo - c.eye.y}); };
   const double amp = f.contribution_bound(1);
   const double global_dy = vertical(hf.height_offset() + hf.min_local() - amp,
@@ -214,7 +214,7 @@ TEST(DetailStream, BadInputRefused) {
   r.prefetch = std::numeric_limits<double>::infinity();
   EXPECT_FALSE(DetailStream::create(terrain->surface(), **cache, r).ok());
   // A cache of another field (the same parameters, another object) is not the surface's.
-  auto other = DetailField::create(make_heightfield(), terrain->detail()->params());
+  auto other = DetailField::create(make_heightfield(), terrain->surface().detail()->params());
   ASSERT_TRUE(other.ok());
   auto other_cache = DetailCache::create(*other, cache_desc(8u << 20, 0));
   ASSERT_TRUE(other_cache.ok());

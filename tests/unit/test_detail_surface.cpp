@@ -40,16 +40,16 @@ std::shared_ptr<Terrain> detail_terrain(std::uint32_t size, std::uint32_t levels
 
 TEST(DetailSurface, QueriesInterpolateTheFinestLattice) {
   auto t = detail_terrain(65, 3);
-  ASSERT_EQ(t->detail_levels(), 3u);
-  EXPECT_EQ(t->fine_width(), 64 * 8 + 1);
+  ASSERT_EQ(t->surface().detail_levels(), 3u);
+  EXPECT_EQ(t->surface().lattice().vertices_x, 64 * 8 + 1);
   const double fs = 4.0 / 8;  // finest spacing
   // At finest vertices the height is the lattice height; at stored vertices the detail is 0.
-  for (std::int64_t j = 0; j < t->fine_height(); j += 37)
-    for (std::int64_t i = 0; i < t->fine_width(); i += 29) {
-      EXPECT_NEAR(*t->height(i * fs, j * fs), t->fine_local_height(i, j), 1e-9);
+  for (std::int64_t j = 0; j < t->surface().lattice().vertices_z; j += 37)
+    for (std::int64_t i = 0; i < t->surface().lattice().vertices_x; i += 29) {
+      EXPECT_NEAR(*t->height(i * fs, j * fs), t->surface().vertex_height(i, j), 1e-9);
       if (i % 8 == 0 && j % 8 == 0) {
         EXPECT_EQ(t->surface().vertex_detail(i, j), 0.0);
-        EXPECT_NEAR(t->fine_local_height(i, j), t->heightfield().local(i / 8, j / 8), 1e-5);
+        EXPECT_NEAR(t->surface().vertex_height(i, j), t->surface().stored_height(i / 8, j / 8), 1e-5);
       }
     }
   // Detail is really there: some finest vertex differs from the stored interpolation.
@@ -60,7 +60,7 @@ TEST(DetailSurface, QueriesInterpolateTheFinestLattice) {
   // Inside a finest triangle the height is the barycentric blend of its corners: at the centre
   // of a cell's edge midpoint between two vertices, the mean.
   EXPECT_NEAR(*t->height(10 * fs + 0.25 * fs, 20 * fs),
-              0.75 * t->fine_local_height(10, 20) + 0.25 * t->fine_local_height(11, 20), 1e-9);
+              0.75 * t->surface().vertex_height(10, 20) + 0.25 * t->surface().vertex_height(11, 20), 1e-9);
   // Face normal is the finest triangle's; off-terrain and NaN give nothing.
   auto n = t->face_normal(33.3, 47.1);
   ASSERT_TRUE(n);
@@ -77,9 +77,9 @@ TEST(DetailSurface, CachedTilesAndDirectEvaluationGiveTheSameSurface) {
   for (std::uint32_t l = 1; l <= 4; ++l) {
     const std::int32_t n = std::int32_t((64 << l) / kDetailTileCells) + 1;
     for (std::int32_t tz = 0; tz < n; ++tz)
-      for (std::int32_t tx = 0; tx < n; ++tx) ASSERT_TRUE(b->detail_cache()->request({l, tx, tz}));
+      for (std::int32_t tx = 0; tx < n; ++tx) ASSERT_TRUE(b->surface().detail_cache()->request({l, tx, tz}));
   }
-  ASSERT_GT(b->detail_cache()->stats().resident_tiles, 10u);
+  ASSERT_GT(b->surface().detail_cache()->stats().resident_tiles, 10u);
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(0, 256);
   for (int k = 0; k < 2000; ++k) {
@@ -111,7 +111,7 @@ namespace {
 int check_bounds_against_brute_force(const Terrain& terrain, const Landscape& landscape) {
   const Landscape* l = &landscape;
   int tighter = 0;
-  const DetailField& field = *terrain.detail();
+  const DetailField& field = *terrain.surface().detail();
   EXPECT_EQ(l->max_level(), 2u * (3 + 3));
   // Every node of a few roots down to the finest level: |surface - plane| over every finest
   // vertex of its triangle stays within the bound, and bounds are nested.
@@ -122,11 +122,11 @@ int check_bounds_against_brute_force(const Terrain& terrain, const Landscape& la
     while (!stack.empty()) {
       auto [heap, tri] = stack.back();
       stack.pop_back();
-      const float b = l->bound(root, heap, tri);
+      const float b = l->bound(root, heap);
       const int level = 63 - __builtin_clzll(heap);
       // Exact error against the finest lattice.
-      const double ha = l->lattice_height(tri.ax, tri.az), hl = l->lattice_height(tri.lx, tri.lz),
-                   hr = l->lattice_height(tri.rx, tri.rz);
+      const double ha = lattice_height(*l, tri.ax, tri.az), hl = lattice_height(*l, tri.lx, tri.lz),
+                   hr = lattice_height(*l, tri.rx, tri.rz);
       const std::int64_t x0 = std::min({tri.ax, tri.lx, tri.rx}),
                          x1 = std::max({tri.ax, tri.lx, tri.rx});
       const std::int64_t z0 = std::min({tri.az, tri.lz, tri.rz}),
@@ -143,7 +143,7 @@ int check_bounds_against_brute_force(const Terrain& terrain, const Landscape& la
           const double wl = 1 - wa - wr;
           if (wa < -1e-12 || wr < -1e-12 || wl < -1e-12) continue;
           worst =
-              std::max(worst, std::abs(l->lattice_height(x, z) - (wa * ha + wl * hl + wr * hr)));
+              std::max(worst, std::abs(lattice_height(*l, x, z) - (wa * ha + wl * hl + wr * hr)));
         }
       EXPECT_LE(worst, double(b) + 1e-4) << "root " << root << " level " << level;
       if (worst > double(b) + 1e-4) return -1;
@@ -160,7 +160,7 @@ int check_bounds_against_brute_force(const Terrain& terrain, const Landscape& la
         for (int k = 0; k < 2; ++k) {
           if (level >= 4 && k != c) continue;
           const LatticeTriangle ct = Landscape::child_triangle(tri, k);
-          EXPECT_LE(l->bound(root, 2 * heap + k, ct), b) << "nested";
+          EXPECT_LE(l->bound(root, 2 * heap + k), b) << "nested";
           stack.push_back({2 * heap + k, ct});
         }
       }
@@ -183,7 +183,7 @@ TEST(DetailSurface, MeasuredBoundsFromResidentTilesHoldAndAreTighter) {
   // Every finest tile resident (synchronous cache): nodes inside one take its measured bound.
   const std::int32_t n = std::int32_t((32 << 3) / kDetailTileCells) + 1;
   for (std::int32_t tz = 0; tz < n; ++tz)
-    for (std::int32_t tx = 0; tx < n; ++tx) ASSERT_TRUE(t->detail_cache()->request({3, tx, tz}));
+    for (std::int32_t tx = 0; tx < n; ++tx) ASSERT_TRUE(t->surface().detail_cache()->request({3, tx, tz}));
   auto l = Landscape::create(t, {.patch_exponent = 3}).value();
   EXPECT_GT(check_bounds_against_brute_force(*t, *l), 20);
 }
@@ -226,7 +226,7 @@ TEST(DetailSurface, SplitsWaitForTilesWithoutBlocking) {
   // Frames go on; the tiles arrive on the worker and the mesh refines.
   std::uint32_t pending = first->pending_splits;
   for (int frame = 0; frame < 400 && pending > 0; ++frame) {
-    t->detail_cache()->wait_idle(5.0);
+    t->surface().detail_cache()->wait_idle(5.0);
     auto st = v->update(cam);
     ASSERT_TRUE(st);
     pending = st->pending_splits;
@@ -333,7 +333,7 @@ TEST(DetailSurface, TilesArrivingLaterTightenTheBounds) {
   std::uint32_t rebounded = 0;
   RoamStats st{};
   for (int frame = 0; frame < 600; ++frame) {
-    t->detail_cache()->wait_idle(5.0);
+    t->surface().detail_cache()->wait_idle(5.0);
     auto s = streamed->update(cam);
     ASSERT_TRUE(s);
     st = *s;

@@ -22,7 +22,7 @@ using ridgeline::Terrain;
 // A collider over the whole footprint and a little past it (those samples stay 0), at a spacing
 // unrelated to the terrain's, filled from the surface.
 HeightfieldCollider make_collider(const Terrain& t) {
-  const ridgeline::Heightfield& hf = t.heightfield();
+  const ridgeline::Heightfield hf = t.surface().to_heightfield().value();
   HeightfieldCollider c;
   c.origin_x = hf.origin_x() - 3;
   c.origin_z = hf.origin_z() - 3;
@@ -40,7 +40,7 @@ HeightfieldCollider make_collider(const Terrain& t) {
 // Bodies resting 0.5 m above the ground every 20 m.
 std::vector<Body> make_bodies(const Terrain& t) {
   std::vector<Body> bodies;
-  const ridgeline::Heightfield& hf = t.heightfield();
+  const ridgeline::Heightfield hf = t.surface().to_heightfield().value();
   for (double z = hf.origin_z() + 10; z < hf.origin_z() + hf.extent_z(); z += 20)
     for (double x = hf.origin_x() + 10; x < hf.origin_x() + hf.extent_x(); x += 20)
       bodies.push_back({x, *t.height(x, z) + 0.5, z, false});
@@ -78,7 +78,7 @@ struct World {
 
 std::shared_ptr<Terrain> plain_terrain() {
   auto hf = ridgeline::make_default_heightfield({.size = 257, .spacing = 2.0, .seed = 5});
-  return Terrain::create(std::move(hf).value());
+  return Terrain::create(std::move(hf).value()).value();
 }
 
 std::shared_ptr<Terrain> detail_terrain() {
@@ -105,7 +105,7 @@ Edit brush(ridgeline::Brush b, double x, double z, double radius, double depth) 
 
 void follows_brushes(std::shared_ptr<Terrain> terrain) {
   World w(std::move(terrain));
-  const ridgeline::Heightfield& hf = w.terrain->heightfield();
+  const ridgeline::Heightfield hf = w.terrain->surface().to_heightfield().value();
   // Nothing changed: nothing to do.
   const std::vector<float> before = w.collider.heights;
   EXPECT_EQ(w.poll(), 0);
@@ -161,7 +161,7 @@ TEST(EngineIntegration, ColliderFollowsALoadedEditState) {
 
 TEST(EngineIntegration, ColliderFollowsMoreEditsThanTheLogHolds) {
   World w(plain_terrain());
-  const ridgeline::Heightfield& hf = w.terrain->heightfield();
+  const ridgeline::Heightfield hf = w.terrain->surface().to_heightfield().value();
   // More changes than the log keeps one by one: the poll gets one merged box (trimmed).
   for (std::size_t k = 0; k < ridgeline::kChangeLogCapacity + 40; ++k) {
     const double x = hf.origin_x() + 20 + double(k % 40) * 11;

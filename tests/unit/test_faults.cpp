@@ -37,14 +37,14 @@ std::shared_ptr<Terrain> make_terrain(std::uint32_t n = 129) {
   p.spacing = 4;
   auto hf = make_default_heightfield(p);
   EXPECT_TRUE(hf.ok());
-  return Terrain::create(std::move(hf).value());
+  return Terrain::create(std::move(hf).value()).value();
 }
 
 std::shared_ptr<const DetailField> make_field(std::uint32_t levels) {
   DetailParams p;
   p.levels = levels;
   p.seed = 3;
-  auto f = DetailField::create(make_terrain()->heightfield(), p);
+  auto f = DetailField::create(make_terrain()->surface().to_heightfield().value(), p);
   EXPECT_TRUE(f.ok()) << (f.ok() ? "" : f.error().message);
   return std::move(f).value();
 }
@@ -171,7 +171,7 @@ TEST(Faults, HeightmapFileChangingWhileLoadedDoesNotTouchTheTerrain) {
   io::RawFormat fmt{16, 16, io::RawType::kU16};
   auto hf = io::load_raw(file.string(), fmt, {});
   ASSERT_TRUE(hf.ok()) << hf.error().message;
-  auto terrain = Terrain::create(std::move(hf).value());
+  auto terrain = Terrain::create(std::move(hf).value()).value();
   const double before = *terrain->height(3, 5);
   EXPECT_DOUBLE_EQ(before, 100 + 3 + 5 * 16);
   // Rewritten with other values, then truncated: the loaded terrain is a copy and unchanged;

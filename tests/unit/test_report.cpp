@@ -31,7 +31,7 @@ std::shared_ptr<const Terrain> field(std::uint32_t w, std::uint32_t h, double sx
     return 20 * std::sin(0.21 * i) * std::cos(0.17 * j) + 7 * std::sin(0.9 * i + 1.3 * j) + 30;
   });
   EXPECT_TRUE(hf.ok()) << hf.error().message;
-  return Terrain::create(std::move(*hf));
+  return Terrain::create(std::move(*hf)).value();
 }
 
 Camera look(const glm::dvec3& eye, const glm::dvec3& target) {
@@ -43,7 +43,7 @@ Camera look(const glm::dvec3& eye, const glm::dvec3& target) {
 
 TEST(ReportSurface, HeightsAtSamplesAreExactAndBetweenFollowTheDiagonalRule) {
   auto t = field(9, 7, 2.0, 3.0, 100.0);
-  const Heightfield& hf = t->heightfield();
+  const Heightfield hf = t->surface().to_heightfield().value();
   for (std::uint32_t j = 0; j < 7; ++j)
     for (std::uint32_t i = 0; i < 9; ++i) EXPECT_EQ(surface_height(hf, i, j), hf.world(i, j));
   std::mt19937 rng(3);
@@ -60,10 +60,10 @@ TEST(ReportUniformGrid, IsWatertightAndCoversTheTerrain) {
   for (auto [w, h] : {std::pair{33u, 33u}, {40u, 27u}, {2u, 2u}}) {
     auto t = field(w, h, 1.5, 0.7);
     for (double n : {2.0, 50.0, 700.0, 5000.0}) {
-      const UniformGrid g = UniformGrid::for_triangles(t->heightfield(), n);
-      const DrawnMesh m = g.mesh(t->heightfield());
+      const UniformGrid g = UniformGrid::for_triangles(Grid(*t), n);
+      const DrawnMesh m = g.mesh(Grid(*t));
       EXPECT_EQ(m.triangles(), g.triangles());
-      EXPECT_EQ(check_watertight(t->heightfield(), m), "") << w << "x" << h << " n=" << n;
+      EXPECT_EQ(check_watertight(Grid(*t), m), "") << w << "x" << h << " n=" << n;
     }
   }
 }
@@ -71,7 +71,7 @@ TEST(ReportUniformGrid, IsWatertightAndCoversTheTerrain) {
 TEST(ReportUniformGrid, MatchesTriangleCountsWithinFivePercent) {
   auto t = field(1025, 700, 1.0, 2.0);
   for (double n : {100.0, 999.0, 5000.0, 24583.0, 123071.0}) {
-    const UniformGrid g = UniformGrid::for_triangles(t->heightfield(), n);
+    const UniformGrid g = UniformGrid::for_triangles(Grid(*t), n);
     EXPECT_NEAR(double(g.triangles()) / n, 1.0, 0.05) << n;
   }
 }
@@ -89,7 +89,7 @@ std::vector<Camera> cameras() {
 TEST(ReportCdlod, MorphedSelectionIsWatertightAndCoversTheTerrain) {
   auto t = field(129, 129);
   for (std::uint32_t g : {4u, 8u}) {
-    const Cdlod cd(t->heightfield(), g);
+    const Cdlod cd(Grid(*t), g);
     int multi_level = 0;
     for (double scale : {1.0, 1.7, 4.0}) {
       for (const Camera& c : cameras()) {
@@ -100,7 +100,7 @@ TEST(ReportCdlod, MorphedSelectionIsWatertightAndCoversTheTerrain) {
           hi = std::max(hi, ch.level);
         }
         multi_level += hi > lo;
-        EXPECT_EQ(check_watertight(t->heightfield(), cd.mesh(s, c, true)), "")
+        EXPECT_EQ(check_watertight(Grid(*t), cd.mesh(s, c, true)), "")
             << "grid " << g << " r0 x" << scale << " eye " << c.eye.x << "," << c.eye.y << ","
             << c.eye.z;
       }
@@ -112,26 +112,26 @@ TEST(ReportCdlod, MorphedSelectionIsWatertightAndCoversTheTerrain) {
 TEST(ReportCdlod, WithoutMorphingLevelsMeetWithTJunctions) {
   // The check must be able to fail: unmorphed chunks of two levels leave cracks.
   auto t = field(129, 129);
-  const Cdlod cd(t->heightfield(), 8);
+  const Cdlod cd(Grid(*t), 8);
   int cracked = 0;
   for (const Camera& c : cameras()) {
     const auto s = cd.select(c, cd.min_r0(), false);
-    cracked += !check_watertight(t->heightfield(), cd.mesh(s, c, false)).empty();
+    cracked += !check_watertight(Grid(*t), cd.mesh(s, c, false)).empty();
   }
   EXPECT_GT(cracked, 0);
 }
 
 TEST(ReportCdlod, NonSquareFieldNotAPowerOfTwoIsCovered) {
   auto t = field(95, 90, 598, 927);  // elev.tif's shape and cell size
-  const Cdlod cd(t->heightfield(), 8);
+  const Cdlod cd(Grid(*t), 8);
   const Camera c = look({20000, 3000, 30000}, {40000, 0, 60000});
   const auto s = cd.select(c, cd.min_r0() * 1.3, false);
-  EXPECT_EQ(check_watertight(t->heightfield(), cd.mesh(s, c, true)), "");
+  EXPECT_EQ(check_watertight(Grid(*t), cd.mesh(s, c, true)), "");
 }
 
 TEST(ReportCdlod, MatchesAFeasibleTriangleTargetWithinTenPercent) {
   auto t = field(1025, 1025);
-  const Cdlod cd(t->heightfield(), 8);
+  const Cdlod cd(Grid(*t), 8);
   std::vector<Camera> path;
   for (int k = 0; k < 30; ++k) {
     const double a = 0.2 * k;
@@ -151,8 +151,8 @@ TEST(ReportCdlod, RefreshAfterAnEditEqualsARebuiltQuadtree) {
   auto hf = scenes::field({.width = 129, .height = 129},
                           [](int i, int) { return 30 + 10 * std::sin(0.1 * i); });
   ASSERT_TRUE(hf.ok());
-  auto t = Terrain::create(std::move(*hf));
-  Cdlod cd(t->heightfield(), 8);
+  auto t = Terrain::create(std::move(*hf)).value();
+  Cdlod cd(Grid(*t), 8);
   Edit e;
   e.brush = Brush::kCrater;
   e.x = 70;
@@ -164,14 +164,14 @@ TEST(ReportCdlod, RefreshAfterAnEditEqualsARebuiltQuadtree) {
   ASSERT_FALSE(r->empty());
   cd.refresh(std::int64_t(r->changed.min.x) - 1, std::int64_t(r->changed.min.z) - 1,
              std::int64_t(r->changed.max.x) + 1, std::int64_t(r->changed.max.z) + 1);
-  const Cdlod rebuilt(t->heightfield(), 8);
+  const Cdlod rebuilt(Grid(*t), 8);
   EXPECT_EQ(cd.min_r0(), rebuilt.min_r0());
   for (const Camera& c : cameras()) {
     const auto a = cd.select(c, rebuilt.min_r0() * 1.2, false);
     const auto b = rebuilt.select(c, rebuilt.min_r0() * 1.2, false);
     ASSERT_EQ(a.chunks.size(), b.chunks.size());
     EXPECT_EQ(a.triangles, b.triangles);
-    EXPECT_EQ(check_watertight(t->heightfield(), cd.mesh(a, c, true)), "");
+    EXPECT_EQ(check_watertight(Grid(*t), cd.mesh(a, c, true)), "");
   }
 }
 
@@ -210,7 +210,7 @@ MeshError brute_force(const Heightfield& hf, const DrawnMesh& m, const Camera& c
 
 TEST(ReportMeasure, AgreesWithBruteForceOnASmallField) {
   auto t = field(33, 33, 2.0, 1.0);
-  const Heightfield& hf = t->heightfield();
+  const Heightfield hf = t->surface().to_heightfield().value();
   const Cdlod cd(hf, 4);
   const MeshErrorMeter meter(hf);
   for (const Camera& c : {look({-10, 60, -10}, {40, 0, 20}), look({33, 25, 16}, {0, 20, 16}),
@@ -235,7 +235,7 @@ TEST(ReportMeasure, AgreesWithBruteForceOnASmallField) {
 
 TEST(ReportMeasure, HolesAreCountedAndAStrideSamplesEveryKthVertex) {
   auto t = field(33, 33);
-  const Heightfield& hf = t->heightfield();
+  const Heightfield hf = t->surface().to_heightfield().value();
   DrawnMesh m = UniformGrid{8, 8}.mesh(hf);
   m.corners.resize(m.corners.size() - 6);  // drop the last quad (its corner (32, 32))
   const Camera c = look({16, 80, -40}, {16, 0, 16});
@@ -265,23 +265,23 @@ TEST(ReportMeasure, RoamViewMeasuresItsPatchMeshesAsTheBruteForceDoes) {
   const Camera c = look({1e6 - 20, 90, 1e6 - 20}, {1e6 + 64, 10, 1e6 + 64});
   ASSERT_TRUE((*v)->converge(c).ok());
   const auto ref = (*v)->measure_error(c);
-  const MeshErrorMeter meter(t->heightfield());
+  const MeshErrorMeter meter(*t);
   // The patch meshes as a renderer draws them (no geomorph) against a search over every triangle.
   const DrawnMesh drawn = RoamSnapshot::capture(**v).draw(meter, c, false);
-  const MeshError b = brute_force(t->heightfield(), drawn, c);
+  const MeshError b = brute_force(t->surface().to_heightfield().value(), drawn, c);
   EXPECT_EQ(b.vertices, ref.vertices);
   EXPECT_EQ(b.uncovered, 0u);
   EXPECT_GT(ref.max_m, 0.1);
   EXPECT_NEAR(b.max_m, ref.max_m, 1e-4);
   EXPECT_NEAR(b.rms_m, ref.rms_m, 1e-4);
   EXPECT_NEAR(b.max_px, ref.max_px, 1e-3);
-  EXPECT_EQ(check_watertight(t->heightfield(), drawn), "");
-  EXPECT_EQ(check_watertight(t->heightfield(), leaves_mesh(**v)), "");
+  EXPECT_EQ(check_watertight(Grid(*t), drawn), "");
+  EXPECT_EQ(check_watertight(Grid(*t), leaves_mesh(**v)), "");
 }
 
 TEST(ReportMeasure, JumpIsZeroForAnUnchangedMeshAndTheHeightJumpOtherwise) {
   auto t = field(33, 33);
-  const Heightfield& hf = t->heightfield();
+  const Heightfield hf = t->surface().to_heightfield().value();
   const MeshErrorMeter meter(hf);
   const Camera c = look({16, 40, -30}, {16, 20, 16});
   const DrawnHeights a = meter.rasterize(UniformGrid{4, 4}.mesh(hf));
@@ -308,7 +308,7 @@ TEST(ReportPop, ARefinementPopsAndASameMeshMorphedDoesNot) {
   ASSERT_TRUE(v.ok());
   const Camera c = look({-20, 70, -20}, {64, 10, 64});
   ASSERT_TRUE((*v)->converge(c).ok());
-  const MeshErrorMeter meter(t->heightfield());
+  const MeshErrorMeter meter(*t);
   const RoamSnapshot coarse = RoamSnapshot::capture(**v);
   ASSERT_TRUE((*v)->set_settings({.threshold = 2.0}).ok());
   ASSERT_TRUE((*v)->converge(c).ok());
@@ -355,7 +355,7 @@ std::vector<Camera> soar_cameras() {
 
 TEST(ReportSoar, StripIsWatertightCoversTheTerrainAndHoldsTheLeafCount) {
   auto t = field(129, 129);
-  const Heightfield& hf = t->heightfield();
+  const Heightfield hf = t->surface().to_heightfield().value();
   const Soar soar(hf);
   EXPECT_EQ(soar.size(), 129u);
   std::vector<std::uint32_t> strip;
@@ -372,7 +372,7 @@ TEST(ReportSoar, StripIsWatertightCoversTheTerrainAndHoldsTheLeafCount) {
 
 TEST(ReportSoar, InfiniteKappaGivesTheFullLatticeAndZeroError) {
   auto t = field(65, 65);
-  const Heightfield& hf = t->heightfield();
+  const Heightfield hf = t->surface().to_heightfield().value();
   const Soar soar(hf);
   std::vector<std::uint32_t> strip;
   const Camera c = soar_cameras()[0];
@@ -386,7 +386,7 @@ TEST(ReportSoar, InfiniteKappaGivesTheFullLatticeAndZeroError) {
 
 TEST(ReportSoar, MoreKappaMoreTrianglesLessErrorAndCullingDropsTheOutOfView) {
   auto t = field(129, 129);
-  const Heightfield& hf = t->heightfield();
+  const Heightfield hf = t->surface().to_heightfield().value();
   const Soar soar(hf);
   const MeshErrorMeter meter(hf);
   std::vector<std::uint32_t> strip;
@@ -408,7 +408,7 @@ TEST(ReportSoar, MoreKappaMoreTrianglesLessErrorAndCullingDropsTheOutOfView) {
 
 TEST(ReportSoar, NonPowerOfTwoFieldIsCoveredThroughThePadding) {
   auto t = field(95, 90, 6.0, 9.0);
-  const Heightfield& hf = t->heightfield();
+  const Heightfield hf = t->surface().to_heightfield().value();
   const Soar soar(hf);
   EXPECT_EQ(soar.size(), 129u);
   const MeshErrorMeter meter(hf);
@@ -423,7 +423,7 @@ TEST(ReportSoar, NonPowerOfTwoFieldIsCoveredThroughThePadding) {
 
 TEST(ReportSoar, MatchFindsTheKappaOfATriangleTarget) {
   auto t = field(257, 257);
-  const Soar soar(t->heightfield());
+  const Soar soar{Grid(*t)};
   std::vector<Camera> path;
   for (int k = 0; k < 12; ++k)
     path.push_back(

@@ -20,6 +20,7 @@
 #include "roam/diamond.h"
 #include "roam/front.h"
 #include "roam/reserved.h"
+#include "roam/landscape_access.h"
 #include "roam_test_util.h"
 
 using namespace ridgeline;
@@ -42,7 +43,7 @@ std::shared_ptr<const Landscape> make_landscape(std::uint32_t size, std::uint32_
     std::vector<float> v(hf->local_heights().begin(), hf->local_heights().end());
     hf = Heightfield::create(d, v);
   }
-  auto terrain = Terrain::create(std::move(hf).value());
+  auto terrain = Terrain::create(std::move(hf).value()).value();
   auto l = Landscape::create(terrain, {.patch_exponent = k});
   EXPECT_TRUE(l) << (l ? "" : l.error().message);
   return l.value();
@@ -60,7 +61,7 @@ std::shared_ptr<const Landscape> make_padded_landscape(std::uint32_t k) {
   for (std::uint32_t j = 0; j < d.height; ++j)
     for (std::uint32_t i = 0; i < d.width; ++i)
       h[i + j * d.width] = float(10 * std::sin(0.3 * i) * std::cos(0.21 * j) + 0.05 * i * j);
-  auto terrain = Terrain::create(Heightfield::create(d, h).value());
+  auto terrain = Terrain::create(Heightfield::create(d, h).value()).value();
   return Landscape::create(terrain, {.patch_exponent = k}).value();
 }
 
@@ -74,8 +75,9 @@ double projected_bound(const Landscape& l, const LatticeTriangle& t, const Camer
   if (((t.lx + t.rx) | (t.lz + t.rz)) & 1) return 0.0;  // finest triangles never split
   const std::int64_t ci = (t.lx + t.rx) / 2, cj = (t.lz + t.rz) / 2;
   const DiamondBound b = l.diamond(ci, cj);
-  const double off = l.terrain().heightfield().height_offset();
-  const glm::dvec3 centre(l.world_x(ci), off + l.lattice_height(ci, cj), l.world_z(cj));
+  const double off = l.terrain().info().height_offset;
+  const glm::dvec3 centre(test::world_x(l, ci), off + test::lattice_height(l, ci, cj),
+                          test::world_z(l, cj));
   // In view: the sphere meets the frustum (the lattice vertices that carry error are inside it;
   // the triangle's corners carry none).
   *in_view = Frustum(c).classify_sphere(centre, double(b.radius)) != Frustum::Cull::kOut;
@@ -103,7 +105,7 @@ TEST(Landscape, BoundsAreNestedAndHonest) {
   for (std::uint32_t root = 0; root < l->root_count(); ++root) {
     for (std::uint64_t h = 1; h < (std::uint64_t{1} << l->max_level()); ++h) {
       const float b = l->bound(root, h);
-      EXPECT_GE(b, l->exact_error(root, h));
+      EXPECT_GE(b, test::exact_error(*l, root, h));
       if (2 * h + 1 < (std::uint64_t{1} << l->max_level())) {
         EXPECT_GE(b, l->bound(root, 2 * h));
         EXPECT_GE(b, l->bound(root, 2 * h + 1));
@@ -120,11 +122,11 @@ TEST(Landscape, ExactErrorMatchesBruteForceOnABump) {
   d.width = d.height = 5;
   std::vector<float> v(25, 0.0f);
   v[1 + 2 * 5] = 3.0f;  // (1, 2)
-  auto t = Terrain::create(std::move(Heightfield::create(d, v)).value());
+  auto t = Terrain::create(std::move(Heightfield::create(d, v)).value()).value();
   auto l = Landscape::create(t, {.patch_exponent = 2}).value();
   // Root 1 has apex (0, 4), hypotenuse (4,4)-(0,0): it holds (1, 2) (x < z).
-  EXPECT_FLOAT_EQ(l->exact_error(1, 1), 3.0f);
-  EXPECT_FLOAT_EQ(l->exact_error(0, 1), 0.0f);
+  EXPECT_FLOAT_EQ(test::exact_error(*l, 1, 1), 3.0f);
+  EXPECT_FLOAT_EQ(test::exact_error(*l, 0, 1), 0.0f);
 }
 
 TEST(Roam, CrackFreeAlongARandomWalkWithChangingThresholdsAndBudgets) {
@@ -182,7 +184,7 @@ TEST(Roam, MeasuredErrorNeverExceedsTheBound) {
   auto l = make_landscape(129, 5);
   auto view = RoamView::create(l, {.metric = ErrorMetric::kWorldMetres, .threshold = 1.5}).value();
   ASSERT_TRUE(view->update(Camera{}));
-  const Heightfield& hf = l->terrain().heightfield();
+  const Heightfield hf = l->terrain().surface().to_heightfield().value();
   double worst = 0;
   view->for_each_leaf([&](std::uint32_t root, std::uint64_t heap, const LatticeTriangle& t) {
     // Measure: every lattice vertex under the triangle against the triangle's plane.
@@ -197,9 +199,9 @@ TEST(Roam, MeasuredErrorNeverExceedsTheBound) {
         const double wl = 1 - wr - wa;
         if (wr < -1e-12 || wa < -1e-12 || wl < -1e-12) continue;
         if (i >= hf.width() || j >= hf.height()) continue;
-        const double plane = wa * l->lattice_height(t.ax, t.az) +
-                             wl * l->lattice_height(t.lx, t.lz) +
-                             wr * l->lattice_height(t.rx, t.rz);
+        const double plane = wa * test::lattice_height(*l, t.ax, t.az) +
+                             wl * test::lattice_height(*l, t.lx, t.lz) +
+                             wr * test::lattice_height(*l, t.rx, t.rz);
         const double err = std::abs(plane - hf.local(std::uint32_t(i), std::uint32_t(j)));
         EXPECT_LE(err, b + 1e-4);
         EXPECT_LE(err, 1.5 + 1e-4);
@@ -279,7 +281,7 @@ TEST(Roam, ToleranceModeGivesTheMinimalTriangulationUnderTheBound) {
           *l, [&](std::uint32_t r, std::uint64_t h) { return l->bound(r, h) <= tol; });
       EXPECT_EQ(st->triangles, ref) << "size " << size << " tolerance " << tol;
       const std::size_t exact = minimal_triangulation(
-          *l, [&](std::uint32_t r, std::uint64_t h) { return l->exact_error(r, h) <= tol; });
+          *l, [&](std::uint32_t r, std::uint64_t h) { return test::exact_error(*l, r, h) <= tol; });
       EXPECT_LE(exact, st->triangles);
       // The exact-bound target of the issue: within 1.1x of the exact minimal count.
       EXPECT_LE(double(st->triangles), 1.1 * double(exact)) << "size " << size << " tol " << tol;
@@ -589,7 +591,7 @@ TEST(Roam, AVertexStartsOnItsParentEdgeAsDrawn) {
   for (const Geomorph g : {Geomorph{}, Geomorph{0.5, 0.0}, Geomorph{1.0, 0.3}}) {
     auto hf = make_default_heightfield({.size = 257, .spacing = 2.0, .seed = 1337});
     ASSERT_TRUE(hf);
-    auto l = Landscape::create(Terrain::create(std::move(hf).value()),
+    auto l = Landscape::create(Terrain::create(std::move(hf).value()).value(),
                                {.patch_exponent = 5, .morph_window = g.window,
                                 .morph_delay = g.delay})
                  .value();
@@ -730,7 +732,7 @@ TEST(Landscape, ConstantTimeGeometryMatchesThePathWalk) {
   for (std::uint32_t root = 0; root < l->root_count(); ++root)
     for (std::uint64_t h = 1; h < (std::uint64_t{1} << (l->max_level() + 1)); ++h) {
       const LatticeTriangle a = l->triangle(root, h);
-      const LatticeTriangle b = l->triangle_at(a.ax, a.az, root, h);
+      const LatticeTriangle b = roam::LandscapeAccess::triangle_at(*l, a.ax, a.az, root, h);
       ASSERT_EQ(std::tie(a.lx, a.lz, a.rx, a.rz), std::tie(b.lx, b.lz, b.rx, b.rz))
           << "root " << root << " heap " << h;
       const Landscape::LatticeBox x = Landscape::box_of(b);

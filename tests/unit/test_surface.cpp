@@ -42,7 +42,7 @@ Heightfield make_samples() {
 }
 
 std::shared_ptr<const Terrain> make_terrain(std::uint32_t levels) {
-  if (levels == 0) return Terrain::create(make_samples());
+  if (levels == 0) return Terrain::create(make_samples()).value();
   DetailParams p;
   p.levels = levels;
   p.seed = 9;
@@ -57,13 +57,14 @@ std::shared_ptr<const Terrain> make_terrain(std::uint32_t levels) {
 
 // The reference: the finest lattice's vertices computed from the definition, once.
 struct Reference {
-  const Heightfield& hf;
+  const Heightfield hf;
   std::uint32_t L;
   std::int64_t w, h;  // vertices per axis
   double sx, sz;      // finest spacing
   std::vector<double> local;
 
-  Reference(const Terrain& t) : hf(t.heightfield()), L(t.surface().detail_levels()) {
+  Reference(const Terrain& t)
+      : hf(t.surface().to_heightfield().value()), L(t.surface().detail_levels()) {
     w = (std::int64_t(hf.width()) - 1) * (std::int64_t{1} << L) + 1;
     h = (std::int64_t(hf.height()) - 1) * (std::int64_t{1} << L) + 1;
     sx = hf.spacing_x() / double(1 << L);
@@ -82,7 +83,7 @@ struct Reference {
         for (int k = 0; k < 3; ++k)
           base += double(tri.w[k]) *
                   hf.local(std::uint32_t(ci + tri.di[k]), std::uint32_t(cj + tri.dj[k]));
-        const double d = L == 0 ? 0.0 : t.detail()->detail(L, i, j);
+        const double d = L == 0 ? 0.0 : t.surface().detail()->detail(L, i, j);
         local[std::size_t(i + j * w)] = base + d;
       }
   }
@@ -129,7 +130,7 @@ void check_against_brute_force(std::uint32_t levels) {
   auto terrain = make_terrain(levels);
   const Surface& s = terrain->surface();
   const Reference ref(*terrain);
-  const Heightfield& hf = terrain->heightfield();
+  const Heightfield hf = terrain->surface().to_heightfield().value();
 
   // The lattice as documented.
   const SurfaceLattice& at = s.lattice();

@@ -149,7 +149,7 @@ bool make_default(ConfigBox* config, TerrainBox* box, char* err) noexcept {
         copy_error(err, hf.error().message.c_str());
         return false;
       }
-      config->default_terrain = Terrain::create(std::move(*hf));
+      config->default_terrain = Terrain::create(std::move(*hf)).value();
     }
     box->terrain = config->default_terrain->clone();
     set_path_rules(box, *config);

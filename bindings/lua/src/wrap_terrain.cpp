@@ -246,9 +246,9 @@ int t_contacts(lua_State* L) {
         L, 5,
         lua_pushfstring(L, "at most %I offsets per call, got %I",
                         static_cast<lua_Integer>(kMaxContacts), static_cast<lua_Integer>(n)));
-  const Heightfield& hf = t.heightfield();
-  const double top = hf.height_offset() + hf.max_local() + 1.0;
-  const double depth = hf.max_local() - hf.min_local() + 2.0;
+  const WorldInfo& hf = t.info();
+  const double top = hf.height_offset + hf.max_local + 1.0;
+  const double depth = hf.max_local - hf.min_local + 2.0;
   lua_settop(L, 5);
   lua_createtable(L, static_cast<int>(n), 0);
   for (lua_Unsigned i = 1; i <= n; ++i) {
@@ -290,13 +290,13 @@ int t_contacts(lua_State* L) {
 
 // terrain:bounds() -> min_x, min_z, max_x, max_z, min_height, max_height (metres)
 int t_bounds(lua_State* L) {
-  const Heightfield& hf = live_terrain(L).heightfield();
-  lua_pushnumber(L, hf.origin_x());
-  lua_pushnumber(L, hf.origin_z());
-  lua_pushnumber(L, hf.origin_x() + hf.extent_x());
-  lua_pushnumber(L, hf.origin_z() + hf.extent_z());
-  lua_pushnumber(L, hf.height_offset() + hf.min_local());
-  lua_pushnumber(L, hf.height_offset() + hf.max_local());
+  const WorldInfo& hf = live_terrain(L).info();
+  lua_pushnumber(L, hf.origin_x);
+  lua_pushnumber(L, hf.origin_z);
+  lua_pushnumber(L, hf.origin_x + hf.extent_x());
+  lua_pushnumber(L, hf.origin_z + hf.extent_z());
+  lua_pushnumber(L, hf.height_offset + hf.min_local);
+  lua_pushnumber(L, hf.height_offset + hf.max_local);
   return 6;
 }
 
@@ -379,10 +379,10 @@ int t_tostring(lua_State* L) {
     lua_pushliteral(L, "ridgeline.terrain (released)");
     return 1;
   }
-  const Heightfield& hf = box->terrain->heightfield();
+  const WorldInfo& hf = box->terrain->info();
   char text[160];
   std::snprintf(text, sizeof text, "ridgeline.terrain (%u x %u samples, %g x %g m spacing)",
-                hf.width(), hf.height(), hf.spacing_x(), hf.spacing_z());
+                hf.width, hf.height, hf.spacing_x, hf.spacing_z);
   lua_pushstring(L, text);
   return 1;
 }

@@ -35,7 +35,7 @@ Status finish_scene(Scene& sc, Result<Heightfield> hf) {
     sc.messages.push_back("refused: " + hf.error().message);
     return Status{};
   }
-  sc.terrain = Terrain::create(std::move(*hf));
+  sc.terrain = Terrain::create(std::move(*hf)).value();
   auto l = landscape_of(sc.terrain);
   if (!l) return l.error();
   sc.landscape = *l;
@@ -164,7 +164,7 @@ Result<Scene> detail_scene(std::uint32_t size, std::uint32_t levels) {
       {"finest_spacing_m", {sc.fine->spacing_x(), sc.fine->spacing_z()}},
       {"cache_budget_bytes", cache.budget_bytes},
       {"cache_worker_threads", cache.worker_threads},
-      {"field_bytes", sc.terrain->detail()->memory_bytes()},
+      {"field_bytes", sc.terrain->surface().detail()->memory_bytes()},
       {"baked_lattice_bytes", sc.fine->memory_bytes()},
       {"bake_s", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()},
       {"comparators",

@@ -33,12 +33,12 @@ void triangulate_grid(const std::vector<glm::dvec3>& v, std::uint32_t nx, std::u
     }
 }
 
-glm::dvec3 to_world(const Heightfield& hf, const glm::dvec3& c) {
+glm::dvec3 to_world(const Grid& hf, const glm::dvec3& c) {
   return {hf.origin_x() + c.x * hf.spacing_x(), c.y, hf.origin_z() + c.z * hf.spacing_z()};
 }
 }  // namespace
 
-double surface_height(const Heightfield& hf, double u, double v) {
+double surface_height(const Grid& hf, double u, double v) {
   const double W = hf.width() - 1, H = hf.height() - 1;
   u = std::clamp(u, 0.0, W);
   v = std::clamp(v, 0.0, H);
@@ -62,7 +62,7 @@ double surface_height(const Heightfield& hf, double u, double v) {
 
 // ---- uniform grid -----------------------------------------------------------------------
 
-UniformGrid UniformGrid::for_triangles(const Heightfield& hf, double triangles) {
+UniformGrid UniformGrid::for_triangles(const Grid& hf, double triangles) {
   const double ex = hf.extent_x(), ez = hf.extent_z();
   const double quads = std::max(1.0, triangles / 2.0);
   // nx / nz = ex / ez (square quads), nx * nz = quads; then the best integer pair near it.
@@ -84,7 +84,7 @@ UniformGrid UniformGrid::for_triangles(const Heightfield& hf, double triangles) 
   return best;
 }
 
-std::vector<glm::dvec3> UniformGrid::vertices(const Heightfield& hf) const {
+std::vector<glm::dvec3> UniformGrid::vertices(const Grid& hf) const {
   const double W = hf.width() - 1, H = hf.height() - 1;
   std::vector<glm::dvec3> v(std::size_t(nx + 1) * (nz + 1));
   for (std::uint32_t b = 0; b <= nz; ++b)
@@ -95,7 +95,7 @@ std::vector<glm::dvec3> UniformGrid::vertices(const Heightfield& hf) const {
   return v;
 }
 
-std::size_t UniformGrid::resample(const Heightfield& hf, std::vector<glm::dvec3>& v, double u0,
+std::size_t UniformGrid::resample(const Grid& hf, std::vector<glm::dvec3>& v, double u0,
                                   double v0, double u1, double v1) const {
   const double W = hf.width() - 1, H = hf.height() - 1;
   const auto a0 = static_cast<std::int64_t>(std::max(0.0, std::floor(u0 * nx / W)));
@@ -120,8 +120,8 @@ DrawnMesh UniformGrid::mesh_of(const std::vector<glm::dvec3>& v) const {
 
 // ---- CDLOD ------------------------------------------------------------------------------
 
-Cdlod::Cdlod(const Heightfield& hf, std::uint32_t grid)
-    : hf_(&hf), grid_(std::max<std::uint32_t>(2, grid & ~1u)) {
+Cdlod::Cdlod(const Grid& hf, std::uint32_t grid)
+    : hf_(hf), grid_(std::max<std::uint32_t>(2, grid & ~1u)) {
   cells_x_ = hf.width() - 1;
   cells_z_ = hf.height() - 1;
   levels_ = 1;
@@ -140,7 +140,7 @@ Cdlod::Cdlod(const Heightfield& hf, std::uint32_t grid)
 }
 
 Cdlod::Node Cdlod::compute(std::uint32_t L, std::int64_t a, std::int64_t b) const {
-  const Heightfield& hf = *hf_;
+  const Grid& hf = hf_;
   const std::int64_t size = std::int64_t(grid_) << L;
   Node n{std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity()};
   if (L == 0) {
@@ -207,7 +207,7 @@ void Cdlod::box(std::uint32_t level, std::int64_t i0, std::int64_t j0, glm::dvec
                 glm::dvec3* hi) const {
   const std::int64_t size = std::int64_t(grid_) << level;
   const Node& n = node(level, i0, j0);
-  const Heightfield& hf = *hf_;
+  const Grid& hf = hf_;
   *lo = {hf.origin_x() + double(i0) * hf.spacing_x(), hf.height_offset() + n.lo,
          hf.origin_z() + double(j0) * hf.spacing_z()};
   *hi = {hf.origin_x() + double(std::min(i0 + size, cells_x_)) * hf.spacing_x(),
@@ -297,7 +297,7 @@ Cdlod::Match Cdlod::match(const std::vector<Camera>& frames, double target,
 
 void Cdlod::emit_quadrant(const Chunk& c, int q, const Frustum& f, bool morph,
                           const std::vector<double>& range, DrawnMesh& out) const {
-  const Heightfield& hf = *hf_;
+  const Grid& hf = hf_;
   const std::uint32_t L = c.level, g = grid_ / 2;
   const std::int64_t s = std::int64_t(1) << L;
   const std::uint32_t gx0 = std::uint32_t(q & 1) * g, gz0 = std::uint32_t(q >> 1) * g;
@@ -336,12 +336,12 @@ std::uint64_t Cdlod::memory_bytes() const noexcept {
   std::uint64_t n = 0;
   for (const auto& l : nodes_) n += l.size() * sizeof(Node);
   return n + std::uint64_t(grid_ + 1) * (grid_ + 1) * 8 + std::uint64_t(grid_) * grid_ * 6 * 4 +
-         std::uint64_t(hf_->width()) * hf_->height() * 4;
+         std::uint64_t(hf_.width()) * hf_.height() * 4;
 }
 
 // ---- watertightness ---------------------------------------------------------------------
 
-std::string check_watertight(const Heightfield& hf, const DrawnMesh& mesh) {
+std::string check_watertight(const Grid& hf, const DrawnMesh& mesh) {
   using P = std::tuple<double, double, double>;
   std::map<std::pair<P, P>, int> edges;
   const double W = hf.width() - 1, H = hf.height() - 1;

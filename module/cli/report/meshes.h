@@ -17,16 +17,18 @@
 
 #include "ridgeline/camera.h"
 #include "ridgeline/mesh_error.h"
+#include "report/grid.h"
 #include "ridgeline/terrain.h"
 
 namespace ridgeline::report {
 
 using ridgeline::DrawnMesh;
 
+
 /// World height of the surface (piecewise linear over the diagonal rule, docs/surface.md) at
 /// lattice coordinates (u, v), clamped into [0, W-1] x [0, H-1]. Exact sample heights at integer
 /// (u, v).
-double surface_height(const Heightfield& hf, double u, double v);
+double surface_height(const Grid& hf, double u, double v);
 
 // ---- uniform grid -----------------------------------------------------------------------
 
@@ -41,14 +43,14 @@ struct UniformGrid {
   }
   /// The grid closest to `triangles` triangles whose quads are as square as the terrain allows
   /// (at least 1 x 1, at most one quad per lattice cell... and beyond: never coarser than 1).
-  static UniformGrid for_triangles(const Heightfield& hf, double triangles);
-  DrawnMesh mesh(const Heightfield& hf) const { return mesh_of(vertices(hf)); }
+  static UniformGrid for_triangles(const Grid& hf, double triangles);
+  DrawnMesh mesh(const Grid& hf) const { return mesh_of(vertices(hf)); }
   /// The (nx + 1) x (nz + 1) vertices, row by row, and the mesh over them.
-  std::vector<glm::dvec3> vertices(const Heightfield& hf) const;
+  std::vector<glm::dvec3> vertices(const Grid& hf) const;
   DrawnMesh mesh_of(const std::vector<glm::dvec3>& vertices) const;
   /// Re-samples the heights of the vertices inside lattice range [u0, u1] x [v0, v1] (after an
   /// edit there); returns how many.
-  std::size_t resample(const Heightfield& hf, std::vector<glm::dvec3>& vertices, double u0,
+  std::size_t resample(const Grid& hf, std::vector<glm::dvec3>& vertices, double u0,
                        double v0, double u1, double v1) const;
 };
 
@@ -68,7 +70,7 @@ struct UniformGrid {
 class Cdlod {
  public:
   /// `grid`: quads per chunk side, an even number >= 2.
-  Cdlod(const Heightfield& hf, std::uint32_t grid);
+  Cdlod(const Grid& hf, std::uint32_t grid);
 
   struct Chunk {
     std::uint32_t level;
@@ -118,7 +120,7 @@ class Cdlod {
   void emit_quadrant(const Chunk& c, int q, const Frustum& f, bool morph,
                      const std::vector<double>& range, DrawnMesh& out) const;
 
-  const Heightfield* hf_;
+  Grid hf_;
   std::uint32_t grid_, levels_;  // levels_: number of levels (top = levels_ - 1)
   std::int64_t cells_x_, cells_z_;
   std::vector<std::vector<Node>> nodes_;  // per level, row-major
@@ -131,6 +133,6 @@ class Cdlod {
 /// coincident corners are skipped, triangles squeezed to zero xz area by a morph are kept, as they
 /// join their neighbours like a skirt), and the triangles' xz areas add up to the area's.
 /// Returns an empty string when they hold, else the first violation.
-std::string check_watertight(const Heightfield& hf, const DrawnMesh& mesh);
+std::string check_watertight(const Grid& hf, const DrawnMesh& mesh);
 
 }  // namespace ridgeline::report

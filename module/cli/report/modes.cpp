@@ -28,6 +28,11 @@ const Cdlod& Scene::cdlod(std::uint32_t grid) {
   return *p;
 }
 
+const Heightfield& Scene::lattice() {
+  if (!fine) fine = std::make_shared<const Heightfield>(finest_lattice(*terrain).value());
+  return *fine;
+}
+
 const Soar& Scene::soar() {
   if (!soar_) soar_ = std::make_unique<Soar>(lattice());
   return *soar_;
@@ -40,20 +45,21 @@ const MeshErrorMeter& Scene::meter(std::uint32_t stride) {
 }
 
 Result<Heightfield> finest_lattice(const Terrain& t) {
-  const Heightfield& stored = t.heightfield();
+  const WorldInfo& stored = t.info();
   HeightfieldDesc d;
-  d.width = static_cast<std::uint32_t>(t.fine_width());
-  d.height = static_cast<std::uint32_t>(t.fine_height());
-  d.spacing_x = stored.spacing_x() / double(1u << t.detail_levels());
-  d.spacing_z = stored.spacing_z() / double(1u << t.detail_levels());
-  d.origin_x = stored.origin_x();
-  d.origin_z = stored.origin_z();
-  d.height_offset = stored.height_offset();
+  d.width = static_cast<std::uint32_t>(t.surface().lattice().vertices_x);
+  d.height = static_cast<std::uint32_t>(t.surface().lattice().vertices_z);
+  d.spacing_x = stored.spacing_x / double(1u << t.surface().detail_levels());
+  d.spacing_z = stored.spacing_z / double(1u << t.surface().detail_levels());
+  d.origin_x = stored.origin_x;
+  d.origin_z = stored.origin_z;
+  d.height_offset = stored.height_offset;
+  d.max_samples = std::uint64_t{1} << 31;
   d.name = "finest lattice";
   std::vector<float> v(std::size_t(d.width) * d.height);
   for (std::uint32_t j = 0; j < d.height; ++j)
     for (std::uint32_t i = 0; i < d.width; ++i)
-      v[i + std::size_t(j) * d.width] = static_cast<float>(t.fine_local_height(i, j));
+      v[i + std::size_t(j) * d.width] = static_cast<float>(t.surface().vertex_height(i, j));
   return Heightfield::create(d, v);
 }
 
@@ -138,7 +144,7 @@ Result<ModeResult> run_roam(Scene& sc, const NamedPath& path, const Setting& st,
     terrain = f->first;
     land = f->second;
   }
-  DetailCache* cache = terrain->detail_cache();
+  DetailCache* cache = terrain->surface().detail_cache();
   auto v = RoamView::create(land, st.roam(mode));
   if (!v) return v.error();
   RoamView& view = **v;
@@ -159,7 +165,7 @@ Result<ModeResult> run_roam(Scene& sc, const NamedPath& path, const Setting& st,
   std::string err;
   std::uint32_t time_stops = 0;
   std::vector<double> cache_ms;
-  const double field_bytes = cache ? double(terrain->detail()->memory_bytes()) : 0.0;
+  const double field_bytes = cache ? double(terrain->surface().detail()->memory_bytes()) : 0.0;
   const MeshErrorMeter& meter = sc.meter(o.stride);
   auto update = [&](std::size_t k) {
     if (cache) {  // the frame loop's once-per-frame cache update (integrate, evict, publish)

@@ -35,8 +35,9 @@ struct Scene {
       fresh;
   Json detail = nullptr;
 
-  /// The lattice everything is measured on: the finest one.
-  const Heightfield& lattice() const { return fine ? *fine : terrain->heightfield(); }
+  /// The lattice everything is measured on: the finest one (the stored samples without detail),
+  /// as a heightfield, made on first use.
+  const Heightfield& lattice();
   /// The comparators and the measurement over lattice(), built on first use.
   const Cdlod& cdlod(std::uint32_t grid);
   const Soar& soar();
@@ -48,8 +49,8 @@ struct Scene {
   std::unique_ptr<MeshErrorMeter> meter_;
 };
 
-/// The finest lattice of `terrain` (base + detail + edits, Terrain::fine_local_height) baked into a
-/// heightfield (spacing / 2^L): what the comparators draw from on a detail terrain.
+/// The finest lattice of `terrain` (base + detail + edits, Surface::vertex_height) baked into a
+/// heightfield (spacing / 2^L): what the comparators draw from.
 Result<Heightfield> finest_lattice(const Terrain& terrain);
 
 /// A mode's mesh as captured after one frame's update, drawable later for any camera (geomorphed

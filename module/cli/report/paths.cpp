@@ -8,14 +8,14 @@ namespace ridgeline::report {
 
 std::vector<NamedPath> make_paths(const Terrain& terrain, int frames) {
   constexpr double kPi = 3.14159265358979323846;
-  const Heightfield& hf = terrain.heightfield();
+  const WorldInfo& hf = terrain.info();
   const double ex = hf.extent_x(), ez = hf.extent_z(), E = std::min(ex, ez);
-  const double cx = hf.origin_x() + ex / 2, cz = hf.origin_z() + ez / 2;
-  const double top = hf.height_offset() + hf.max_local();
+  const double cx = hf.origin_x + ex / 2, cz = hf.origin_z + ez / 2;
+  const double top = hf.height_offset + hf.max_local;
   const double far = std::max(50000.0, 2.0 * std::hypot(ex, ez));
   auto ground = [&](double x, double z) {
-    x = std::clamp(x, hf.origin_x(), hf.origin_x() + ex);
-    z = std::clamp(z, hf.origin_z(), hf.origin_z() + ez);
+    x = std::clamp(x, hf.origin_x, hf.origin_x + ex);
+    z = std::clamp(z, hf.origin_z, hf.origin_z + ez);
     return terrain.height(x, z).value_or(top);
   };
   auto cam = [&](glm::dvec3 eye, glm::dvec3 target, double fov = 60, glm::dvec3 up = {0, 1, 0}) {

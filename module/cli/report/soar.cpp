@@ -16,7 +16,7 @@ constexpr std::uint32_t kUndecided = 0xF;
 constexpr std::uint32_t kOutside = 0x10;
 }  // namespace
 
-Soar::Soar(const Heightfield& hf)
+Soar::Soar(const Grid& hf)
     : origin_x_(hf.origin_x()),
       origin_z_(hf.origin_z()),
       offset_(hf.height_offset()),

@@ -19,6 +19,7 @@
 
 #include "ridgeline/camera.h"
 #include "ridgeline/heightfield.h"
+#include "report/grid.h"
 #include "ridgeline/mesh_error.h"
 
 namespace ridgeline::report {
@@ -33,7 +34,7 @@ class Soar {
   /// (2^n + 1)^2 vertices covering it (the smallest such; samples beyond the heightfield repeat
   /// its edge samples, the padding rule), their heights, and the nested errors and radii.
   /// Precondition: both sides of `hf` at most kMaxSide (callers check; see bench_soar.cpp).
-  explicit Soar(const Heightfield& hf);
+  explicit Soar(const Grid& hf);
 
   /// Result of one refinement.
   struct Frame {

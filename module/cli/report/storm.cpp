@@ -25,7 +25,7 @@ struct Pristine {
   std::vector<float> local;
   std::shared_ptr<Terrain> fresh() const {
     auto hf = Heightfield::create(desc, local);
-    return hf ? Terrain::create(std::move(*hf)) : nullptr;
+    return hf ? Terrain::create(std::move(*hf)).value() : nullptr;
   }
 };
 
@@ -68,11 +68,11 @@ Edit crater_for(const Terrain& t, const Camera& c, std::size_t k) {
 struct CellBox {
   std::int64_t i0, j0, i1, j1;
 };
-CellBox cells_of(const Heightfield& hf, const Box& b) {
-  return {std::int64_t(std::floor((b.min.x - hf.origin_x()) / hf.spacing_x())) - 1,
-          std::int64_t(std::floor((b.min.z - hf.origin_z()) / hf.spacing_z())) - 1,
-          std::int64_t(std::ceil((b.max.x - hf.origin_x()) / hf.spacing_x())) + 1,
-          std::int64_t(std::ceil((b.max.z - hf.origin_z()) / hf.spacing_z())) + 1};
+CellBox cells_of(const WorldInfo& hf, const Box& b) {
+  return {std::int64_t(std::floor((b.min.x - hf.origin_x) / hf.spacing_x)) - 1,
+          std::int64_t(std::floor((b.min.z - hf.origin_z) / hf.spacing_z)) - 1,
+          std::int64_t(std::ceil((b.max.x - hf.origin_x) / hf.spacing_x)) + 1,
+          std::int64_t(std::ceil((b.max.z - hf.origin_z) / hf.spacing_z)) + 1};
 }
 
 // One mode in the storm: what it does after each frame's crater (inside its timed update), and
@@ -105,7 +105,7 @@ Result<ModeResult> run_storm_mode(Terrain& t, MeshErrorMeter& meter, const Named
         }
         std::optional<CellBox> changed;
         if (!e->empty()) {
-          changed = cells_of(t.heightfield(), e->changed);
+          changed = cells_of(t.info(), e->changed);
           meter.refresh(changed->i0, changed->j0, changed->i1, changed->j1);
         }
         if (auto s = m.step(k, changed, r); !s) err = s.message();
@@ -126,7 +126,7 @@ Result<ModeResult> storm_roam(const Pristine& pr, const NamedPath& path, const S
   RoamView& view = **v;
   if (mode == RoamMode::kCoherent)
     if (auto s = view.converge(path.frames[0]); !s) return s.error();
-  MeshErrorMeter meter(t->heightfield(), o.stride);
+  MeshErrorMeter meter(*t, o.stride);
   StormMode m;
   m.name = mode == RoamMode::kCoherent ? "roam_coherent" : "roam_rebuild";
   m.morph = st.threshold_px() > 0;
@@ -159,8 +159,8 @@ Result<ModeResult> storm_comparator(Scene& base, const Pristine& pr, const Named
                                     double target, const Options& o, bool cdlod) {
   auto t = pr.fresh();
   if (!t) return Error{"storm: cannot rebuild the terrain"};
-  const Heightfield& hf = t->heightfield();
-  MeshErrorMeter meter(hf, o.stride);
+  const Grid hf(*t);  // reads the terrain's live samples: the craters show
+  MeshErrorMeter meter(*t, o.stride);
   StormMode m;
   Json extra = {{"target_triangles", target}};
   // The grid's state.
@@ -227,7 +227,7 @@ Result<ModeResult> storm_comparator(Scene& base, const Pristine& pr, const Named
 
 Result<Json> run_storm(Scene& base, const Options& o, std::string& csv_out) {
   const auto t0 = Clock::now();
-  const Pristine pr = pristine_of(base.terrain->heightfield());
+  const Pristine pr = pristine_of(base.terrain->surface().to_heightfield().value());
   std::string csv;
   const std::string name = "storm_" + base.name;
   Json paths = Json::array();
@@ -261,12 +261,12 @@ Result<Json> run_storm(Scene& base, const Options& o, std::string& csv_out) {
     paths.push_back({{"name", p.name}, {"frames", p.frames.size()}, {"settings", rows}});
   }
   csv_out += csv;
-  const Heightfield& hf = base.terrain->heightfield();
+  const WorldInfo& hf = base.terrain->info();
   return Json{{"name", name},
               {"source", base.source + ", a crater every frame (apply_edit) where the view ray "
                                        "meets the ground, radius 6-12 m, depth 2 m"},
-              {"samples", {hf.width(), hf.height()}},
-              {"spacing_m", {hf.spacing_x(), hf.spacing_z()}},
+              {"samples", {hf.width, hf.height}},
+              {"spacing_m", {hf.spacing_x, hf.spacing_z}},
               {"paths", paths},
               {"wall_s", ms_since(t0) / 1000}};
 }

@@ -31,8 +31,8 @@ struct DrawnMesh {
 
 /// The leaves of a ROAM view as drawn without geomorphs, straight from the bintree
 /// (RoamView::for_each_leaf), in finest-lattice units of the view's terrain, each corner at its
-/// lattice height (Landscape::lattice_height: base + detail + edits; the padding repeats the edge
-/// samples). Needs no patch meshes. Not during the view's update().
+/// lattice height (Surface::vertex_height as a float: base + detail + edits; the padding repeats
+/// the edge samples). Needs no patch meshes. Not during the view's update().
 DrawnMesh leaves_mesh(const RoamView& view);
 
 /// Measured error over the sampled lattice vertices (docs/report.md).
@@ -57,7 +57,7 @@ struct DrawnHeights {
 /// of them with stride 1; a fixed stratified sample otherwise): vertex (k, l) of the sample is
 /// lattice vertex (k * stride, l * stride). The lattice is a heightfield's samples, or a
 /// terrain's finest lattice (spacing / 2^L with L detail levels; heights base + detail + edits as
-/// Terrain::fine_local_height gives them).
+/// Surface::vertex_height gives them).
 ///
 /// The meter copies the surface heights when built (and when refresh() is called after an edit);
 /// it keeps a pointer to the terrain or heightfield it was built from, which must outlive it.
@@ -121,7 +121,8 @@ class MeshErrorMeter {
   std::uint64_t triangles_in_view(const DrawnMesh& mesh, const Camera& camera) const;
 
  private:
-  void init(const Heightfield& hf, std::int64_t width, std::int64_t height, double subdivision);
+  void init(std::int64_t width, std::int64_t height, double sx, double sz, double ox, double oz,
+            double offset);
   void read(std::uint32_t k0, std::uint32_t l0, std::uint32_t k1, std::uint32_t l1);
   MeshError finish(std::vector<float>& px, double sum2, MeshError out) const;
 

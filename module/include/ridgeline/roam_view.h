@@ -85,13 +85,16 @@ struct RoamStats {
   /// resized: upload them whole) because their slots outnumbered their live triangles or vertices
   /// more than 2 to 1 (docs/roam.md, "Output for an engine").
   std::uint32_t compacted_patches = 0;
-  /// Diamonds that should split but wait for a procedural-detail tile (requested, generated on the
-  /// cache's workers): held at the coarser level, exempt from the converged bound, tested again
-  /// at the next update. max_remaining_error does not count them.
+  /// Diamonds that should split but wait for data: a procedural-detail tile or a page of a paged
+  /// world (requested; made or loaded on workers): held at the coarser level, exempt from the
+  /// converged bound, tested again at the next update. max_remaining_error does not count them.
   std::uint32_t pending_splits = 0;
-  /// Diamonds whose bound a detail tile's arrival tightened in this update (the measured bound
-  /// replacing the analytic one).
+  /// Diamonds whose bound a detail tile's or a page's arrival tightened in this update (the
+  /// measured or exact bound replacing the provisional one).
   std::uint32_t rebounded = 0;
+  /// Pages of a paged world (Terrain::open) this update's splits wait for, requested urgently:
+  /// those splits are counted in pending_splits and go ahead once the pages are resident.
+  std::uint32_t requested_pages = 0;
 };
 
 /// One output vertex: patch-local float position (x, height, z) relative to the patch origin, the

@@ -18,6 +18,7 @@
 #include <glm/vec3.hpp>
 
 #include "ridgeline/heightfield.h"
+#include "ridgeline/world.h"
 
 namespace ridgeline {
 
@@ -25,6 +26,12 @@ class DetailField;
 class DetailCache;
 class EditLayer;
 class Terrain;
+namespace world {
+class PageStore;
+}
+namespace detail {
+struct SurfaceAccess;
+}
 
 /// Diagonal rule in global lattice indices: cell (i, j) (between samples i..i+1 and j..j+1) is
 /// split along (i, j)-(i+1, j+1) when i + j is even (the "main" diagonal), along
@@ -133,15 +140,20 @@ struct SurfaceLattice {
 /// point query is defined here once, over that lattice: the height is the barycentric blend of
 /// the three finest vertices of the triangle under the point, the face normal that triangle's,
 /// the smooth normal the blend of the area-weighted vertex normals, the material the stored
-/// cell's. Rays and box queries need the terrain's ray hierarchy as well (Terrain::raycast,
-/// Terrain::triangles_in_box); they read the same lattice.
+/// cell's. Rays and box queries read the same lattice (Terrain::raycast,
+/// Terrain::triangles_in_box).
+///
+/// The stored samples live in pages (world.h). A terrain made from a Heightfield holds every page;
+/// a terrain opened from a baked world pages them in: a query whose page is not resident loads
+/// it on the calling thread first (a synchronous load, about 0.2-1 ms a page: docs/worlds.md),
+/// unless an engine pinned or prefetched the region (Terrain::pin, Terrain::prefetch). A page
+/// that cannot be loaded (the source's error is logged) answers as off-terrain.
 ///
 /// Owned by a Terrain (Terrain::surface()), which also owns the sparse edit layer inside it and
 /// is the only writer: an edit changes the surface inside Terrain::apply_edit() or load_edits()
 /// (edit.h). Threading: every method may run concurrently from any number of threads, never
-/// during an edit (terrain.h). Detail values come from the detail cache's current snapshot (kept
-/// per thread, refreshed when the cache publishes: no lock per call) or are evaluated directly
-/// (bit-identical).
+/// during an edit (terrain.h). Pages and detail tiles come from snapshots kept per thread and
+/// refreshed when their caches publish: no lock per call.
 ///
 /// Queries take world coordinates in double precision. Points outside the footprint (including
 /// the padding that patches add), and NaN or infinite input, give an empty optional; they never
@@ -155,8 +167,8 @@ class Surface {
 
   // ---- what the surface is made of -----------------------------------------------------------
 
-  /// The stored samples, edits included, and their placement.
-  const Heightfield& heightfield() const noexcept { return samples_; }
+  /// The stored samples' size, placement and encoding (edits widen min_local / max_local).
+  const WorldInfo& info() const noexcept;
   /// The finest lattice's size and placement.
   const SurfaceLattice& lattice() const noexcept { return lattice_; }
   /// Detail levels L (0: no procedural detail).
@@ -172,17 +184,27 @@ class Surface {
   /// Bound (metres) on |detail| at every vertex (DetailField::contribution_bound(1)); 0 without
   /// detail. The surface lies within this of the stored samples' interpolation.
   double detail_bound() const noexcept { return detail_bound_; }
-  /// Hash of the current stored samples (base + edits): equal hashes, equal surfaces (for the
-  /// same detail parameters).
-  std::uint64_t heights_hash() const noexcept { return samples_.content_hash(); }
+  /// Hash of the current stored samples (base + edits), computed like WorldInfo::content_hash:
+  /// equal hashes, equal surfaces (for the same detail parameters). O(samples); on a paged world
+  /// it loads every page.
+  std::uint64_t heights_hash() const;
   /// Number of 32 x 32-sample chunks of stored samples that edits have changed (0 when unedited).
   std::size_t edited_chunks() const noexcept;
-  /// Bytes held: stored samples, materials, detail field (not the cache's tiles: see
+  /// Bytes held: resident pages (heights, materials, ray pyramids; the tessellator's bounds are
+  /// counted by its Landscape) and the detail field (not the detail cache's tiles: see
   /// DetailCache::stats()).
   std::size_t memory_bytes() const noexcept;
 
-  // ---- the finest lattice, vertex by vertex ----------------------------------------------------
+  // ---- the stored samples and the finest lattice, vertex by vertex ----------------------------
 
+  /// Local height (metres, relative to info().height_offset) of stored sample (i, j), edits
+  /// included, with (i, j) clamped into the data (the edge-repeating padding).
+  float stored_height(std::int64_t i, std::int64_t j) const noexcept;
+  /// The stored samples (edits included) and materials as one Heightfield: the same local
+  /// heights bit for bit, with height_scale 1 (what tools and comparators that need the whole
+  /// field at once read). O(samples) memory; on a paged world it loads every page. Fails only
+  /// when the field exceeds `max_samples`.
+  Result<Heightfield> to_heightfield(std::uint64_t max_samples = std::uint64_t{1} << 31) const;
   /// Local height (metres, relative to lattice().height_offset) of finest-lattice vertex (i, j):
   /// base + detail, edits included. Indices outside the lattice are clamped into it (the
   /// edge-repeating padding of docs/surface.md). Without detail this is the stored sample.
@@ -199,7 +221,7 @@ class Surface {
   /// known to be before its detail is.
   double vertex_base_height(std::int64_t i, std::int64_t j) const noexcept;
   /// Material id of finest-lattice cell (i, j) (that of the stored cell holding it), clamped into
-  /// the lattice's cells; 0 when the heightfield has no material layer.
+  /// the lattice's cells; 0 when the data has no material layer.
   std::uint8_t cell_material(std::int64_t i, std::int64_t j) const noexcept;
   /// Measured bound (metres) on |D_L - P_{from_level - 1}| over the finest-lattice rectangle
   /// [i0, i1] x [j0, j1] when it lies inside one resident finest tile (its
@@ -219,7 +241,7 @@ class Surface {
   /// (x, z). Empty as for height().
   std::optional<glm::vec3> smooth_normal(double x, double z) const noexcept;
   /// Material id of the stored cell under (x, z) (edge points as for face_normal()); 0 when the
-  /// heightfield has no material layer. Empty as for height().
+  /// data has no material layer. Empty as for height().
   std::optional<std::uint8_t> material(double x, double z) const noexcept;
   /// Height, face normal and material in one lookup. Empty as for height().
   std::optional<HeightNormal> height_normal(double x, double z) const noexcept;
@@ -227,9 +249,8 @@ class Surface {
   std::optional<SurfaceSample> sample(double x, double z) const noexcept;
 
   /// Batched heights: out[k] = height(xz[k]) or NaN off the footprint, for k < min(xz.size(),
-  /// out.size()), bit for bit. On stored samples larger than 8 MiB (more than the cache holds)
-  /// it fetches the cell of the point a few places ahead while evaluating the current one, which
-  /// pays on scattered points.
+  /// out.size()), bit for bit. Fetches the cell of the point a few places ahead while
+  /// evaluating the current one, which pays on scattered points over large worlds.
   void heights(std::span<const glm::dvec2> xz, std::span<double> out) const noexcept;
   /// Batched samples: valid[k] says whether out[k] is meaningful (out[k] is SurfaceSample{} when
   /// not), for k below the smallest of the three sizes.
@@ -237,15 +258,17 @@ class Surface {
                std::span<std::uint8_t> valid) const noexcept;
 
  private:
-  friend class Terrain;  // creates and clones it; its edits are the only writer of samples_
+  friend class Terrain;  // creates and clones it; its edits are the only writer of the pages
+  friend struct detail::SurfaceAccess;  // the lattice views of module/src/surface/lattice.h
   struct CloneTag {};
-  Surface(Heightfield samples, std::shared_ptr<const DetailField> detail,
+  Surface(std::shared_ptr<world::PageStore> store, std::shared_ptr<const DetailField> detail,
           std::unique_ptr<DetailCache> cache);
   Surface(const Surface& other, CloneTag);
 
-  Heightfield samples_;
+  std::shared_ptr<world::PageStore> store_;
   std::unique_ptr<EditLayer> edits_;  // the original heights of every edited chunk
   SurfaceLattice lattice_;
+  SurfaceLattice stored_at_;  // the stored samples as a lattice (L = 0)
   std::shared_ptr<const DetailField> detail_;
   std::unique_ptr<DetailCache> cache_;
   std::uint64_t detail_hash_ = 0;

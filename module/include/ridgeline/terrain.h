@@ -18,10 +18,10 @@
 #include "ridgeline/heightfield.h"
 #include "ridgeline/result.h"
 #include "ridgeline/surface.h"
+#include "ridgeline/world.h"
 
 namespace ridgeline {
 
-class RayHierarchy;
 class EditLayer;
 class DetailField;
 class DetailCache;
@@ -32,6 +32,10 @@ struct EditLimits;
 struct EditResult;
 class ChangeLog;
 struct SampleChanges;
+namespace detail {
+struct SurfaceAccess;
+struct TerrainAccess;
+}  // namespace detail
 
 /// An inclusive range of finest-lattice vertex indices, [i0, i1] x [j0, j1]: vertex (i, j) sits
 /// at world (origin_x + i * spacing_x / 2^L, origin_z + j * spacing_z / 2^L), L being the
@@ -75,17 +79,39 @@ struct TerrainChanges {
 /// single summary entry, so changes_since() always answers, with coarser boxes past this many.
 inline constexpr std::size_t kChangeLogCapacity = 1024;
 
-/// The terrain shared by every view and every physics query. Created once from a Heightfield;
-/// changed afterwards only by edits (apply_edit, load_edits in edit.h). It composes three parts:
-/// the Surface (surface(): the finest lattice and every point query on it), the ray hierarchy
-/// (a min/max pyramid over the stored samples that raycast() and triangles_in_box() descend
-/// before reading the surface's lattice), and the edit transaction (apply_edit(): the surface's
-/// samples, the pyramid, the version and the change log, changed together).
+/// A region kept resident (Terrain::pin): while it lives, the pages under it are never evicted,
+/// so queries there never load. Move-only; releases the pages when destroyed or reset.
+class RegionPin {
+ public:
+  RegionPin() = default;
+  RegionPin(RegionPin&& o) noexcept : store_(std::move(o.store_)), keys_(std::move(o.keys_)) {}
+  RegionPin& operator=(RegionPin&& o) noexcept;
+  RegionPin(const RegionPin&) = delete;
+  RegionPin& operator=(const RegionPin&) = delete;
+  ~RegionPin() { reset(); }
+  /// Releases the pages (the region may be evicted again).
+  void reset() noexcept;
+  /// Level-0 pages held.
+  std::size_t pages() const noexcept { return keys_.size(); }
+
+ private:
+  friend class Terrain;
+  std::shared_ptr<const world::PageStore> store_;
+  std::vector<PageKey> keys_;
+};
+
+/// The terrain shared by every view and every physics query. Made once, from a Heightfield
+/// (every page in memory) or from a PageSource (a baked world, paged in: docs/worlds.md); changed
+/// afterwards only by edits (apply_edit, load_edits in edit.h). It composes the Surface
+/// (surface(): the finest lattice and every point query on it), the ray and box queries (which
+/// descend the min/max pyramid of its pages before reading the surface's lattice), and the edit
+/// transaction (apply_edit(): the surface's pages, the version and the change log, changed
+/// together).
 ///
 /// Edits are pulled, not pushed: every edit that changes the surface bumps edit_version() and
 /// records what it changed in a bounded change log; whoever caches something derived from the
-/// surface (a Landscape's bounds, a RoamView's mesh, a physics engine's shape, a game's sleeping
-/// bodies) keeps the version it has seen and asks changes_since(it) when it next runs, as Jolt's
+/// surface (a RoamView's mesh, a physics engine's shape, a game's sleeping bodies) keeps the
+/// version it has seen and asks changes_since(it) when it next runs, as Jolt's
 /// HeightFieldShape::SetHeights is followed by NotifyShapeChanged and waking the bodies in the
 /// box. Nothing is called back from inside an edit.
 ///
@@ -95,17 +121,20 @@ inline constexpr std::size_t kChangeLogCapacity = 1024;
 /// RoamView built on it, or on its change log may run meanwhile (querying while modifying is a
 /// race). Between edits any number of threads may query, pull changes_since() and update views.
 /// An engine whose physics thread must keep querying during edits queries a clone() (a
-/// snapshot) and swaps it after the edit.
+/// snapshot: it shares every page, so it costs about a pointer per page) and swaps it after the
+/// edit.
 ///
 /// Queries take world coordinates in double precision. Points outside the sampled area (including
 /// the padding that patches add), and NaN or infinite input, give an empty optional or no hit;
 /// they never have undefined behaviour. A point exactly on the far edge (x = origin_x + extent_x)
-/// is on the terrain.
+/// is on the terrain. On a paged world a query over a page that is not resident loads it on the
+/// calling thread (surface.h); pin() and prefetch() keep that off the hot path.
 class Terrain {
  public:
-  /// Builds the query acceleration structures (a max-height pyramid for rays). Never fails for a
-  /// valid Heightfield.
-  static std::shared_ptr<Terrain> create(Heightfield heightfield);
+  /// A terrain holding `heightfield`'s samples in memory (every page resident; 16-bit when every
+  /// sample is an integer times height_scale, so 16-bit input takes 2 bytes a sample). Never
+  /// fails for a valid Heightfield (the Result is for symmetry with the other makers).
+  static Result<std::shared_ptr<Terrain>> create(Heightfield heightfield);
   /// A terrain whose surface includes procedural detail with L = detail.levels levels
   /// (docs/detail.md, docs/surface.md): every query, Landscape and RoamView then works on the
   /// finest lattice (spacing / 2^L), whose vertex heights are base + detail (+ edits). The
@@ -115,6 +144,12 @@ class Terrain {
   /// cells or more per side. detail.levels == 0 gives a terrain without detail.
   static Result<std::shared_ptr<Terrain>> create(Heightfield heightfield, const DetailParams& detail,
                                                  const DetailCacheDesc& cache);
+  /// A terrain over a world served by `source` (io::open_world for a baked world, or an engine's
+  /// own PageSource), paged in under `cache`'s budget: reads the world's page summaries and its
+  /// coarse levels, nothing proportional to the world. Fails (naming the world) when the source
+  /// does, or when `cache` is invalid.
+  static Result<std::shared_ptr<Terrain>> open(std::shared_ptr<const PageSource> source,
+                                               const WorldCacheDesc& cache = {});
 
   ~Terrain();
   Terrain(const Terrain&) = delete;
@@ -122,12 +157,12 @@ class Terrain {
 
   /// The surface: stored samples (with edits), detail, the finest lattice and the point queries.
   const Surface& surface() const noexcept { return surface_; }
+  /// The stored samples' size, placement and encoding: surface().info().
+  const WorldInfo& info() const noexcept { return surface_.info(); }
 
   // ---- queries ---------------------------------------------------------------------------------
   // The point queries are the surface's (surface.h documents them); these forward to it.
 
-  /// The stored samples, edits included: surface().heightfield().
-  const Heightfield& heightfield() const noexcept { return surface_.heightfield(); }
   /// Surface::height(): world height at (x, z), metres; empty off-terrain or for non-finite input.
   std::optional<double> height(double x, double z) const noexcept { return surface_.height(x, z); }
   /// Surface::face_normal(): unit normal of the finest triangle under (x, z).
@@ -174,7 +209,7 @@ class Terrain {
   /// Cost: the ray descends the min/max pyramid (widened by the detail bound), so a long ray
   /// costs about the number of pyramid nodes it crosses at the level where it clears the
   /// terrain, not the number of cells; it meets the surface's finest cells only in the leaf
-  /// blocks it cannot skip.
+  /// blocks it cannot skip. On a paged world the pages of those blocks are loaded when missing.
   std::optional<RayHit> raycast(const glm::dvec3& origin, const glm::dvec3& direction,
                                 double max_distance) const noexcept;
 
@@ -189,35 +224,35 @@ class Terrain {
   std::size_t triangles_in_box(const Box& box, std::vector<SurfaceTriangle>& out,
                                std::size_t max_triangles = 0) const;
 
-  // ---- the surface's lattice and detail, as existing callers (the tessellator) read them -------
+  // ---- residency (docs/worlds.md) ------------------------------------------------------------
 
-  /// surface().detail_levels(): detail levels L (0: the stored lattice is the finest).
-  std::uint32_t detail_levels() const noexcept { return surface_.detail_levels(); }
-  /// surface().detail(): the detail field, or null without detail.
-  const DetailField* detail() const noexcept { return surface_.detail(); }
-  /// surface().detail_cache(): the tile cache, or null without detail.
-  DetailCache* detail_cache() const noexcept { return surface_.detail_cache(); }
-  /// surface().lattice().vertices_x and vertices_z: finest-lattice samples per axis,
-  /// (width - 1) * 2^L + 1 and (height - 1) * 2^L + 1.
-  std::int64_t fine_width() const noexcept { return surface_.lattice().vertices_x; }
-  std::int64_t fine_height() const noexcept { return surface_.lattice().vertices_z; }
-  /// surface().vertex_height(i, j): local height of finest-lattice vertex (i, j), clamped in.
-  double fine_local_height(std::int64_t i, std::int64_t j) const noexcept {
-    return surface_.vertex_height(i, j);
-  }
-  /// surface().measured_detail_bound(): a resident finest tile's measured detail bound.
-  double measured_detail_bound(std::uint32_t from_level, std::int64_t i0, std::int64_t j0,
-                               std::int64_t i1, std::int64_t j1) const noexcept {
-    return surface_.measured_detail_bound(from_level, i0, j0, i1, j1);
-  }
+  /// Keeps the stored pages under the xz range of `region` resident until the returned pin is
+  /// destroyed, loading the missing ones now on this thread: what a physics engine holds around
+  /// each body (a residency radius) so that its queries never load. Empty for an invalid box
+  /// (non-finite, min > max) or one off the footprint. On a terrain held in memory it holds
+  /// nothing (every page is resident anyway).
+  RegionPin pin(const Box& region) const;
+  /// Asks for the pages under `region` to be loaded in the background (never waits); they are
+  /// resident after a later update_pages() once loaded.
+  void prefetch(const Box& region) const;
+  /// Integrates the pages loaded since the last call, evicts least recently used ones beyond the
+  /// cache's budget and publishes the new set to readers. RoamView::update() calls it; an engine
+  /// that only queries calls it once per frame. Any thread; cheap when nothing changed.
+  void update_pages() const;
+  /// The pages' streaming statistics (for a terrain held in memory: everything resident).
+  WorldStats world_stats() const;
+  /// True when the stored samples are paged in from a source (Terrain::open()).
+  bool paged() const noexcept;
 
   // ---- deformation (edit.h, docs/deformation.md) -------------------------------------------
 
   /// Applies one brush as one transaction: changes the surface's stored samples (clamped to the
-  /// edit limits; the edit layer keeps the originals), refreshes the ray pyramid over the changed
-  /// blocks, bumps edit_version() and records the change in the log (changes_since()). Every
-  /// query sees the new surface when it returns; Landscapes and RoamViews catch up at their next
-  /// sync() / update(). Cost follows the edited area, never the terrain size.
+  /// edit limits; the edit layer keeps the originals), refreshes the pages' ray pyramids and the
+  /// tessellator's bounds over the changed region, bumps edit_version() and records the change
+  /// in the log (changes_since()). Every query sees the new surface when it returns; RoamViews
+  /// catch up at their next update(). Cost follows the edited area and the patch size, never the
+  /// terrain size; on a paged world the pages it touches are loaded first and stay resident
+  /// (an edited page is never evicted).
   /// Errors (nothing changes): a field fails validate_edit(), the radius exceeds the terrain's
   /// larger extent, the area cap is exceeded with EditLimits::refuse_oversize, or keep_detail is
   /// false on a terrain with detail (edit.h). A brush wholly outside the terrain, or one that
@@ -227,7 +262,8 @@ class Terrain {
   /// Limits for later edits (validated: finite, area > 0, min < max; else an error and no change).
   Status set_edit_limits(const EditLimits& limits);
   const EditLimits& edit_limits() const noexcept;
-  /// Hash of the heightfield as created, before any edit (what save files record).
+  /// Hash of the stored samples as created, before any edit (info().content_hash: what save
+  /// files record; a baked world and the map it was baked from have the same one).
   std::uint64_t base_hash() const noexcept { return base_hash_; }
   /// The surface's version: 0 as created, one more with every edit or load that changed a
   /// height (one change-log entry each).
@@ -242,39 +278,38 @@ class Terrain {
   /// not this terrain's: one entry covering the whole footprint, `trimmed`. Cost: O(entries
   /// returned); allocates only when something changed. Any thread, concurrently with queries
   /// and other pulls, never during an edit. docs/engine_integration.md shows a physics engine's
-  /// heightfield collider kept up to date this way.
+  /// collider kept up to date this way.
   TerrainChanges changes_since(std::uint64_t version) const;
-  /// A deep copy (samples, edit layer, limits, ray pyramid, version and change log; the detail
-  /// field is shared, immutable, with a tile cache of its own), not attached to any Landscape: a
-  /// snapshot a physics thread can query while this terrain is being edited.
+  /// A snapshot (pages shared, copy on write: about a pointer per page; the edit layer, limits,
+  /// version and change log copied; the detail field shared, immutable, with a tile cache of its
+  /// own), not attached to any Landscape: a physics thread can query it while this terrain is
+  /// being edited. A clone of a paged world loads what it misses synchronously.
   std::shared_ptr<Terrain> clone() const;
 
-  /// Checks the query structures against the surface: the ray pyramid equals, node by node, one
-  /// rebuilt from the current samples. Returns an empty string when it holds, else the first
-  /// difference. O(samples): for tests and debugging after edits.
+  /// Checks the query structures against the surface: every resident page's ray pyramid, the
+  /// page summaries and the pyramid above pages equal ones rebuilt from the current samples.
+  /// Returns an empty string when they hold, else the first difference. O(resident samples):
+  /// for tests and debugging after edits.
   std::string check_invariants() const;
 
-  /// Bytes held: the surface (surface().memory_bytes()) and the ray hierarchy.
+  /// Bytes held: the surface (resident pages, detail field) and the edit layer.
   std::size_t memory_bytes() const noexcept;
-  /// Bytes held by the ray hierarchy alone (the min/max pyramid over 4 x 4-cell blocks, about
-  /// 0.67 bytes per sample).
-  std::size_t ray_hierarchy_bytes() const noexcept;
 
  private:
-  Terrain(Heightfield heightfield, std::shared_ptr<const DetailField> detail,
+  Terrain(std::shared_ptr<world::PageStore> store, std::shared_ptr<const DetailField> detail,
           std::unique_ptr<DetailCache> cache);
   Terrain(const Terrain& other, Surface::CloneTag);
+  friend struct detail::SurfaceAccess;
+  friend struct detail::TerrainAccess;
 
   // The edit transaction (module/src/edit/): after the surface's samples changed, refreshes the
-  // ray pyramid over them, bumps the version, records the change and fills the result's box.
+  // tessellator's bounds over them, bumps the version, records the change and fills the result's
+  // box.
   void commit(const SampleChanges& changes, EditResult& result);
-  // The surface's samples and edit layer, as the edit code writes them.
-  Heightfield& samples_for_edit() noexcept { return surface_.samples_; }
-  EditLayer& edit_layer() noexcept { return *surface_.edits_; }
-  const EditLayer& edit_layer() const noexcept { return *surface_.edits_; }
+  EditLayer& edit_layer() noexcept;
+  const EditLayer& edit_layer() const noexcept;
 
   Surface surface_;
-  std::unique_ptr<RayHierarchy> rays_;
   std::unique_ptr<ChangeLog> log_;
   std::uint64_t base_hash_ = 0;
   std::uint64_t edit_version_ = 0;

@@ -25,27 +25,28 @@ constexpr std::int64_t kLocalRangeCells = 16;
 // of every cell the tile overlaps (the stored surface there lies within their range) widened by
 // the bound of the detail over the tile.
 template <class Vertical>
-double vertical_to_tile(const Heightfield& hf, const DetailField& field, std::uint32_t level,
+double vertical_to_tile(const Surface& surface, const DetailField& field, std::uint32_t level,
                         std::int64_t tx, std::int64_t tz, const Vertical& vertical) {
+  const WorldInfo& hf = surface.info();
   const std::int64_t li0 = tx * kDetailTileCells, lj0 = tz * kDetailTileCells;
   const std::int64_t li1 = li0 + kDetailTileCells, lj1 = lj0 + kDetailTileCells;
   // Stored sample indices covering [li0, li1] / 2^level (floor and ceiling), clamped.
-  const std::int64_t w = hf.width() - 1, h = hf.height() - 1;
+  const std::int64_t w = hf.width - 1, h = hf.height - 1;
   const std::int64_t i0 = std::clamp<std::int64_t>(li0 >> level, 0, w);
   const std::int64_t j0 = std::clamp<std::int64_t>(lj0 >> level, 0, h);
   const std::int64_t i1 =
       std::clamp<std::int64_t>((li1 + (std::int64_t{1} << level) - 1) >> level, 0, w);
   const std::int64_t j1 =
       std::clamp<std::int64_t>((lj1 + (std::int64_t{1} << level) - 1) >> level, 0, h);
-  float lo = hf.local(std::uint32_t(i0), std::uint32_t(j0)), hi = lo;
+  float lo = surface.stored_height(i0, j0), hi = lo;
   for (std::int64_t j = j0; j <= j1; ++j)
     for (std::int64_t i = i0; i <= i1; ++i) {
-      const float v = hf.local(std::uint32_t(i), std::uint32_t(j));
+      const float v = surface.stored_height(i, j);
       lo = std::min(lo, v);
       hi = std::max(hi, v);
     }
   const double amp = field.contribution_bound(1, level, li0, lj0, li1, lj1);
-  return vertical(hf.height_offset() + double(lo) - amp, hf.height_offset() + double(hi) + amp);
+  return vertical(hf.height_offset + double(lo) - amp, hf.height_offset + double(hi) + amp);
 }
 
 }  // namespace
@@ -74,11 +75,11 @@ Status detail_tiles_for_view(const Surface& surface, const Camera& camera,
   if (auto s = validate_camera(camera); !s) return s;
   if (!surface.detail()) return {};
   const DetailField& field = *surface.detail();
-  const Heightfield& hf = surface.heightfield();
+  const WorldInfo& hf = surface.info();
   // The height range any surface point can have: a lower bound of the vertical distance.
   const double amp = field.contribution_bound(1);
-  const double global_top = hf.height_offset() + double(hf.max_local()) + amp;
-  const double global_bottom = hf.height_offset() + double(hf.min_local()) - amp;
+  const double global_top = hf.height_offset + double(hf.max_local) + amp;
+  const double global_bottom = hf.height_offset + double(hf.min_local) - amp;
   const double ex = camera.eye.x, ey = camera.eye.y, ez = camera.eye.z;
   auto vertical = [ey](double bottom, double top) {
     return std::max({0.0, ey - top, bottom - ey});
@@ -94,13 +95,13 @@ Status detail_tiles_for_view(const Surface& surface, const Camera& camera,
     // samples under them (plus the detail bound there); coarser tiles the global range.
     const bool local_range = (kDetailTileCells >> level) <= kLocalRangeCells;
     // Tile sides in metres, and the footprint's tiles: lattice indices 0 .. (w - 1) * 2^level.
-    const double side_x = std::ldexp(hf.spacing_x(), -int(level)) * kDetailTileCells;
-    const double side_z = std::ldexp(hf.spacing_z(), -int(level)) * kDetailTileCells;
+    const double side_x = std::ldexp(hf.spacing_x, -int(level)) * kDetailTileCells;
+    const double side_z = std::ldexp(hf.spacing_z, -int(level)) * kDetailTileCells;
     const std::int64_t tiles_x =
-        ((std::int64_t{hf.width()} - 1) * (std::int64_t{1} << level) + kDetailTileCells - 1) /
+        ((std::int64_t{hf.width} - 1) * (std::int64_t{1} << level) + kDetailTileCells - 1) /
         kDetailTileCells;
     const std::int64_t tiles_z =
-        ((std::int64_t{hf.height()} - 1) * (std::int64_t{1} << level) + kDetailTileCells - 1) /
+        ((std::int64_t{hf.height} - 1) * (std::int64_t{1} << level) + kDetailTileCells - 1) /
         kDetailTileCells;
     // Index range of the square around the eye, clamped to the footprint (in double first: the
     // eye may be far away).
@@ -111,21 +112,21 @@ Status detail_tiles_for_view(const Surface& surface, const Camera& camera,
       b = std::int64_t(std::clamp(fb, -1.0, double(n - 1)));
     };
     std::int64_t tx0, tx1, tz0, tz1;
-    range(ex - horizontal - hf.origin_x(), ex + horizontal - hf.origin_x(), side_x, tiles_x, tx0,
+    range(ex - horizontal - hf.origin_x, ex + horizontal - hf.origin_x, side_x, tiles_x, tx0,
           tx1);
-    range(ez - horizontal - hf.origin_z(), ez + horizontal - hf.origin_z(), side_z, tiles_z, tz0,
+    range(ez - horizontal - hf.origin_z, ez + horizontal - hf.origin_z, side_z, tiles_z, tz0,
           tz1);
     const std::size_t level_begin = out.size();
     for (std::int64_t tz = tz0; tz <= tz1; ++tz) {
-      const double z0 = hf.origin_z() + double(tz) * side_z;
+      const double z0 = hf.origin_z + double(tz) * side_z;
       const double dz = std::max({0.0, z0 - ez, ez - (z0 + side_z)});
       for (std::int64_t tx = tx0; tx <= tx1; ++tx) {
-        const double x0 = hf.origin_x() + double(tx) * side_x;
+        const double x0 = hf.origin_x + double(tx) * side_x;
         const double dx = std::max({0.0, x0 - ex, ex - (x0 + side_x)});
         const double dxz2 = dx * dx + dz * dz;
         if (dxz2 + global_dy * global_dy > reach * reach) continue;
         const double dy =
-            local_range ? vertical_to_tile(hf, field, level, tx, tz, vertical) : global_dy;
+            local_range ? vertical_to_tile(surface, field, level, tx, tz, vertical) : global_dy;
         const double d = std::sqrt(dxz2 + dy * dy);
         if (d > reach) continue;
         if (out.size() >= rule.max_tiles) {

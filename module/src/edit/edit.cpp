@@ -14,7 +14,8 @@
 #include "edit/edit_layer.h"
 #include "edit/edit_log.h"
 #include "format.h"
-#include "surface/ray_hierarchy.h"
+#include "surface/lattice.h"
+#include "world/page_store.h"
 #include "ridgeline/detail.h"
 
 namespace ridgeline {
@@ -94,26 +95,27 @@ double plateau(double r) {
 // What the changed stored samples of `c` changed on surface `s`: the cells touching them, the
 // surface's height range there before and after, the finest-lattice vertices that moved.
 static TerrainChange describe_change(const Surface& s, const SampleChanges& c) {
-  const Heightfield& hf = s.heightfield();
+  const WorldInfo& hf = s.info();
   const int L = int(s.detail_levels());
   // Corners of the cells touching a changed sample (unchanged corners keep their height).
   const std::uint32_t vi0 = c.i0 > 0 ? c.i0 - 1 : 0, vj0 = c.j0 > 0 ? c.j0 - 1 : 0;
-  const std::uint32_t vi1 = std::min(c.i1 + 1, hf.width() - 1),
-                      vj1 = std::min(c.j1 + 1, hf.height() - 1);
+  const std::uint32_t vi1 = std::min(c.i1 + 1, hf.width - 1),
+                      vj1 = std::min(c.j1 + 1, hf.height - 1);
   float lo = c.lo, hi = c.hi;  // the changed samples, before and after
+  const detail::StoredLattice g = detail::stored_lattice(s);
   for (std::uint32_t j = vj0; j <= vj1; ++j)
     for (std::uint32_t i = vi0; i <= vi1; ++i)
-      lo = std::min(lo, hf.local(i, j)), hi = std::max(hi, hf.local(i, j));
+      lo = std::min(lo, g.local(i, j)), hi = std::max(hi, g.local(i, j));
   // The surface is piecewise linear over those corners, plus detail below the stored resolution.
   const std::int64_t n = std::int64_t{1} << L;  // finest cells per stored cell side
   const double pad = L == 0 ? 0.0
                             : s.detail()->contribution_bound(1, std::uint32_t(L), vi0 * n, vj0 * n,
                                                              vi1 * n, vj1 * n);
   TerrainChange ch;
-  ch.box.min = {hf.origin_x() + vi0 * hf.spacing_x(), hf.height_offset() + double(lo) - pad,
-                hf.origin_z() + vj0 * hf.spacing_z()};
-  ch.box.max = {hf.origin_x() + vi1 * hf.spacing_x(), hf.height_offset() + double(hi) + pad,
-                hf.origin_z() + vj1 * hf.spacing_z()};
+  ch.box.min = {hf.origin_x + vi0 * hf.spacing_x, hf.height_offset + double(lo) - pad,
+                hf.origin_z + vj0 * hf.spacing_z};
+  ch.box.max = {hf.origin_x + vi1 * hf.spacing_x, hf.height_offset + double(hi) + pad,
+                hf.origin_z + vj1 * hf.spacing_z};
   if (L == 0) {
     ch.vertices = {c.i0, c.j0, c.i1, c.j1};
   } else {
@@ -128,16 +130,16 @@ static TerrainChange describe_change(const Surface& s, const SampleChanges& c) {
   return ch;
 }
 
-// After the samples changed: ray pyramid, version, change log and the result's box. Nothing is
-// called back: landscapes, views and engines pull the log (Terrain::changes_since).
+// After the samples changed (their pages and ray pyramids are published): the tessellator's
+// bounds over them, the version, the change log and the result's box. Nothing is called back:
+// views and engines pull the log (Terrain::changes_since).
 void Terrain::commit(const SampleChanges& c, EditResult& r) {
   r.samples_changed = c.samples;
   if (c.samples == 0) return;
-  const Heightfield& hf = surface_.heightfield();
-  // Cells touching a changed sample.
-  const std::uint32_t ci0 = c.i0 > 0 ? c.i0 - 1 : 0, cj0 = c.j0 > 0 ? c.j0 - 1 : 0;
-  const std::uint32_t ci1 = std::min(c.i1, hf.width() - 2), cj1 = std::min(c.j1, hf.height() - 2);
-  rays_->update_cells(hf, ci0, cj0, ci1, cj1);
+  world::PageStore& store = *surface_.store_;
+  for (int slot = 0; slot < int(world::kRecordSlots); ++slot)
+    if (const world::RecordMaker* m = store.maker(slot))
+      store.set_records(slot, m->remake(store, c.i0, c.j0, c.i1, c.j1));
   TerrainChange ch = describe_change(surface_, c);
   ch.version = ++edit_version_;
   log_->record(ch);
@@ -147,13 +149,13 @@ void Terrain::commit(const SampleChanges& c, EditResult& r) {
 TerrainChanges Terrain::changes_since(std::uint64_t version) const {
   if (version <= edit_version_) return log_->since(version, edit_version_);
   // Not a version of this terrain: everything may differ.
-  const Heightfield& hf = surface_.heightfield();
+  const WorldInfo& hf = surface_.info();
   const double pad = surface_.detail_bound();
   TerrainChange whole;
   whole.version = edit_version_;
-  whole.box.min = {hf.origin_x(), hf.height_offset() + double(hf.min_local()) - pad, hf.origin_z()};
-  whole.box.max = {hf.origin_x() + hf.extent_x(), hf.height_offset() + double(hf.max_local()) + pad,
-                   hf.origin_z() + hf.extent_z()};
+  whole.box.min = {hf.origin_x, hf.height_offset + double(hf.min_local) - pad, hf.origin_z};
+  whole.box.max = {hf.origin_x + hf.extent_x(), hf.height_offset + double(hf.max_local) + pad,
+                   hf.origin_z + hf.extent_z()};
   whole.vertices = {0, 0, surface_.lattice().vertices_x - 1, surface_.lattice().vertices_z - 1};
   TerrainChanges out;
   out.version = edit_version_;
@@ -164,7 +166,7 @@ TerrainChanges Terrain::changes_since(std::uint64_t version) const {
 
 Result<EditResult> Terrain::apply_edit(const Edit& e) {
   if (auto s = validate_edit(e); !s) return Error{s.message()};
-  Heightfield& hf = samples_for_edit();
+  const WorldInfo& hf = surface_.info();
   EditLayer& layer = edit_layer();
   const std::uint32_t levels = surface_.detail_levels();
   if (!e.keep_detail && levels != 0)
@@ -174,7 +176,7 @@ Result<EditResult> Terrain::apply_edit(const Edit& e) {
         fmt("edit: keep_detail = false is not supported on a terrain with procedural "
             "detail (%u levels): edits are stored at the base spacing (%s m) and the "
             "detail always rides on top of them; use keep_detail = true",
-            levels, num(std::min(hf.spacing_x(), hf.spacing_z())).c_str())};
+            levels, num(std::min(hf.spacing_x, hf.spacing_z)).c_str())};
   const double extent = std::max(hf.extent_x(), hf.extent_z());
   if (e.radius > extent)
     return Error{"edit: radius " + num(e.radius) + " m is larger than the terrain (" +
@@ -193,33 +195,34 @@ Result<EditResult> Terrain::apply_edit(const Edit& e) {
   r.radius_used = radius;
   const double reach = radius * reach_factor(e.brush);
   // Sample range under the brush (lattice units relative to the origin, double: no overflow).
-  const double cu = (e.x - hf.origin_x()) / hf.spacing_x(), cv = (e.z - hf.origin_z()) / hf.spacing_z();
-  const double ru = reach / hf.spacing_x(), rv = reach / hf.spacing_z();
-  const double u0 = std::max(std::ceil(cu - ru), 0.0), u1 = std::min(std::floor(cu + ru), double(hf.width() - 1));
-  const double v0 = std::max(std::ceil(cv - rv), 0.0), v1 = std::min(std::floor(cv + rv), double(hf.height() - 1));
+  const double cu = (e.x - hf.origin_x) / hf.spacing_x, cv = (e.z - hf.origin_z) / hf.spacing_z;
+  const double ru = reach / hf.spacing_x, rv = reach / hf.spacing_z;
+  const double u0 = std::max(std::ceil(cu - ru), 0.0), u1 = std::min(std::floor(cu + ru), double(hf.width - 1));
+  const double v0 = std::max(std::ceil(cv - rv), 0.0), v1 = std::min(std::floor(cv + rv), double(hf.height - 1));
   if (!(u0 <= u1 && v0 <= v1)) return r;  // wholly outside: a no-op
   const auto i0 = std::uint32_t(u0), i1 = std::uint32_t(u1), j0 = std::uint32_t(v0), j1 = std::uint32_t(v1);
 
+  auto edit = surface_.store_->begin_edit();
   // Smooth reads the heights before the edit, one sample around the range.
   std::vector<float> before;
   std::uint32_t bi0 = 0, bj0 = 0, bw = 0, bh = 0;
   if (e.brush == Brush::kSmooth) {
     bi0 = i0 > 0 ? i0 - 1 : 0, bj0 = j0 > 0 ? j0 - 1 : 0;
-    bw = std::min(i1 + 1, hf.width() - 1) - bi0 + 1, bh = std::min(j1 + 1, hf.height() - 1) - bj0 + 1;
+    bw = std::min(i1 + 1, hf.width - 1) - bi0 + 1, bh = std::min(j1 + 1, hf.height - 1) - bj0 + 1;
     before.resize(std::size_t{bw} * bh);
     for (std::uint32_t j = 0; j < bh; ++j)
-      for (std::uint32_t i = 0; i < bw; ++i) before[i + j * bw] = hf.local(bi0 + i, bj0 + j);
+      for (std::uint32_t i = 0; i < bw; ++i) before[i + j * bw] = edit->height(bi0 + i, bj0 + j);
   }
-  const double target = e.height - hf.height_offset();
+  const double target = e.height - hf.height_offset;
   const double amount = e.strength * e.depth;
   SampleChanges c;
   for (std::uint32_t j = j0; j <= j1; ++j) {
-    const double dz = (double(j) - cv) * hf.spacing_z();
+    const double dz = (double(j) - cv) * hf.spacing_z;
     for (std::uint32_t i = i0; i <= i1; ++i) {
-      const double dx = (double(i) - cu) * hf.spacing_x();
+      const double dx = (double(i) - cu) * hf.spacing_x;
       const double r_n = std::sqrt(dx * dx + dz * dz) / radius;
       if (r_n * radius > reach) continue;
-      const float old = hf.local(i, j);
+      const float old = edit->height(i, j);
       double h = old;
       switch (e.brush) {
         case Brush::kCrater: h += amount * crater_profile(r_n, e.rim); break;
@@ -246,12 +249,13 @@ Result<EditResult> Terrain::apply_edit(const Edit& e) {
       }
       const float nh = static_cast<float>(h);
       if (nh == old) continue;
-      layer.touch(hf, i, j);
-      EditLayer::write(hf, i, j, nh);
+      layer.touch(*edit, i, j, hf.width, hf.height);
+      edit->write(i, j, nh);
       c.add(i, j, old, nh);
     }
   }
   r.clamped = r.samples_clamped > 0;
+  edit->commit();
   commit(c, r);
   return r;
 }

@@ -11,6 +11,7 @@
 #include <cstring>
 
 #include "edit/edit_layer.h"
+#include "surface/lattice.h"
 #include "format.h"
 #include "ridgeline/edit.h"
 
@@ -50,7 +51,8 @@ T get(std::string_view in, std::size_t at) {
 }  // namespace
 
 Status save_edits(const Terrain& terrain, const std::string& path) {
-  const Heightfield& hf = terrain.heightfield();
+  const WorldInfo& hf = terrain.info();
+  const detail::StoredLattice g = detail::stored_lattice(terrain.surface());
   const EditLayer& layer = terrain.edit_layer();
   const std::vector<std::uint64_t> keys = layer.sorted_keys();
   std::string out;
@@ -60,8 +62,8 @@ Status save_edits(const Terrain& terrain, const std::string& path) {
   put(out, EditLayer::kChunk);
   put(out, terrain.base_hash());
   put(out, terrain.surface().detail_hash());
-  put(out, hf.width());
-  put(out, hf.height());
+  put(out, hf.width);
+  put(out, hf.height);
   put(out, std::uint64_t{keys.size()});
   put(out, std::uint64_t{0});
   put(out, std::uint64_t{0});
@@ -72,8 +74,8 @@ Status save_edits(const Terrain& terrain, const std::string& path) {
     const std::uint32_t i0 = cx << EditLayer::kChunkShift, j0 = cz << EditLayer::kChunkShift;
     for (std::uint32_t dj = 0; dj < EditLayer::kChunk; ++dj)
       for (std::uint32_t di = 0; di < EditLayer::kChunk; ++di) {
-        const bool in = i0 + di < hf.width() && j0 + dj < hf.height();
-        put(out, in ? hf.local(i0 + di, j0 + dj) : 0.0f);
+        const bool in = i0 + di < hf.width && j0 + dj < hf.height;
+        put(out, in ? g.local(i0 + di, j0 + dj) : 0.0f);
       }
   }
   put(out, fnv1a(out.data(), out.size()));
@@ -124,7 +126,7 @@ Status save_edits(const Terrain& terrain, const std::string& path) {
 // The header fields that tie a file to a terrain (base hash, detail hash, size); `in` holds at
 // least the header.
 static Status check_edit_header(const Terrain& terrain, std::string_view in) {
-  const Heightfield& hf = terrain.heightfield();
+  const WorldInfo& hf = terrain.info();
   const std::string what = "edit file";
   if (std::memcmp(in.data(), kMagic, 8) != 0)
     return Error{what + ": not a Ridgeline edit file (bad magic)"};
@@ -143,23 +145,23 @@ static Status check_edit_header(const Terrain& terrain, std::string_view in) {
             static_cast<unsigned long long>(terrain.base_hash()))};
   if (get<std::uint64_t>(in, 24) != terrain.surface().detail_hash())
     return Error{what + ": saved with other detail parameters (detail hash differs)"};
-  if (get<std::uint32_t>(in, 32) != hf.width() || get<std::uint32_t>(in, 36) != hf.height())
+  if (get<std::uint32_t>(in, 32) != hf.width || get<std::uint32_t>(in, 36) != hf.height)
     return Error{fmt("%s: saved for a %u x %u terrain; this one is %u x %u", what.c_str(),
-                     get<std::uint32_t>(in, 32), get<std::uint32_t>(in, 36), hf.width(),
-                     hf.height())};
+                     get<std::uint32_t>(in, 32), get<std::uint32_t>(in, 36), hf.width,
+                     hf.height)};
   return {};
 }
 
 Result<EditResult> load_edits_from_memory(Terrain& terrain, std::string_view in) {
-  Heightfield& hf = terrain.samples_for_edit();
+  const WorldInfo& hf = terrain.info();
   const std::string what = "edit file";
   if (in.size() < kHeaderBytes + 8)
     return Error{fmt("%s: %zu bytes; truncated (a valid file has at least %zu)", what.c_str(),
                      in.size(), kHeaderBytes + 8)};
   if (auto s = check_edit_header(terrain, in); !s) return Error{s.message()};
   const auto count = get<std::uint64_t>(in, 40);
-  const std::uint64_t chunks_x = (hf.width() + EditLayer::kChunk - 1) / EditLayer::kChunk;
-  const std::uint64_t chunks_z = (hf.height() + EditLayer::kChunk - 1) / EditLayer::kChunk;
+  const std::uint64_t chunks_x = (hf.width + EditLayer::kChunk - 1) / EditLayer::kChunk;
+  const std::uint64_t chunks_z = (hf.height + EditLayer::kChunk - 1) / EditLayer::kChunk;
   if (count > chunks_x * chunks_z)
     return Error{fmt("%s: %llu chunks; this terrain has only %llu", what.c_str(),
                      static_cast<unsigned long long>(count),
@@ -196,37 +198,54 @@ Result<EditResult> load_edits_from_memory(Terrain& terrain, std::string_view in)
     }
   }
 
-  // Checked: apply. Undo the current edits, then write the saved chunks.
+  // Checked: apply. Undo the current edits, then write the saved chunks. What changed is found
+  // by comparing the region the chunks cover (before and after) with what it held.
   EditLayer& layer = terrain.edit_layer();
-  std::vector<float> old(hf.local_heights().begin(), hf.local_heights().end());
+  const std::uint32_t W = hf.width, H = hf.height;
   std::uint32_t ri0 = ~0u, rj0 = ~0u, ri1 = 0, rj1 = 0;  // chunks touched before or after
   auto cover = [&](std::uint64_t k) {
     const std::uint32_t i0 = std::uint32_t(k) << EditLayer::kChunkShift,
                         j0 = std::uint32_t(k >> 32) << EditLayer::kChunkShift;
     ri0 = std::min(ri0, i0), rj0 = std::min(rj0, j0);
-    ri1 = std::max(ri1, std::min(i0 + EditLayer::kChunk - 1, hf.width() - 1));
-    rj1 = std::max(rj1, std::min(j0 + EditLayer::kChunk - 1, hf.height() - 1));
+    ri1 = std::max(ri1, std::min(i0 + EditLayer::kChunk - 1, W - 1));
+    rj1 = std::max(rj1, std::min(j0 + EditLayer::kChunk - 1, H - 1));
   };
   for (std::uint64_t k : layer.sorted_keys()) cover(k);
-  layer.restore_all(hf);
+  for (std::uint64_t c = 0; c < count; ++c) {
+    const std::size_t at = kHeaderBytes + c * kChunkBytes;
+    cover(EditLayer::key(get<std::uint32_t>(in, at), get<std::uint32_t>(in, at + 4)));
+  }
+  auto edit = detail::SurfaceAccess::store(const_cast<Surface&>(terrain.surface())).begin_edit();
+  std::vector<float> old;
+  const std::size_t rw = ri0 == ~0u ? 0 : std::size_t(ri1 - ri0 + 1);
+  if (ri0 != ~0u) {
+    old.resize(rw * std::size_t(rj1 - rj0 + 1));
+    for (std::uint32_t j = rj0; j <= rj1; ++j)
+      for (std::uint32_t i = ri0; i <= ri1; ++i)
+        old[(i - ri0) + std::size_t(j - rj0) * rw] = edit->height(i, j);
+  }
+  layer.restore_all(*edit, W, H);
   for (std::uint64_t c = 0; c < count; ++c) {
     const std::size_t at = kHeaderBytes + c * kChunkBytes;
     const auto cx = get<std::uint32_t>(in, at), cz = get<std::uint32_t>(in, at + 4);
-    cover(EditLayer::key(cx, cz));
     const std::uint32_t i0 = cx << EditLayer::kChunkShift, j0 = cz << EditLayer::kChunkShift;
-    layer.touch(hf, i0, j0);
-    for (std::uint32_t dj = 0; dj < EditLayer::kChunk && j0 + dj < hf.height(); ++dj)
-      for (std::uint32_t di = 0; di < EditLayer::kChunk && i0 + di < hf.width(); ++di)
-        EditLayer::write(hf, i0 + di, j0 + dj,
-                         get<float>(in, at + 8 + 4 * (di + dj * EditLayer::kChunk)));
+    layer.touch(*edit, i0, j0, W, H);
+    for (std::uint32_t dj = 0; dj < EditLayer::kChunk && j0 + dj < H; ++dj)
+      for (std::uint32_t di = 0; di < EditLayer::kChunk && i0 + di < W; ++di) {
+        const float h = get<float>(in, at + 8 + 4 * (di + dj * EditLayer::kChunk));
+        if (std::bit_cast<std::uint32_t>(edit->height(i0 + di, j0 + dj)) !=
+            std::bit_cast<std::uint32_t>(h))
+          edit->write(i0 + di, j0 + dj, h);
+      }
   }
   SampleChanges changes;
   for (std::uint32_t j = rj0; ri0 != ~0u && j <= rj1; ++j)
     for (std::uint32_t i = ri0; i <= ri1; ++i) {
-      const float before = old[i + std::size_t{j} * hf.width()], after = hf.local(i, j);
+      const float before = old[(i - ri0) + std::size_t(j - rj0) * rw], after = edit->height(i, j);
       if (std::bit_cast<std::uint32_t>(before) != std::bit_cast<std::uint32_t>(after))
         changes.add(i, j, before, after);
     }
+  edit->commit();
   EditResult r;
   terrain.commit(changes, r);
   return r;
@@ -238,10 +257,10 @@ Result<EditResult> load_edits(Terrain& terrain, const std::string& path) {
   std::string bytes;
   char buf[1 << 16];
   // Cap: the largest valid file for this terrain plus one chunk.
-  const Heightfield& hf = terrain.heightfield();
+  const WorldInfo& hf = terrain.info();
   const std::size_t cap =
       kHeaderBytes + 8 +
-      (std::size_t((hf.width() + 31) / 32) * ((hf.height() + 31) / 32) + 1) * kChunkBytes;
+      (std::size_t((hf.width + 31) / 32) * ((hf.height + 31) / 32) + 1) * kChunkBytes;
   for (;;) {
     const std::size_t n = std::fread(buf, 1, sizeof buf, f);
     bytes.append(buf, n);

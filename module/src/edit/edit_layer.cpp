@@ -5,7 +5,8 @@
 
 namespace ridgeline {
 
-void EditLayer::touch(const Heightfield& hf, std::uint32_t i, std::uint32_t j) {
+void EditLayer::touch(world::PageEdit& edit, std::uint32_t i, std::uint32_t j,
+                      std::uint32_t width, std::uint32_t height) {
   const std::uint64_t k = key(i >> kChunkShift, j >> kChunkShift);
   auto [it, inserted] = originals_.try_emplace(k);
   if (!inserted) return;
@@ -13,9 +14,9 @@ void EditLayer::touch(const Heightfield& hf, std::uint32_t i, std::uint32_t j) {
   o.assign(std::size_t{kChunk} * kChunk, 0.0f);
   const std::uint32_t i0 = (i >> kChunkShift) << kChunkShift, j0 = (j >> kChunkShift)
                                                                    << kChunkShift;
-  for (std::uint32_t dj = 0; dj < kChunk && j0 + dj < hf.height(); ++dj)
-    for (std::uint32_t di = 0; di < kChunk && i0 + di < hf.width(); ++di)
-      o[di + dj * kChunk] = hf.local(i0 + di, j0 + dj);
+  for (std::uint32_t dj = 0; dj < kChunk && j0 + dj < height; ++dj)
+    for (std::uint32_t di = 0; di < kChunk && i0 + di < width; ++di)
+      o[di + dj * kChunk] = edit.height(i0 + di, j0 + dj);
 }
 
 std::vector<std::uint64_t> EditLayer::sorted_keys() const {
@@ -31,13 +32,14 @@ const std::vector<float>* EditLayer::original(std::uint64_t k) const {
   return it == originals_.end() ? nullptr : &it->second;
 }
 
-void EditLayer::restore_all(Heightfield& hf) {
+void EditLayer::restore_all(world::PageEdit& edit, std::uint32_t width, std::uint32_t height) {
   for (const auto& [k, o] : originals_) {
     const std::uint32_t i0 = std::uint32_t(k) << kChunkShift, j0 = std::uint32_t(k >> 32)
                                                                    << kChunkShift;
-    for (std::uint32_t dj = 0; dj < kChunk && j0 + dj < hf.height(); ++dj)
-      for (std::uint32_t di = 0; di < kChunk && i0 + di < hf.width(); ++di)
-        write(hf, i0 + di, j0 + dj, o[di + dj * kChunk]);
+    for (std::uint32_t dj = 0; dj < kChunk && j0 + dj < height; ++dj)
+      for (std::uint32_t di = 0; di < kChunk && i0 + di < width; ++di)
+        if (edit.height(i0 + di, j0 + dj) != o[di + dj * kChunk])
+          edit.write(i0 + di, j0 + dj, o[di + dj * kChunk]);
   }
   originals_.clear();
 }

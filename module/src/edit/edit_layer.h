@@ -1,8 +1,9 @@
 // Private: the sparse edit layer of a terrain's Surface (docs/deformation.md), and the record of
-// what one edit transaction changed. The surface's stored samples are edited in place (so
-// queries cost the same edited or not); the layer keeps, for every 32 x 32 chunk an edit
-// touched, the chunk's original heights, so that the edits can be saved (the current values of
-// the touched chunks) and undone (load_edits restores the originals first).
+// what one edit transaction changed. The surface's stored samples are edited in their pages
+// (copies of the pages they lie in, so queries cost the same edited or not); the layer keeps,
+// for every 32 x 32 chunk an edit touched, the chunk's original heights, so that the edits can
+// be saved (the current values of the touched chunks) and undone (load_edits restores the
+// originals first).
 #pragma once
 
 #include <algorithm>
@@ -14,6 +15,7 @@
 
 #include "ridgeline/edit.h"
 #include "ridgeline/heightfield.h"
+#include "world/page_store.h"
 
 namespace ridgeline {
 
@@ -38,14 +40,10 @@ class EditLayer {
 
   EditLimits limits;
 
-  /// Records the original heights of the chunk holding sample (i, j) if not yet recorded.
-  void touch(const Heightfield& hf, std::uint32_t i, std::uint32_t j);
-  /// Writes local height `h` at sample (i, j) (the chunk must be touched).
-  static void write(Heightfield& hf, std::uint32_t i, std::uint32_t j, float h) noexcept {
-    hf.heights_[i + std::size_t{j} * hf.width_] = h;
-    hf.min_local_ = std::min(hf.min_local_, h);
-    hf.max_local_ = std::max(hf.max_local_, h);
-  }
+  /// Records the original heights of the chunk holding sample (i, j) if not yet recorded,
+  /// reading them through `edit` (before it writes them) from a field of width x height samples.
+  void touch(world::PageEdit& edit, std::uint32_t i, std::uint32_t j, std::uint32_t width,
+             std::uint32_t height);
   std::size_t chunks() const noexcept { return originals_.size(); }
   /// Chunk keys in ascending order (cz, cx): the save order.
   std::vector<std::uint64_t> sorted_keys() const;
@@ -55,8 +53,12 @@ class EditLayer {
   /// Original heights of a touched chunk (kChunk * kChunk, row-major; samples past the field's
   /// edge hold 0), or null.
   const std::vector<float>* original(std::uint64_t key) const;
-  /// Restores every touched chunk's original heights and forgets them.
-  void restore_all(Heightfield& hf);
+  /// Writes every touched chunk's original heights back through `edit` and forgets them.
+  void restore_all(world::PageEdit& edit, std::uint32_t width, std::uint32_t height);
+  /// Bytes held by the originals.
+  std::size_t memory_bytes() const noexcept {
+    return originals_.size() * (sizeof(float) * kChunk * kChunk + 48);
+  }
 
  private:
   std::unordered_map<std::uint64_t, std::vector<float>> originals_;

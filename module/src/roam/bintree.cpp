@@ -23,12 +23,12 @@ using namespace roam;
 RoamView::Impl::Impl(const Landscape& l)
     : land(l),
       K(l.patch_log2()),
-      cache(l.terrain().detail_cache()),
-      last_i(l.last_i()),
-      last_j(l.last_j()),
+      cache(l.terrain().surface().detail_cache()),
+      last_i(LandscapeAccess::last_i(l)),
+      last_j(LandscapeAccess::last_j(l)),
       px_count(l.patches_x()),
-      sx(float(l.spacing_x())),
-      sz(float(l.spacing_z())) {
+      sx(float(LandscapeAccess::spacing_x(l))),
+      sz(float(LandscapeAccess::spacing_z(l))) {
   // Padding exists only in the last row or column of patches (landscape.h).
   const std::int64_t P = l.patch_cells();
   may_pad = std::int64_t(l.patches_x()) * P > last_i || std::int64_t(l.patches_z()) * P > last_j;
@@ -50,12 +50,42 @@ LatticeTriangle RoamView::Impl::leaf_triangle(std::uint32_t n) const {
 // ---- front entries
 // --------------------------------------------------------------------------------
 
-void RoamView::Impl::entry_data_slow(std::int64_t i, std::int64_t j, float& y, float& mu, float& r,
-                                     bool& provisional) const {
-  provisional = false;
-  const DiamondBound b = LandscapeAccess::diamond(land, i, j);
-  mu = cam.world ? b.error : b.morph;
-  r = b.radius;
+RoamView::Impl::EntryData RoamView::Impl::entry_data_slow(std::int64_t i,
+                                                          std::int64_t j) const {
+  DiamondBound b;
+  float y;
+  switch (reader.stored(i, j, b, y)) {
+    case Reader::Vertex::kResident:
+      return {float(i) * sx, y, float(j) * sz, cam.world ? b.error : b.morph, b.radius, false};
+    case Reader::Vertex::kMissing: {
+      // Its page is not resident: the sphere and bound of the nearest resident ancestor, which
+      // hold this diamond's (nested), so the test stays conservative until the page arrives.
+      std::int64_t ci = i, cj = j;
+      for (;;) {
+        const Diamond d = diamond_at(ci, cj, K);
+        if (d.corner || d.top) break;
+        std::int64_t ax, az, bx, bz;
+        d.apexes(ax, az, bx, bz);
+        for (const auto& p : {std::pair{ax, az}, std::pair{bx, bz}}) {
+          if (p.first < 0 || p.second < 0 || diamond_at(p.first, p.second, K).corner) continue;
+          DiamondBound pb;
+          float py;
+          if (reader.stored(p.first, p.second, pb, py) == Reader::Vertex::kResident) {
+            const float mu = cam.world ? pb.error : pb.morph;
+            return {float(p.first) * sx, py, float(p.second) * sz, mu, pb.radius, true};
+          }
+        }
+        ci = ax, cj = az;  // one level up
+        if (ci < 0 || cj < 0) ci = bx, cj = bz;
+      }
+      // Nothing resident above (cannot happen while the coarse levels are): always split.
+      return {float(i) * sx, 0.0f, float(j) * sz, 0.0f, Front::kBorderRadius, true};
+    }
+    case Reader::Vertex::kDetail:
+      break;
+  }
+  b = LandscapeAccess::compute_detail(land, i, j);
+  EntryData v{float(i) * sx, 0.0f, float(j) * sz, cam.world ? b.error : b.morph, b.radius, false};
   if (snapshot != nullptr) {
     const int L = int(land.detail_levels());
     const int tz = std::min({ctz64(i), ctz64(j), L});
@@ -65,27 +95,27 @@ void RoamView::Impl::entry_data_slow(std::int64_t i, std::int64_t j, float& y, f
       if (snapshot->find(key) == nullptr) {
         // Its height is the stored surface's plus an unknown detail: widen the sphere by the
         // detail's bound so that it holds every height the vertex may have.
-        provisional = true;
-        y = land.base_lattice_height(i, j);
-        if (r < Front::kBorderRadius) r += land.detail_offset_bound(i, j);
-        return;
+        v.provisional = true;
+        v.y = static_cast<float>(land.terrain().surface().vertex_base_height(i, j));
+        if (v.r < Front::kBorderRadius) v.r += LandscapeAccess::detail_offset_bound(land, i, j);
+        return v;
       }
     }
   }
-  y = LandscapeAccess::height(land, i, j);
+  v.y = static_cast<float>(land.terrain().surface().vertex_height(i, j));
+  return v;
 }
 
 std::uint32_t RoamView::Impl::add_entry(std::int64_t i, std::int64_t j, std::int64_t hu,
                                         std::int64_t hw, std::uint32_t n, std::uint32_t partner,
                                         bool split) {
-  float y, mu, r;
-  bool prov;
-  entry_data(i, j, y, mu, r, prov);
+  const EntryData v = entry_data(i, j);
   const std::uint32_t t = std::uint32_t(std::min(ctz64(i), ctz64(j)));
-  // The centre's metres as the front's test computed them from lattice indices: float(i) * sx.
-  const std::uint32_t e =
-      front.add(std::int32_t(i), std::int32_t(j), std::int32_t(hu), std::int32_t(hw), t,
-                float(i) * sx, y, float(j) * sz, mu, r, n, split, prov);
+  // The centre's metres as the front's test computes them from lattice indices: float(i) * sx
+  // (a provisional diamond's: its ancestor's).
+  const std::uint32_t e = front.add(std::int32_t(i), std::int32_t(j), std::int32_t(hu),
+                                    std::int32_t(hw), t, v.x, v.y, v.z, v.mu, v.r, n, split,
+                                    v.provisional);
   nodes[n].set_entry(e);
   if (partner != kNone) nodes[partner].set_entry(e);
   return e;
@@ -101,11 +131,9 @@ void RoamView::Impl::remove_entry(std::uint32_t e) {
 }
 
 void RoamView::Impl::refresh_entry(std::uint32_t e) {
-  float y, mu, r;
-  bool prov;
-  entry_data(front.ci(e), front.cj(e), y, mu, r, prov);
-  front.set_data(e, y, mu, r);
-  front.set_provisional(e, prov);
+  const EntryData v = entry_data(front.ci(e), front.cj(e));
+  front.set_data(e, v.x, v.y, v.z, v.mu, v.r);
+  front.set_provisional(e, v.provisional);
 }
 
 std::uint8_t RoamView::Impl::test_new(std::uint32_t e) {
@@ -174,11 +202,11 @@ void RoamView::Impl::attach_leaf(std::uint32_t n, const LatticeTriangle& t,
 // ---------------------------------------------------------------------------------
 
 bool RoamView::Impl::chain_ready(std::uint32_t n) {
-  if (cache == nullptr) return true;
   bool ready = true;
   const int L = int(land.detail_levels());
   for (std::uint32_t x = n;;) {
-    // The vertex this split creates: its diamond's centre. A stored vertex needs no tile.
+    // The vertex this split creates: its diamond's centre. A stored vertex needs its page, a
+    // detail vertex its tile.
     const std::uint32_t xe = nodes[x].entry();
     const std::int64_t ci = front.ci(xe), cj = front.cj(xe);
     const int tz = std::min({ctz64(ci), ctz64(cj), L});
@@ -186,8 +214,16 @@ bool RoamView::Impl::chain_ready(std::uint32_t n) {
       const DetailTileKey key{std::uint32_t(L - tz), std::int32_t((ci >> tz) / kDetailTileCells),
                               std::int32_t((cj >> tz) / kDetailTileCells)};
       // Request every missing tile of the chain at once.
-      if (snapshot == nullptr || snapshot->find(key) == nullptr)
+      if (cache != nullptr && (snapshot == nullptr || snapshot->find(key) == nullptr))
         ready = cache->request(key) && ready;
+    } else {
+      DiamondBound b;
+      float y;
+      PageKey missing;
+      if (reader.stored(ci, cj, b, y, &missing) == Reader::Vertex::kMissing) {
+        page_requests.push_back(missing);
+        ready = false;
+      }
     }
     const std::uint32_t w = nodes[x].base();
     if (w == kNone || back(w) == 0) break;
@@ -253,10 +289,23 @@ bool RoamView::Impl::split(std::uint32_t n, bool forced, std::vector<std::uint32
     if (!split(to(w), true, queue)) return false;
   const std::uint32_t e = nodes[n].entry();
   if (front.provisional(e)) {
-    // The new vertex's detail tile is not resident: request it and wait (the split is tested
-    // again next update).
+    // The new vertex's detail tile or page is not resident: request it and wait (the split is
+    // tested again next update).
     if (!chain_ready(n)) return false;
     refresh_entry(e);
+  }
+  // A stored vertex's shading comes from its page when the split writes it: a page evicted
+  // since the entry was made is requested again.
+  const std::int64_t vi = front.ci(e), vj = front.cj(e);
+  if (!front.provisional(e) && reader.address(vi, vj) == nullptr &&
+      land.detail_levels() == 0) {
+    DiamondBound b;
+    float y;
+    PageKey missing;
+    if (reader.stored(vi, vj, b, y, &missing) == Reader::Vertex::kMissing) {
+      page_requests.push_back(missing);
+      return false;
+    }
   }
   if (forced)
     ++st.forced_splits;
@@ -271,7 +320,14 @@ bool RoamView::Impl::split(std::uint32_t n, bool forced, std::vector<std::uint32
   // error bound, so the output looks its bounds up. An entry still provisional after the
   // refresh above waited on a tile this update's snapshot does not hold yet (a synchronous
   // cache made it resident during the request): its true height comes from the surface.
-  const float vy = front.provisional(e) ? LandscapeAccess::height(land, ci, cj) : front.y(e);
+  if (front.provisional(e)) {
+    DiamondBound b;
+    float y;
+    if (reader.stored(ci, cj, b, y) == Reader::Vertex::kMissing) return false;  // its page
+  }
+  const float vy = front.provisional(e)
+                       ? static_cast<float>(land.terrain().surface().vertex_height(ci, cj))
+                       : front.y(e);
   const float vmu = front.mu(e), vr = front.radius(e);
   auto add_vertex = [&](std::uint32_t patch) {
     return cam.world ? out.add_vertex(patch, ci, cj) : out.add_vertex(patch, ci, cj, vy, vmu, vr);
@@ -385,7 +441,7 @@ void RoamView::Impl::reset() {
   const std::uint32_t px = land.patches_x(), pz = land.patches_z();
   nodes.reset(land.root_count());
   front.clear();
-  out.reset(land);
+  out.reset(land, reader);
   const std::int64_t P = land.patch_cells();
   for (std::uint32_t z = 0; z < pz; ++z) {
     for (std::uint32_t x = 0; x < px; ++x) {

@@ -40,14 +40,10 @@ void RoamView::Impl::build_children(std::uint32_t c, const LatticeTriangle& t,
     (coarser ? lonely : wave)
         .push_back({n, coarser ? kNone : to(w), std::int32_t(ci), std::int32_t(cj),
                     std::int32_t(hu), std::int32_t(hw)});
-    // Its record is read when the next level is built (after the rest of this one), or at the
+    // Its height is read when the next level is built (after the rest of this one), or at the
     // patch's end when it stays alone: fetched now, so that the misses overlap the work in
     // between (and again a few items ahead, build()).
-    {
-      const char* a = static_cast<const char*>(LandscapeAccess::address(land, ci, cj));
-      detail::prefetch(a);
-      detail::prefetch(a + sizeof(float) * 6);  // a record may straddle two lines
-    }
+    if (const void* a = reader.address(ci, cj)) detail::prefetch(a);
   }
 }
 
@@ -66,15 +62,13 @@ void RoamView::Impl::build() {
   // rebuild; 16 the same; also fetching the parent's triangle slot cost 10 %).
   constexpr std::size_t kAhead = 8;
   auto prefetch_record = [&](const BuildItem& d) {
-    const char* a = static_cast<const char*>(LandscapeAccess::address(land, d.ci, d.cj));
-    detail::prefetch(a);
-    detail::prefetch(a + sizeof(float) * 6);  // a record may straddle two lines
+    if (const void* a = reader.address(d.ci, d.cj)) detail::prefetch(a);
   };
   // A diamond's entry: node T, and its partner B when there is one.
-  auto enter = [&](const BuildItem& d, float y, float mu, float r, bool split, bool prov) {
+  auto enter = [&](const BuildItem& d, const EntryData& v, bool split) {
     const std::uint32_t t = std::uint32_t(std::min(ctz64(d.ci), ctz64(d.cj)));
-    const std::uint32_t e = front.add(d.ci, d.cj, d.hu, d.hw, t, float(d.ci) * sx, y,
-                                      float(d.cj) * sz, mu, r, d.T, split, prov);
+    const std::uint32_t e = front.add(d.ci, d.cj, d.hu, d.hw, t, v.x, v.y, v.z, v.mu, v.r, d.T,
+                                      split, v.provisional);
     nodes[d.T].set_entry(e);
     if (d.B != kNone) nodes[d.B].set_entry(e);
   };
@@ -93,15 +87,12 @@ void RoamView::Impl::build() {
         nodes[d.B].set_entry(kNoEntry);
         nodes[d.T].set_entry(kNoEntry);
       }
-      float y, mu, r;
-      bool prov;
-      entry_data(d.ci, d.cj, y, mu, r, prov);
+      const EntryData v = entry_data(d.ci, d.cj);
       ++st.priority_updates;
-      const std::uint8_t test =
-          Front::test_values(float(d.ci) * sx, y, float(d.cj) * sz, mu, r, cam);
-      // Waiting for a detail tile: left to the update's pass (split(), chain_ready()).
-      if (!(test & kActive) || prov) {
-        enter(d, y, mu, r, false, prov);
+      const std::uint8_t test = Front::test_values(v.x, v.y, v.z, v.mu, v.r, cam);
+      // Waiting for a detail tile or a page: left to the update's pass (split(), chain_ready()).
+      if (!(test & kActive) || v.provisional) {
+        enter(d, v, false);
         continue;
       }
       ++st.splits;
@@ -111,7 +102,7 @@ void RoamView::Impl::build() {
       const std::uint32_t pT = patch_of(tT);
       auto add_vertex = [&](std::uint32_t patch) {
         return cam.world ? out.add_vertex(patch, d.ci, d.cj)
-                         : out.add_vertex(patch, d.ci, d.cj, y, mu, r);
+                         : out.add_vertex(patch, d.ci, d.cj, v.y, v.mu, v.r);
       };
       const std::uint32_t vT = add_vertex(pT);
       LatticeTriangle tB{};
@@ -135,8 +126,7 @@ void RoamView::Impl::build() {
       if (B != kNone) link_children(B, cB, cT, vB);
       triangles += B != kNone ? 2 : 1;
       splits.push_back(d);
-      BuildItem& s = splits.back();
-      s.y = y, s.mu = mu, s.r = r, s.prov = prov;
+      splits.back().data = v;
       build_children(cT, tT, next, lonely);
       if (B != kNone) build_children(cB, tB, next, lonely);
     }
@@ -176,15 +166,12 @@ void RoamView::Impl::build() {
       for (std::size_t k = 0; k < lonely.size(); ++k) {
         if (k + kAhead < lonely.size()) prefetch_record(lonely[k + kAhead]);
         const BuildItem& d = lonely[k];
-        float y, mu, r;
-        bool prov;
-        entry_data(d.ci, d.cj, y, mu, r, prov);
-        enter(d, y, mu, r, false, prov);
+        enter(d, entry_data(d.ci, d.cj), false);
       }
       // A split diamond whose children all stayed unsplit may merge: it joins the front.
       for (const BuildItem& d : splits)
         if (children_leaves(d.T) && (d.B == kNone || children_leaves(d.B)))
-          enter(d, d.y, d.mu, d.r, true, d.prov);
+          enter(d, d.data, true);
     }
   // The lists are as long as the largest patch's levels (100-300 KiB near the eye): given back,
   // not kept in the view's state between builds.

@@ -141,10 +141,10 @@ class Front {
   std::uint32_t add(std::int32_t i, std::int32_t j, std::int32_t hu, std::int32_t hw,
                     std::uint32_t t, float x, float y, float z, float mu, float r,
                     std::uint32_t node, bool split, bool provisional);
-  /// Rewrites an entry's data (after an edit or a tile's arrival).
-  void set_data(std::uint32_t e, float y, float mu, float r) noexcept {
+  /// Rewrites an entry's sphere and bound (after an edit, or a page's or tile's arrival).
+  void set_data(std::uint32_t e, float x, float y, float z, float mu, float r) noexcept {
     Hot& h = block(e >> 3);
-    h.y[e & 7] = y, h.mu[e & 7] = mu, h.r[e & 7] = r;
+    h.x[e & 7] = x, h.y[e & 7] = y, h.z[e & 7] = z, h.mu[e & 7] = mu, h.r[e & 7] = r;
   }
   /// Removes entry `e` by moving the last entry into its place; returns the old index of the
   /// moved entry (== e when `e` was the last), whose nodes the caller re-points.

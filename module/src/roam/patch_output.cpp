@@ -9,11 +9,13 @@
 #include "ridgeline/surface.h"
 #include "roam/diamond.h"
 #include "roam/landscape_access.h"
+#include "ridgeline/terrain.h"
 
 namespace ridgeline::roam {
 
-void PatchOutput::reset(const Landscape& land) {
+void PatchOutput::reset(const Landscape& land, const Reader& reader) {
   land_ = &land;
+  reader_ = &reader;
   const std::uint32_t np = land.patch_count();
   if (patches_.size() != np) patches_.assign(np, Patch{});
   dirty_list_.clear();
@@ -25,9 +27,9 @@ void PatchOutput::reset(const Landscape& land) {
     Patch& pt = patches_[p];
     const std::int64_t i0 = std::int64_t(p % land.patches_x()) * P;
     const std::int64_t j0 = std::int64_t(p / land.patches_x()) * P;
-    pt.mesh.origin_x = land.world_x(i0);
-    pt.mesh.origin_z = land.world_z(j0);
-    pt.mesh.origin_y = land.terrain().heightfield().height_offset();
+    pt.mesh.origin_x = LandscapeAccess::world_x(land, i0);
+    pt.mesh.origin_z = LandscapeAccess::world_z(land, j0);
+    pt.mesh.origin_y = land.terrain().info().height_offset;
     pt.mesh.vertices.clear();
     pt.mesh.indices.clear();
     pt.mesh.dirty_vertices.clear();
@@ -51,7 +53,7 @@ void PatchOutput::reset(const Landscape& land) {
     for (int c = 0; c < 4; ++c) add_vertex(p, i0 + (c & 1) * P, j0 + (c >> 1) * P);
     // Root 0: apex (P, 0), left (0, 0), right (P, P); root 1: apex (0, P), left (P, P),
     // right (0, 0) (landscape.h). Their slots are 0 and 1. A root over the padding is hidden.
-    const bool pad = i0 >= land.last_i() || j0 >= land.last_j();
+    const bool pad = i0 >= LandscapeAccess::last_i(land) || j0 >= LandscapeAccess::last_j(land);
     add_triangle(p, {1, 0, 3}, pad);
     add_triangle(p, {2, 3, 0}, pad);
   }
@@ -64,27 +66,57 @@ void PatchOutput::write_vertex(std::uint32_t patch, std::uint32_t slot, std::int
   const std::int64_t P = l.patch_cells();
   const std::int64_t i0 = std::int64_t(patch % l.patches_x()) * P;
   const std::int64_t j0 = std::int64_t(patch / l.patches_x()) * P;
-  const VertexShading sh = LandscapeAccess::shading(l, i, j);
   MeshVertex v;
-  v.x = static_cast<float>(double(i - i0) * l.spacing_x());
-  v.z = static_cast<float>(double(j - j0) * l.spacing_z());
-  v.nx = sh.normal.x, v.ny = sh.normal.y, v.nz = sh.normal.z;
-  v.morph_dy = sh.morph_dy;
-  if (known != nullptr) {
-    v.y = known->y;
-    v.morph_bound = known->morph;
-    v.morph_radius = known->radius;
-  } else {
-    v.y = LandscapeAccess::height(l, i, j);
-    if (diamond_at(i, j, l.patch_log2()).corner) {
-      v.morph_bound = FLT_MAX;
-      v.morph_radius = 0.0f;
-    } else {
-      const DiamondBound b = LandscapeAccess::diamond(l, i, j);
+  v.x = static_cast<float>(double(i - i0) * LandscapeAccess::spacing_x(l));
+  v.z = static_cast<float>(double(j - j0) * LandscapeAccess::spacing_z(l));
+  const int L = int(l.detail_levels());
+  const std::int64_t mask = (std::int64_t{1} << L) - 1;
+  const Diamond d = diamond_at(i, j, l.patch_log2());
+  VertexShading sh;
+  if ((i & mask) != 0 || (j & mask) != 0) {
+    // Below the stored resolution: the detail lattice's.
+    sh = LandscapeAccess::detail_shading(l, i, j);
+    if (known == nullptr) {
+      const DiamondBound b = LandscapeAccess::compute_detail(l, i, j);
+      v.y = static_cast<float>(l.terrain().surface().vertex_height(i, j));
       v.morph_bound = b.morph;
       v.morph_radius = b.radius;
     }
+  } else {
+    const std::int64_t si = i >> L, sj = j >> L;
+    const Diamond sd = diamond_at(si, sj, int(l.patch_exponent()));
+    // Patch corners take the coarsest level holding them (always resident): stored_shading().
+    const int t = sd.corner ? int(l.patch_exponent()) : sd.t;
+    float corner_y = 0;
+    const bool ok = reader_->stored_shading(si, sj, sd, t, sh, &corner_y);
+    RIDGELINE_ASSERT(ok);
+    (void)ok;
+    if (known == nullptr) {
+      DiamondBound b;
+      float y = 0;
+      if (d.corner) {
+        y = corner_y;
+        b = {FLT_MAX, FLT_MAX, 0.0f};
+      } else if (reader_->stored(i, j, b, y) != Reader::Vertex::kResident) {
+        y = static_cast<float>(l.terrain().surface().stored_height(si, sj));
+        b = l.diamond(i, j);
+      }
+      v.y = y;
+      v.morph_bound = b.morph;
+      v.morph_radius = b.radius >= FLT_MAX ? FLT_MAX : b.radius;
+    }
   }
+  if (known != nullptr) {
+    v.y = known->y;
+    v.morph_bound = known->morph;
+    v.morph_radius = known->radius >= FLT_MAX ? FLT_MAX : known->radius;
+  }
+  if (d.corner) {
+    v.morph_bound = FLT_MAX;
+    v.morph_radius = 0.0f;
+  }
+  v.nx = sh.normal.x, v.ny = sh.normal.y, v.nz = sh.normal.z;
+  v.morph_dy = sh.morph_dy;
   v.material = sh.material;
   p.mesh.vertices[slot] = v;
   mark(p.vert_bits, slot, sizeof(MeshVertex));

@@ -22,13 +22,18 @@
 #include "memory_hints.h"
 #include "ridgeline/landscape.h"
 #include "ridgeline/roam_view.h"
+#include "roam/landscape_access.h"
 
 namespace ridgeline::roam {
 
 class PatchOutput {
  public:
-  /// Every patch back to its two root triangles over its four corner vertices.
-  void reset(const Landscape& land);
+  /// Every patch back to its two root triangles over its four corner vertices, read through
+  /// `reader` (the view's, kept for later writes: set_reader()).
+  void reset(const Landscape& land, const Reader& reader);
+  /// The reader of the current update (a vertex's shading and, when not given, its height and
+  /// bounds come from its page).
+  void set_reader(const Reader& reader) noexcept { reader_ = &reader; }
 
   /// The data of a new vertex that the caller already has: its height and its diamond's morph
   /// bound and radius.
@@ -136,9 +141,9 @@ class PatchOutput {
     const MeshVertex& v = patches_[patch].mesh.vertices[slot];
     const std::int64_t P = land_->patch_cells();
     return {std::int64_t(patch % land_->patches_x()) * P +
-                std::llround(double(v.x) / land_->spacing_x()),
+                std::llround(double(v.x) / LandscapeAccess::spacing_x(*land_)),
             std::int64_t(patch / land_->patches_x()) * P +
-                std::llround(double(v.z) / land_->spacing_z())};
+                std::llround(double(v.z) / LandscapeAccess::spacing_z(*land_))};
   }
   std::uint32_t vertex_slots(std::uint32_t patch) const {
     return std::uint32_t(patches_[patch].mesh.vertices.size());
@@ -234,6 +239,7 @@ class PatchOutput {
   std::uint32_t grow_triangles(Patch& p);
 
   const Landscape* land_ = nullptr;
+  const Reader* reader_ = nullptr;
   std::vector<Patch> patches_;
   std::vector<std::uint32_t> dirty_list_;
   std::vector<std::uint32_t> pending_;  // patches listed for compaction

@@ -20,6 +20,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <functional>
+#include <tuple>
 #include <unordered_set>
 
 #include "format.h"
@@ -27,6 +28,7 @@
 #include "ridgeline/log.h"
 #include "roam/landscape_access.h"
 #include "roam/view_impl.h"
+#include "surface/lattice.h"
 
 namespace ridgeline {
 
@@ -69,8 +71,10 @@ Result<std::unique_ptr<RoamView>> RoamView::create(std::shared_ptr<const Landsca
   v->landscape_ = std::move(landscape);
   v->impl_ = std::make_unique<Impl>(*v->landscape_);
   if (auto s = v->set_settings(settings); !s) return Error{s.message()};
+  v->impl_->reader = roam::Reader(
+      *v->landscape_, detail::SurfaceAccess::store(v->landscape_->terrain().surface()).snapshot());
   v->impl_->reset();
-  v->impl_->synced_version = v->landscape_->version();
+  v->impl_->synced_version = v->landscape_->terrain().edit_version();
   return v;
 }
 
@@ -120,23 +124,25 @@ const PatchMesh& RoamView::patch_mesh(std::uint32_t patch) const {
 
 namespace {
 
-// True when the box of lattice cells [i0, i1] x [j0, j1], widened by `grow`, holds (i, j).
-bool reaches(const Landscape::Change& c, std::int64_t i, std::int64_t j, std::int64_t grow) {
+// True when the range of lattice vertices, widened by `grow`, holds (i, j).
+bool reaches(const LatticeRange& c, std::int64_t i, std::int64_t j, std::int64_t grow) {
   return i >= c.i0 - grow && i <= c.i1 + grow && j >= c.j0 - grow && j <= c.j1 + grow;
 }
 
 }  // namespace
 
-// Refreshes what the landscape's changes since the last update reach: the front's diamonds
-// (bounds, positions) and the output vertices (heights, normals, bounds). A diamond's bound
-// depends on everything within its reach, a vertex's normal on its neighbours.
+// Refreshes what the terrain's edits since the last update reach (its change log): the front's
+// diamonds (bounds, positions) and the output vertices (heights, normals, bounds). A diamond's
+// bound depends on everything within its reach, a vertex's normal and geomorph offset on the
+// vertices of its level around it.
 void RoamView::Impl::pull_changes() {
   Impl& m = *this;
-  bool trimmed = false;
-  const std::vector<Landscape::Change> changes = m.land.changes_since(m.synced_version, &trimmed);
-  m.synced_version = m.land.version();
-  if (changes.empty()) return;
-  for (const Landscape::Change& c : changes) {
+  const TerrainChanges pulled = m.land.terrain().changes_since(m.synced_version);
+  m.synced_version = pulled.version;
+  if (pulled.empty()) return;
+  for (const TerrainChange& ch : pulled.changes) {
+    const LatticeRange& c = ch.vertices;
+    if (c.empty()) continue;
     for (std::uint32_t e = 0; e < m.front.size(); ++e) {
       const std::int64_t s = std::int64_t{1} << m.front.t(e);
       if (reaches(c, m.front.ci(e), m.front.cj(e), 3 * s + 1)) m.refresh_entry(e);
@@ -153,10 +159,29 @@ void RoamView::Impl::pull_changes() {
           if (!m.out.vertex_live(p, v)) continue;
           const auto q = m.out.coord(p, v);
           const Diamond d = diamond_at(q[0], q[1], m.K);
-          const std::int64_t grow = d.corner ? 1 : std::max<std::int64_t>(1, d.reach()) + 1;
+          const std::int64_t grow = d.corner ? P + 1 : std::max<std::int64_t>(1, d.reach()) + 1;
           if (reaches(c, q[0], q[1], grow)) m.out.refresh_vertex(p, v);
         }
       }
+  }
+}
+
+void RoamView::Impl::pull_pages() {
+  Impl& m = *this;
+  const std::uint64_t g = m.reader.table().generation();
+  if (g == m.pages_generation) return;
+  m.pages_generation = g;
+  if (!m.land.terrain().paged()) return;
+  for (std::uint32_t e = 0; e < m.front.size(); ++e) {
+    if (!m.front.provisional(e)) continue;
+    const std::int64_t ki = m.front.ci(e), kj = m.front.cj(e);
+    DiamondBound b;
+    float y;
+    if (m.reader.stored(ki, kj, b, y) == Reader::Vertex::kResident) {
+      const float before = m.front.mu(e);
+      m.refresh_entry(e);
+      if (m.front.mu(e) < before) ++m.st.rebounded;
+    }
   }
 }
 
@@ -259,7 +284,7 @@ void RoamView::Impl::collect() {
 // one change at a time.
 void RoamView::Impl::prefetch_change(const std::vector<std::uint32_t>& list, bool split) const {
   auto prefetch_record = [&](std::int64_t i, std::int64_t j) {
-    detail::prefetch(LandscapeAccess::address(land, i, j));
+    if (const void* a = reader.address(i, j)) detail::prefetch(a);
   };
   constexpr std::size_t D1 = 32, D2 = 16, D3 = 8;  // measured: 16/8/4 was ~10 % slower
   const std::size_t n = list.size();
@@ -593,9 +618,10 @@ void RoamView::Impl::split_border() {
 }
 
 roam::FrontCamera RoamView::Impl::front_camera(const Camera& camera, double px) const {
-  return FrontCamera::screen(camera, px, land.world_x(0),
-                             land.terrain().heightfield().height_offset(), land.world_z(0),
-                             land.spacing_x(), land.spacing_z(), land.local_extent());
+  return FrontCamera::screen(camera, px, LandscapeAccess::world_x(land, 0),
+                             land.terrain().info().height_offset, LandscapeAccess::world_z(land, 0),
+                             LandscapeAccess::spacing_x(land), LandscapeAccess::spacing_z(land),
+                             LandscapeAccess::local_extent(land));
 }
 
 // Under a triangle cap alone. Splitting the highest priority first until the cap is reached
@@ -720,24 +746,28 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
                         std::chrono::duration<double, std::milli>(settings_.budget_ms));
   m.clock_checks = 0;
 
-  // 1. Edits and detail tiles.
+  // 1. Edits, pages and detail tiles.
   if (m.cache != nullptr) {
     m.cache->update();  // integrate tiles generated since the last frame
     m.snapshot = m.cache->snapshot();
   }
-  l.sync();
+  l.terrain().update_pages();  // integrate pages loaded since the last frame, evict to budget
+  m.reader = Reader(l, detail::SurfaceAccess::store(l.terrain().surface()).snapshot());
+  m.out.set_reader(m.reader);
+  m.page_requests.clear();
   // A mesh made from the roots is built top down when nothing orders the changes (no time
   // budget, no queues of a cap's first update): build.cpp.
   const bool whole = !m.has_deadline && (cap == 0 || (capped && m.cap_threshold > 0.0));
   if (m.reset_pending || settings_.mode == RoamMode::kRebuild) {
     m.reset_pending = false;
-    m.synced_version = l.version();
+    m.synced_version = l.terrain().edit_version();
     m.reset();
     if (whole) m.build();
   } else {
     m.pull_changes();
   }
   m.pull_tiles();
+  m.pull_pages();
 
 #ifdef RIDGELINE_ROAM_PARANOID
   if (auto e = m.check(); !e.empty()) {
@@ -799,6 +829,18 @@ Result<RoamStats> RoamView::update(const Camera& camera) {
   // 5. Output: patches whose buffers hold many more slots than live triangles are compacted
   // (under a time budget before the changes, in a share of the budget).
   if (!m.has_deadline) m.compact_output(nullptr);
+
+  // Pages the splits wait for, urgent (loaded by the terrain's workers; resident from a later
+  // update on).
+  if (!m.page_requests.empty()) {
+    std::sort(m.page_requests.begin(), m.page_requests.end(), [](const PageKey& a, const PageKey& b) {
+      return std::tie(a.level, a.pz, a.px) < std::tie(b.level, b.pz, b.px);
+    });
+    m.page_requests.erase(std::unique(m.page_requests.begin(), m.page_requests.end()),
+                          m.page_requests.end());
+    detail::SurfaceAccess::store(l.terrain().surface()).request(m.page_requests, true);
+    m.st.requested_pages = std::uint32_t(m.page_requests.size());
+  }
 
   // Statistics.
   m.st.triangles = m.triangles;

@@ -46,7 +46,12 @@ struct RoamView::Impl {
   // Procedural detail: the terrain's tile cache (null without detail).
   DetailCache* cache = nullptr;
   std::shared_ptr<const DetailSnapshot> snapshot;  // the cache's tiles for this update
-  std::uint64_t synced_version = 0;  // the landscape's change version this view has applied
+  // The terrain's pages for this update (heights, bounds, shading), and the generation of the
+  // snapshot the front's provisional entries were last checked against.
+  roam::Reader reader;
+  std::uint64_t pages_generation = 0;
+  std::vector<PageKey> page_requests;  // pages this update's splits wait for (urgent)
+  std::uint64_t synced_version = 0;  // the terrain's edit_version() this view has applied
   std::uint64_t tiles_generation = ~std::uint64_t{0};  // the cache's snapshot last seen
   bool reset_pending = true;
   std::unordered_set<std::uint64_t> known_tiles;  // finest tiles resident at the last look
@@ -123,22 +128,23 @@ struct RoamView::Impl {
   void remove_entry(std::uint32_t e);
   /// Recomputes an entry's bounds and position from the landscape.
   void refresh_entry(std::uint32_t e);
-  /// A diamond's entry data: its centre's height, its bound (morph, or error in the tolerance
-  /// mode) and radius, and whether it is provisional (its detail tile is not resident).
-  void entry_data(std::int64_t i, std::int64_t j, float& y, float& mu, float& r,
-                  bool& provisional) const {
+  /// What the front's test reads of a diamond: the sphere's centre (its vertex, or for a
+  /// provisional diamond one that holds every position the vertex may take) and radius, and its
+  /// bound (morph, or error in the tolerance mode). Provisional: its detail tile or its page is
+  /// not resident.
+  struct EntryData {
+    float x, y, z, mu, r;
+    bool provisional;
+  };
+  EntryData entry_data(std::int64_t i, std::int64_t j) const {
     DiamondBound b;
-    if (roam::LandscapeAccess::bound_and_height(land, i, j, b, y)) {  // stored: one read
-      mu = cam.world ? b.error : b.morph;
-      r = b.radius;
-      provisional = false;
-      return;
-    }
-    entry_data_slow(i, j, y, mu, r, provisional);
+    float y;
+    if (reader.stored(i, j, b, y) == roam::Reader::Vertex::kResident)  // stored: one page
+      return {float(i) * sx, y, float(j) * sz, cam.world ? b.error : b.morph, b.radius, false};
+    return entry_data_slow(i, j);
   }
-  /// entry_data() of a vertex without a stored record (procedural detail, outside the data).
-  void entry_data_slow(std::int64_t i, std::int64_t j, float& y, float& mu, float& r,
-                       bool& provisional) const;
+  /// entry_data() of a vertex without a resident page (procedural detail, or a page to load).
+  EntryData entry_data_slow(std::int64_t i, std::int64_t j) const;
   /// Tests a new entry now (counted, and its priority kept for the remaining error).
   std::uint8_t test_new(std::uint32_t e);
 
@@ -155,7 +161,8 @@ struct RoamView::Impl {
   bool children_leaves(std::uint32_t n) const;
   /// Triangles a split of leaf n adds, counting the forced splits it needs.
   std::uint32_t split_cost(std::uint32_t n) const;
-  /// True when the vertices a split of n (and its forced chain) creates have their detail.
+  /// True when the vertices a split of n (and its forced chain) creates have their detail
+  /// tiles and pages (the missing ones are requested, urgent).
   bool chain_ready(std::uint32_t n);
   /// Points the link of the neighbour that link word w names (the link that pointed back) at
   /// link word `word`; nothing for kNone.
@@ -175,8 +182,7 @@ struct RoamView::Impl {
   struct BuildItem {
     std::uint32_t T, B;
     std::int32_t ci, cj, hu, hw;
-    float y = 0, mu = 0, r = 0;  // a split diamond's entry data (kept for its entry)
-    bool prov = false;
+    EntryData data{};  // a split diamond's entry data (kept for its entry)
   };
   /// After reset(): the mesh the camera's test asks for, built top down, level by level, with
   /// the front and the output (build.cpp). Leaves to the update's pass only what the nesting
@@ -192,6 +198,9 @@ struct RoamView::Impl {
 
   void pull_changes();
   void pull_tiles();
+  /// Pages that became resident since the last update: the provisional stored diamonds over
+  /// them get their true data.
+  void pull_pages();
   /// The front's entries whose test disagrees with their state, into to_merge and to_split.
   void collect();
   void converge_all();

@@ -1,19 +1,22 @@
 // Private: a Surface's finest lattice as the queries read it. Two views with one interface, so
 // that every query is written once, as a template over the view (point_queries.cpp,
-// ray_hierarchy.cpp), and with_lattice() picks the view once per call:
-//  - StoredLattice (L = 0): vertex heights are the stored float samples, read directly;
+// ray_queries.cpp), and with_lattice() picks the view once per call:
+//  - StoredLattice (L = 0): vertex heights are the stored samples, read from their pages;
 //  - DetailLattice (L >= 1): vertex heights are the stored surface interpolated at the vertex
 //    plus the detail there, in double (docs/surface.md, "Detail and edits").
-// A view reads vertices and cells inside the lattice only (the public Surface calls clamp).
+// A view reads vertices and cells inside the lattice only (the public Surface calls clamp). A view
+// lives for one query (or one batch) on one thread: it keeps the page table snapshot it started
+// with and the last page it read, and loads a missing page on the spot (a synchronous load).
 #pragma once
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 
-#include "ridgeline/heightfield.h"
 #include "ridgeline/surface.h"
 #include "surface/surface_eval.h"
+#include "world/page_store.h"
 
 namespace ridgeline::detail {
 
@@ -23,21 +26,72 @@ struct StoredLattice {
   static constexpr int levels = 0;
   static constexpr double scale = 1.0;  ///< 2^L: finest cells per stored cell side
   static constexpr double inv_scale = 1.0;
-  const Heightfield& hf;
+  const world::PageStore& store;
   const SurfaceLattice& at;
+  mutable const world::PageTable* table;
+  mutable std::shared_ptr<const world::PageTable> keep;  // a snapshot taken by a synchronous load
+  mutable const world::Page* page = nullptr;             // the page read last
+  mutable std::int64_t pi0 = 0, pj0 = 0;                 // its sample (0, 0)
+  /// A page could not be loaded: what was read from it is 0 and the query answers nothing.
+  mutable bool missing = false;
 
+  StoredLattice(const world::PageStore& s, const SurfaceLattice& a) noexcept
+      : store(s), at(a), table(&s.current()) {}
+
+  /// A page holding stored sample (i, j) (the last one read when its entries hold it).
+  const world::Page* page_at(std::int64_t i, std::int64_t j) const noexcept {
+    if (page != nullptr && i - pi0 >= -kPageApron && i - pi0 <= kPageCells + kPageApron &&
+        j - pj0 >= -kPageApron && j - pj0 <= kPageCells + kPageApron)
+      return page;
+    const PageKey k = store.grid().page_of(0, i, j);
+    const world::Page* p = table->find(k);
+    if (p == nullptr) {
+      p = store.require(k, keep);
+      if (p == nullptr) return nullptr;
+      table = keep.get();
+    }
+    page = p;
+    pi0 = std::int64_t(k.px) << 8, pj0 = std::int64_t(k.pz) << 8;
+    return p;
+  }
+  /// Page `k` itself (found, or loaded on the spot); null when it cannot be loaded.
+  const world::Page* page_of_key(const PageKey& k) const noexcept {
+    const world::Page* p = table->find(k);
+    if (p == nullptr) {
+      p = store.require(k, keep);
+      if (p == nullptr) {
+        missing = true;
+        return nullptr;
+      }
+      table = keep.get();
+    }
+    return p;
+  }
   Height local(std::int64_t i, std::int64_t j) const noexcept {
-    return hf.local(std::uint32_t(i), std::uint32_t(j));
+    const world::Page* p = page_at(i, j);
+    if (p == nullptr) {
+      missing = true;
+      return 0.0f;
+    }
+    return p->local(std::int32_t(i - pi0), std::int32_t(j - pj0));
   }
   Height base(std::int64_t i, std::int64_t j) const noexcept { return local(i, j); }
   std::uint8_t material(std::int64_t i, std::int64_t j) const noexcept {
-    return hf.material(std::uint32_t(i), std::uint32_t(j));
+    const world::Page* p = page_at(i, j);
+    return p ? p->material(std::int32_t(i - pi0), std::int32_t(j - pj0)) : 0;
   }
-  /// Starts fetching the samples of cell (i, j) into the cache (the next query's, in a batch).
+  /// Starts fetching the samples of cell (i, j) into the cache (the next query's, in a batch):
+  /// only when its page is resident.
   void prefetch(std::int64_t i, std::int64_t j) const noexcept {
-    const float* row = hf.local_heights().data() + std::size_t(i) + std::size_t(j) * hf.width();
-    __builtin_prefetch(row);
-    __builtin_prefetch(row + hf.width());
+    const PageKey k = store.grid().page_of(0, i, j);
+    if (const world::Page* p = table->find(k)) {
+      const std::size_t e = world::entry_index(std::int32_t(i - (std::int64_t(k.px) << 8)),
+                                               std::int32_t(j - (std::int64_t(k.pz) << 8)));
+      const char* a = p->f32 ? reinterpret_cast<const char*>(p->f32 + e)
+                             : reinterpret_cast<const char*>(p->u16 + e);
+      __builtin_prefetch(a);
+      __builtin_prefetch(a + (p->f32 ? 4 : 2) * kPageStride);
+    }
   }
   // What vertex_normal() (surface_eval.h) reads.
   double spacing_x() const noexcept { return at.spacing_x; }
@@ -53,9 +107,10 @@ struct DetailLattice {
   int levels;        ///< L >= 1
   double scale;      ///< 2^L
   double inv_scale;  ///< 2^-L
-  const Heightfield& hf;
+  StoredLattice stored;
   const SurfaceLattice& at;
   const Surface& surface;  // for the detail (Surface::vertex_detail: the cache or the field)
+  mutable bool missing = false;
 
   /// The stored surface at the vertex (its cell's triangle plane, evaluated exactly: the
   /// vertex's fractions are multiples of 2^-L) plus the detail there.
@@ -67,15 +122,16 @@ struct DetailLattice {
     const std::int64_t mask = (std::int64_t{1} << levels) - 1;
     std::int64_t k = i >> levels, m = j >> levels, fi = i & mask, fj = j & mask;
     // The far edge belongs to the last cell (fraction 1), as in the point queries.
-    if (k == std::int64_t(hf.width()) - 1) --k, fi = mask + 1;
-    if (m == std::int64_t(hf.height()) - 1) --m, fj = mask + 1;
+    if (k == stored.store.grid().last_i) --k, fi = mask + 1;
+    if (m == stored.store.grid().last_j) --m, fj = mask + 1;
     const float fu = std::ldexp(float(fi), -levels), fv = std::ldexp(float(fj), -levels);
-    const CellPlane plane = cell_plane(hf, k, m, locate_in_cell(k, m, fu, fv));
+    const CellPlane plane = cell_plane(stored, k, m, locate_in_cell(k, m, fu, fv));
+    missing |= stored.missing;
     return plane.at(fu, fv);
   }
   std::uint8_t material(std::int64_t i, std::int64_t j) const noexcept {
-    return hf.material(std::min(std::uint32_t(i >> levels), hf.width() - 2),
-                       std::min(std::uint32_t(j >> levels), hf.height() - 2));
+    return stored.material(std::min(i >> levels, stored.store.grid().last_i - 1),
+                           std::min(j >> levels, stored.store.grid().last_j - 1));
   }
   void prefetch(std::int64_t, std::int64_t) const noexcept {}  // detail dominates; nothing to gain
   double spacing_x() const noexcept { return at.spacing_x; }
@@ -84,13 +140,23 @@ struct DetailLattice {
   std::int64_t height() const noexcept { return at.vertices_z; }
 };
 
+/// What the lattice views read of a Surface's private parts.
+struct SurfaceAccess {
+  static const world::PageStore& store(const Surface& s) noexcept { return *s.store_; }
+  static world::PageStore& store(Surface& s) noexcept { return *s.store_; }
+  /// The stored samples' placement as a lattice (L = 0).
+  static const SurfaceLattice& stored_at(const Surface& s) noexcept { return s.stored_at_; }
+  static EditLayer& edits(Surface& s) noexcept { return *s.edits_; }
+  static const EditLayer& edits(const Surface& s) noexcept { return *s.edits_; }
+};
+
 /// The view of `s`'s lattice of each kind (the caller knows which one `s` has).
 inline StoredLattice stored_lattice(const Surface& s) noexcept {
-  return {s.heightfield(), s.lattice()};
+  return StoredLattice(SurfaceAccess::store(s), SurfaceAccess::stored_at(s));
 }
 inline DetailLattice detail_lattice(const Surface& s) noexcept {
   const int L = int(s.lattice().levels);
-  return {L, std::ldexp(1.0, L), std::ldexp(1.0, -L), s.heightfield(), s.lattice(), s};
+  return {L, std::ldexp(1.0, L), std::ldexp(1.0, -L), stored_lattice(s), s.lattice(), s};
 }
 
 /// Calls f(view) with the view of `s`'s lattice and returns what it returns.

@@ -83,7 +83,9 @@ template <class Answer, class G>
     -> std::optional<decltype(Answer::at(g, LatticePoint<G>{}))> {
   LatticePoint<G> p;
   if (!detail::locate(g, x, z, p)) return std::nullopt;
-  return Answer::at(g, p);
+  auto a = Answer::at(g, p);
+  if (g.missing) return std::nullopt;  // a page that could not be loaded
+  return a;
 }
 
 // With detail, out of line: such a query costs microseconds, while the stored path it would
@@ -136,14 +138,15 @@ void Surface::heights(std::span<const glm::dvec2> xz, std::span<double> out) con
   }
   // A copy of the placement: the stores to `out` cannot then alias it, so it stays in registers.
   const SurfaceLattice at = lattice();
-  const detail::StoredLattice g{heightfield(), at};
+  const detail::StoredLattice g = detail::stored_lattice(*this);
   const double max_u = double(at.vertices_x - 2), max_v = double(at.vertices_z - 2);
   // Scattered points miss the cache once the samples outgrow it: then start fetching the cell of
   // the point kAhead places on while this one is evaluated (clamped into the lattice,
   // branch-free; NaN goes to 0: a hint only). On samples that fit in the cache the hint only
   // costs instructions (+13 % on a 4 MiB field, -16 % time on a 16 MiB one: docs/benchmarks.md).
-  constexpr std::size_t kAhead = 8, kPrefetchBytes = std::size_t{8} << 20;
-  const bool prefetch = heightfield().local_heights().size_bytes() > kPrefetchBytes;
+  constexpr std::size_t kAhead = 8;
+  constexpr double kPrefetchSamples = double(std::size_t{2} << 20);
+  const bool prefetch = double(at.vertices_x) * double(at.vertices_z) > kPrefetchSamples;
   const std::size_t ahead = prefetch && n > kAhead ? n - kAhead : 0;
   for (std::size_t k = 0; k < n; ++k) {
     if (k < ahead) {
@@ -153,6 +156,7 @@ void Surface::heights(std::span<const glm::dvec2> xz, std::span<double> out) con
       g.prefetch(static_cast<std::int64_t>(u), static_cast<std::int64_t>(v));
     }
     out[k] = answer_on<Height>(g, xz[k].x, xz[k].y).value_or(kNaN);
+    g.missing = false;
   }
 }
 

@@ -10,6 +10,7 @@
 #include "ridgeline/detail.h"
 #include "ridgeline/log.h"
 #include "surface/lattice.h"
+#include "world/page_store.h"
 
 namespace ridgeline {
 
@@ -43,38 +44,40 @@ const DetailSnapshot* current_snapshot(const DetailCache* cache) {
   return snapshot.get();
 }
 
-SurfaceLattice lattice_of(const Heightfield& hf, std::uint32_t levels) {
+SurfaceLattice lattice_of(const WorldInfo& hf, std::uint32_t levels) {
   SurfaceLattice at;
   const int L = int(levels);
   at.levels = levels;
-  at.vertices_x = (std::int64_t(hf.width() - 1) << L) + 1;
-  at.vertices_z = (std::int64_t(hf.height() - 1) << L) + 1;
-  at.spacing_x = std::ldexp(hf.spacing_x(), -L);
-  at.spacing_z = std::ldexp(hf.spacing_z(), -L);
-  at.inv_spacing_x = std::ldexp(1.0 / hf.spacing_x(), L);
-  at.inv_spacing_z = std::ldexp(1.0 / hf.spacing_z(), L);
-  at.origin_x = hf.origin_x();
-  at.origin_z = hf.origin_z();
-  at.height_offset = hf.height_offset();
+  at.vertices_x = (std::int64_t(hf.width - 1) << L) + 1;
+  at.vertices_z = (std::int64_t(hf.height - 1) << L) + 1;
+  at.spacing_x = std::ldexp(hf.spacing_x, -L);
+  at.spacing_z = std::ldexp(hf.spacing_z, -L);
+  at.inv_spacing_x = std::ldexp(1.0 / hf.spacing_x, L);
+  at.inv_spacing_z = std::ldexp(1.0 / hf.spacing_z, L);
+  at.origin_x = hf.origin_x;
+  at.origin_z = hf.origin_z;
+  at.height_offset = hf.height_offset;
   return at;
 }
 
 }  // namespace
 
-Surface::Surface(Heightfield samples, std::shared_ptr<const DetailField> detail,
-                 std::unique_ptr<DetailCache> cache)
-    : samples_(std::move(samples)),
+Surface::Surface(std::shared_ptr<world::PageStore> store,
+                 std::shared_ptr<const DetailField> detail, std::unique_ptr<DetailCache> cache)
+    : store_(std::move(store)),
       edits_(std::make_unique<EditLayer>()),
-      lattice_(lattice_of(samples_, detail ? detail->levels() : 0)),
+      lattice_(lattice_of(store_->info(), detail ? detail->levels() : 0)),
+      stored_at_(lattice_of(store_->info(), 0)),
       detail_(std::move(detail)),
       cache_(std::move(cache)),
       detail_hash_(detail_ ? hash_params(detail_->params()) : 0),
       detail_bound_(detail_ ? detail_->contribution_bound(1) : 0.0) {}
 
 Surface::Surface(const Surface& o, CloneTag)
-    : samples_(o.samples_.duplicate()),
+    : store_(o.store_->clone()),
       edits_(std::make_unique<EditLayer>(*o.edits_)),
       lattice_(o.lattice_),
+      stored_at_(o.stored_at_),
       detail_(o.detail_),  // immutable, and bound to no terrain: shared
       detail_hash_(o.detail_hash_),
       detail_bound_(o.detail_bound_) {
@@ -91,12 +94,58 @@ Surface::Surface(const Surface& o, CloneTag)
 
 Surface::~Surface() = default;
 
+const WorldInfo& Surface::info() const noexcept { return store_->info(); }
+
 std::size_t Surface::edited_chunks() const noexcept {
   return edits_->chunks();
 }
 
 std::size_t Surface::memory_bytes() const noexcept {
-  return sizeof(*this) + samples_.memory_bytes() + (detail_ ? detail_->memory_bytes() : 0);
+  return sizeof(*this) + store_->stats().resident_bytes +
+         (detail_ ? detail_->memory_bytes() : 0);
+}
+
+std::uint64_t Surface::heights_hash() const {
+  const world::PageGrid& g = store_->grid();
+  std::vector<std::uint64_t> pages(g.count(0));
+  std::shared_ptr<const world::PageTable> keep;
+  for (std::int32_t pz = 0; pz < g.pz[0]; ++pz)
+    for (std::int32_t px = 0; px < g.px[0]; ++px) {
+      const world::Page* p = store_->require({0, px, pz}, keep);
+      pages[std::size_t(px) + std::size_t(pz) * std::size_t(g.px[0])] =
+          p ? world::hash_page(*p, g, info().has_materials) : 0;
+    }
+  return world::combine_hashes(world::hash_header(info()), pages);
+}
+
+float Surface::stored_height(std::int64_t i, std::int64_t j) const noexcept {
+  const detail::StoredLattice g = detail::stored_lattice(*this);
+  return g.local(std::clamp<std::int64_t>(i, 0, g.store.grid().last_i),
+                 std::clamp<std::int64_t>(j, 0, g.store.grid().last_j));
+}
+
+Result<Heightfield> Surface::to_heightfield(std::uint64_t max_samples) const {
+  const WorldInfo& w = info();
+  HeightfieldDesc d;
+  d.width = w.width, d.height = w.height;
+  d.spacing_x = w.spacing_x, d.spacing_z = w.spacing_z;
+  d.origin_x = w.origin_x, d.origin_z = w.origin_z;
+  d.height_offset = w.height_offset;
+  d.height_scale = 1.0;
+  d.max_samples = max_samples;
+  d.name = w.name;
+  if (auto s = validate_heightfield_desc(d); !s) return Error{s.message()};
+  std::vector<float> values(std::size_t(w.width) * w.height);
+  std::vector<std::uint8_t> materials;
+  if (w.has_materials) materials.resize(std::size_t(w.width - 1) * (w.height - 1));
+  const detail::StoredLattice g = detail::stored_lattice(*this);
+  for (std::uint32_t j = 0; j < w.height; ++j)
+    for (std::uint32_t i = 0; i < w.width; ++i) {
+      values[i + std::size_t(j) * w.width] = g.local(i, j);
+      if (!materials.empty() && i + 1 < w.width && j + 1 < w.height)
+        materials[i + std::size_t(j) * (w.width - 1)] = g.material(i, j);
+    }
+  return Heightfield::create(d, values, materials);
 }
 
 double Surface::vertex_height(std::int64_t i, std::int64_t j) const noexcept {

@@ -29,7 +29,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%s\n", hf.error().message.c_str());
     return 1;
   }
-  auto terrain = ridgeline::Terrain::create(std::move(hf).value());
+  auto terrain = ridgeline::Terrain::create(std::move(hf).value()).value();
   auto h = terrain->height(5.0, 7.0);
   if (!h || std::abs(*h - 10.0) > 1e-6) return 1;
   auto host = ridgeline::lua::Host::create();

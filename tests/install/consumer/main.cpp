@@ -16,7 +16,7 @@ int main() {
     std::fprintf(stderr, "%s\n", hf.error().message.c_str());
     return 1;
   }
-  auto terrain = ridgeline::Terrain::create(std::move(hf).value());
+  auto terrain = ridgeline::Terrain::create(std::move(hf).value()).value();
   auto h = terrain->height(1.5, 0.5);
   if (!h || std::abs(*h - 2.0) > 1e-9) return 1;
   std::printf("consumer: height %.3f\n", *h);

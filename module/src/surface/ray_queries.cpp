@@ -10,15 +10,17 @@
 // Everything runs in double precision in lattice-local coordinates (grid units from sample (0, 0)
 // along x and z, metres above the height offset along y), so terrains far from the world origin
 // lose nothing.
-#include "surface/ray_hierarchy.h"
+#include "surface/ray_queries.h"
 
 #include <algorithm>
 #include <cmath>
 #include <glm/geometric.hpp>
 #include <limits>
 
+#include "format.h"
 #include "surface/lattice.h"
 #include "surface/surface_eval.h"
+#include "world/page_store.h"
 
 namespace ridgeline {
 
@@ -42,7 +44,7 @@ inline bool clip_axis(double o, double d, double inv, double a, double b, double
 
 }  // namespace
 
-struct RayHierarchy::Ray {
+struct RayQueries::Ray {
   double u0, v0, y0;       // origin: grid units along x and z, metres above the height offset
   double du, dv, dy;       // change per metre along the ray
   double inv_du, inv_dv;   // 1 / du, 1 / dv (unused when zero)
@@ -52,116 +54,95 @@ struct RayHierarchy::Ray {
 
 namespace {
 
-double touch_tolerance_of(const Heightfield& hf) {
-  return 1e-9 *
-         (1.0 + std::max(std::abs(double(hf.min_local())), std::abs(double(hf.max_local()))));
-}
+// The pyramid as a ray walks it: levels 0 .. 5 inside level-0 pages (blocks of 4 << l cells),
+// levels 6 and up above them (the store's pyramid over pages). Pages are read through the
+// lattice view, which loads a missing one (a synchronous load).
+struct Pyramid {
+  const detail::StoredLattice& g;
+  const world::PageStore& store;
+  int levels() const noexcept { return world::kRayLevels + int(store.upper_rays().size()); }
+  std::int64_t nx(int l) const noexcept {
+    return l < world::kRayLevels ? std::int64_t(store.grid().px[0]) * (64 >> l)
+                                 : store.upper_rays()[std::size_t(l - world::kRayLevels)].nx;
+  }
+  std::int64_t nz(int l) const noexcept {
+    return l < world::kRayLevels ? std::int64_t(store.grid().pz[0]) * (64 >> l)
+                                 : store.upper_rays()[std::size_t(l - world::kRayLevels)].nz;
+  }
+  // Min and max of node (x, z) of level l; false when its page could not be loaded.
+  bool node(int l, std::int64_t x, std::int64_t z, float& lo, float& hi) const noexcept {
+    if (l >= world::kRayLevels) {
+      const auto& u = store.upper_rays()[std::size_t(l - world::kRayLevels)];
+      const std::size_t k = std::size_t(x) + std::size_t(z) * std::size_t(u.nx);
+      lo = u.min[k], hi = u.max[k];
+      return true;
+    }
+    const int s = world::kRayLevels - l;
+    const world::Page* p = g.page_of_key({0, std::int32_t(x >> s), std::int32_t(z >> s)});
+    if (p == nullptr) return false;
+    const std::int32_t m = (64 >> l) - 1;
+    const std::size_t k = p->rays->index(l, std::int32_t(x) & m, std::int32_t(z) & m);
+    lo = p->rays->min[k], hi = p->rays->max[k];
+    return true;
+  }
+};
+
+const detail::StoredLattice& stored_of(const detail::StoredLattice& g) { return g; }
+const detail::StoredLattice& stored_of(const detail::DetailLattice& g) { return g.stored; }
 
 }  // namespace
 
-RayHierarchy::RayHierarchy(const Heightfield& hf)
-    : inv_sx_(1.0 / hf.spacing_x()), inv_sz_(1.0 / hf.spacing_z()), touch_(touch_tolerance_of(hf)) {
-  const std::uint32_t cells_x = hf.width() - 1, cells_z = hf.height() - 1;
-  Level leaf;
-  leaf.nx = (cells_x + kLeafCells - 1) >> kLeafShift;
-  leaf.nz = (cells_z + kLeafCells - 1) >> kLeafShift;
-  leaf.max.resize(std::size_t{leaf.nx} * leaf.nz);
-  leaf.min.resize(leaf.max.size());
-  levels_.push_back(std::move(leaf));
-  for (std::uint32_t bz = 0; bz < levels_[0].nz; ++bz)
-    for (std::uint32_t bx = 0; bx < levels_[0].nx; ++bx) leaf_block(hf, bx, bz);
-  while (levels_.back().nx > 1 || levels_.back().nz > 1) {
-    Level up;
-    up.nx = (levels_.back().nx + 1) / 2;
-    up.nz = (levels_.back().nz + 1) / 2;
-    up.max.resize(std::size_t{up.nx} * up.nz);
-    up.min.resize(up.max.size());
-    levels_.push_back(std::move(up));
-    const std::size_t lv = levels_.size() - 1;
-    for (std::uint32_t z = 0; z < levels_[lv].nz; ++z)
-      for (std::uint32_t x = 0; x < levels_[lv].nx; ++x) parent_node(lv, x, z);
-  }
+double RayQueries::touch_tolerance(const Surface& s) noexcept {
+  const WorldInfo& hf = s.info();
+  return 1e-9 * (1.0 + std::max(std::abs(double(hf.min_local)), std::abs(double(hf.max_local))));
 }
 
-// Min and max of the samples of leaf block (bx, bz) (its cells' corners).
-void RayHierarchy::leaf_block(const Heightfield& hf, std::uint32_t bx, std::uint32_t bz) {
-  const std::uint32_t cells_x = hf.width() - 1, cells_z = hf.height() - 1;
-  const std::uint32_t j0 = bz << kLeafShift, j1 = std::min(j0 + kLeafCells, cells_z);
-  const std::uint32_t i0 = bx << kLeafShift, i1 = std::min(i0 + kLeafCells, cells_x);
-  float lo = hf.local(i0, j0), hi = lo;
-  for (std::uint32_t j = j0; j <= j1; ++j) {
-    for (std::uint32_t i = i0; i <= i1; ++i) {
-      const float h = hf.local(i, j);
-      lo = std::min(lo, h);
-      hi = std::max(hi, h);
+std::string RayQueries::check(const world::PageStore& store) {
+  using detail::fmt;
+  const std::shared_ptr<const world::PageTable> t = store.snapshot();
+  for (std::size_t k = 0; k < t->size(); ++k) {
+    const world::Page& p = t->page(k);
+    if (p.key.level != 0) continue;
+    const auto fresh = world::make_rays(p);
+    for (std::size_t n = 0; n < world::PageRays::kNodes; ++n)
+      if (fresh->min[n] != p.rays->min[n] || fresh->max[n] != p.rays->max[n])
+        return fmt("ray pyramid: page (%d, %d) node %zu holds [%g, %g], rebuilt [%g, %g]", p.key.px,
+                   p.key.pz, n, double(p.rays->min[n]), double(p.rays->max[n]),
+                   double(fresh->min[n]), double(fresh->max[n]));
+  }
+  const world::PageGrid& g = store.grid();
+  const detail::StoredLattice lat(store, SurfaceLattice{});
+  for (std::int32_t pz = 0; pz < g.pz[0]; ++pz)
+    for (std::int32_t px = 0; px < g.px[0]; ++px) {
+      const PageSummary s = world::summarize(
+          g, px, pz, [&](std::int64_t i, std::int64_t j) { return lat.local(i, j); });
+      const PageSummary& have = store.summary(px, pz);
+      if (s.lo != have.lo || s.hi != have.hi || s.lo8 != have.lo8 || s.hi8 != have.hi8)
+        return fmt("page summary (%d, %d) holds [%g, %g] / [%g, %g], rebuilt [%g, %g] / [%g, %g]",
+                   px, pz, double(have.lo), double(have.hi), double(have.lo8), double(have.hi8),
+                   double(s.lo), double(s.hi), double(s.lo8), double(s.hi8));
+      const auto& u = store.upper_rays()[0];
+      const std::size_t k = std::size_t(px) + std::size_t(pz) * std::size_t(u.nx);
+      if (u.min[k] != s.lo || u.max[k] != s.hi)
+        return fmt("ray pyramid above pages: node (%d, %d) differs from its page", px, pz);
     }
-  }
-  Level& leaf = levels_[0];
-  leaf.min[leaf.index(bx, bz)] = lo;
-  leaf.max[leaf.index(bx, bz)] = hi;
-}
-
-// Node (x, z) of `level` >= 1 from its (up to four) children.
-void RayHierarchy::parent_node(std::size_t level, std::uint32_t x, std::uint32_t z) {
-  const Level& below = levels_[level - 1];
-  Level& up = levels_[level];
-  float lo = below.min[below.index(2 * x, 2 * z)], hi = below.max[below.index(2 * x, 2 * z)];
-  for (std::uint32_t c = 1; c < 4; ++c) {
-    const std::uint32_t cx = 2 * x + (c & 1), cz = 2 * z + (c >> 1);
-    if (cx >= below.nx || cz >= below.nz) continue;
-    lo = std::min(lo, below.min[below.index(cx, cz)]);
-    hi = std::max(hi, below.max[below.index(cx, cz)]);
-  }
-  up.min[up.index(x, z)] = lo;
-  up.max[up.index(x, z)] = hi;
-}
-
-void RayHierarchy::update_cells(const Heightfield& hf, std::uint32_t i0, std::uint32_t j0,
-                                std::uint32_t i1, std::uint32_t j1) {
-  // A sample on a block border belongs to both blocks: widen by one cell.
-  const std::uint32_t cells_x = hf.width() - 1, cells_z = hf.height() - 1;
-  i0 = i0 > 0 ? i0 - 1 : 0;
-  j0 = j0 > 0 ? j0 - 1 : 0;
-  i1 = std::min(i1 + 1, cells_x - 1);
-  j1 = std::min(j1 + 1, cells_z - 1);
-  std::uint32_t x0 = i0 >> kLeafShift, x1 = i1 >> kLeafShift;
-  std::uint32_t z0 = j0 >> kLeafShift, z1 = j1 >> kLeafShift;
-  for (std::uint32_t bz = z0; bz <= z1; ++bz)
-    for (std::uint32_t bx = x0; bx <= x1; ++bx) leaf_block(hf, bx, bz);
-  for (std::size_t lv = 1; lv < levels_.size(); ++lv) {
-    x0 >>= 1, x1 >>= 1, z0 >>= 1, z1 >>= 1;
-    for (std::uint32_t z = z0; z <= z1; ++z)
-      for (std::uint32_t x = x0; x <= x1; ++x) parent_node(lv, x, z);
-  }
-  touch_ = touch_tolerance_of(hf);
-}
-
-std::string RayHierarchy::compare(const RayHierarchy& o) const {
-  if (levels_.size() != o.levels_.size())
-    return "ray pyramid: " + std::to_string(levels_.size()) + " levels, rebuilt " +
-           std::to_string(o.levels_.size());
-  if (touch_ != o.touch_) return "ray pyramid: touch tolerance differs from a rebuild";
-  for (std::size_t lv = 0; lv < levels_.size(); ++lv) {
-    const Level &a = levels_[lv], &b = o.levels_[lv];
-    if (a.nx != b.nx || a.nz != b.nz)
-      return "ray pyramid: level " + std::to_string(lv) + " size differs";
-    for (std::uint32_t z = 0; z < a.nz; ++z)
-      for (std::uint32_t x = 0; x < a.nx; ++x) {
-        const std::size_t k = a.index(x, z);
-        if (a.min[k] != b.min[k] || a.max[k] != b.max[k])
-          return "ray pyramid: level " + std::to_string(lv) + " node (" + std::to_string(x) + ", " +
-                 std::to_string(z) + ") holds [" + std::to_string(a.min[k]) + ", " +
-                 std::to_string(a.max[k]) + "], rebuilt [" + std::to_string(b.min[k]) + ", " +
-                 std::to_string(b.max[k]) + "]";
+  const auto& up = store.upper_rays();
+  for (std::size_t l = 1; l < up.size(); ++l)
+    for (std::int32_t z = 0; z < up[l].nz; ++z)
+      for (std::int32_t x = 0; x < up[l].nx; ++x) {
+        float lo = INFINITY, hi = -INFINITY;
+        for (int c = 0; c < 4; ++c) {
+          const std::int32_t cx = 2 * x + (c & 1), cz = 2 * z + (c >> 1);
+          if (cx >= up[l - 1].nx || cz >= up[l - 1].nz) continue;
+          const std::size_t k = std::size_t(cx) + std::size_t(cz) * std::size_t(up[l - 1].nx);
+          lo = std::min(lo, up[l - 1].min[k]), hi = std::max(hi, up[l - 1].max[k]);
+        }
+        const std::size_t k = std::size_t(x) + std::size_t(z) * std::size_t(up[l].nx);
+        if (up[l].min[k] != lo || up[l].max[k] != hi)
+          return fmt("ray pyramid above pages: level %zu node (%d, %d) differs from its children",
+                     l, x, z);
       }
-  }
   return {};
-}
-
-std::size_t RayHierarchy::memory_bytes() const noexcept {
-  std::size_t bytes = levels_.capacity() * sizeof(Level);
-  for (const Level& l : levels_) bytes += (l.max.capacity() + l.min.capacity()) * sizeof(float);
-  return bytes;
 }
 
 namespace {
@@ -202,8 +183,8 @@ PointPlane point_plane(const Lattice& g, double u, double v) noexcept {
 // Tests the finest cells of leaf block (bx, bz) that the ray crosses during [ta, tb], in ray
 // order (a 2D DDA over the block's 2^L x 2^L finest cells per stored cell).
 template <class Lattice>
-bool RayHierarchy::walk_leaf(const Lattice& g, const Ray& stored, std::uint32_t bx,
-                             std::uint32_t bz, double ta, double tb, RayHit& hit) const noexcept {
+bool RayQueries::walk_leaf(const Lattice& g, double touch_, const Ray& stored, std::uint32_t bx,
+                           std::uint32_t bz, double ta, double tb, RayHit& hit) noexcept {
   const int L = g.levels;
   Ray r = stored;  // the same ray in finest-lattice units (exact: powers of two)
   r.u0 *= g.scale, r.v0 *= g.scale, r.du *= g.scale, r.dv *= g.scale;
@@ -287,28 +268,33 @@ bool RayHierarchy::walk_leaf(const Lattice& g, const Ray& stored, std::uint32_t 
   }
 }
 
-std::optional<RayHit> RayHierarchy::raycast(const Surface& s, const glm::dvec3& origin,
-                                            const glm::dvec3& direction,
-                                            double max_distance) const noexcept {
-  return detail::with_lattice(s, [&](const auto& g) {
-    return raycast_impl(g, s.detail_bound(), origin, direction, max_distance);
+std::optional<RayHit> RayQueries::raycast(const Surface& s, const glm::dvec3& origin,
+                                          const glm::dvec3& direction,
+                                          double max_distance) noexcept {
+  return detail::with_lattice(s, [&](const auto& g) -> std::optional<RayHit> {
+    auto hit = raycast_impl(g, s, s.detail_bound(), origin, direction, max_distance);
+    if (g.missing || stored_of(g).missing) return std::nullopt;  // a page could not be loaded
+    return hit;
   });
 }
 
-std::size_t RayHierarchy::triangles_in_box(const Surface& s, const Box& box,
-                                           std::vector<SurfaceTriangle>& out,
-                                           std::size_t max_triangles) const {
+std::size_t RayQueries::triangles_in_box(const Surface& s, const Box& box,
+                                         std::vector<SurfaceTriangle>& out,
+                                         std::size_t max_triangles) {
   return detail::with_lattice(
       s, [&](const auto& g) { return boxes_impl(g, s.detail_bound(), box, out, max_triangles); });
 }
 
 // `widen`: the detail bound, metres, by which the pyramid's stored maxima are raised.
 template <class Lattice>
-std::optional<RayHit> RayHierarchy::raycast_impl(const Lattice& g, double widen,
-                                                 const glm::dvec3& origin,
-                                                 const glm::dvec3& direction,
-                                                 double max_distance) const noexcept {
-  const Heightfield& hf = g.hf;
+std::optional<RayHit> RayQueries::raycast_impl(const Lattice& g, const Surface& s, double widen,
+                                               const glm::dvec3& origin,
+                                               const glm::dvec3& direction,
+                                               double max_distance) noexcept {
+  const WorldInfo& hf = s.info();
+  const double touch_ = touch_tolerance(s);
+  const double inv_sx_ = 1.0 / hf.spacing_x, inv_sz_ = 1.0 / hf.spacing_z;
+  const Pyramid pyr{stored_of(g), detail::SurfaceAccess::store(s)};
   if (!(max_distance > 0.0)) return std::nullopt;  // also NaN
   for (int a = 0; a < 3; ++a)
     if (!std::isfinite(origin[a]) || !std::isfinite(direction[a])) return std::nullopt;
@@ -327,13 +313,13 @@ std::optional<RayHit> RayHierarchy::raycast_impl(const Lattice& g, double widen,
   r.origin = origin;
   r.dir = d;
   // Multiplied by 1 / spacing like Terrain's point queries, so both locate the same cell.
-  r.u0 = (origin.x - hf.origin_x()) * inv_sx_;
-  r.v0 = (origin.z - hf.origin_z()) * inv_sz_;
-  r.y0 = origin.y - hf.height_offset();
+  r.u0 = (origin.x - hf.origin_x) * inv_sx_;
+  r.v0 = (origin.z - hf.origin_z) * inv_sz_;
+  r.y0 = origin.y - hf.height_offset;
   r.du = d.x * inv_sx_;
   r.dv = d.z * inv_sz_;
   r.dy = d.y;
-  const double umax = hf.width() - 1.0, vmax = hf.height() - 1.0;
+  const double umax = hf.width - 1.0, vmax = hf.height - 1.0;
   RayHit hit;
 
   if (r.du == 0.0 && r.dv == 0.0) {
@@ -377,7 +363,7 @@ std::optional<RayHit> RayHierarchy::raycast_impl(const Lattice& g, double widen,
   // leaf blocks, whose cells are tested in ray order. Stepping is in integer node coordinates,
   // one axis at a time, so every node the ray touches is visited (through a corner, the side node
   // gets an empty interval) and the walk always advances.
-  const int top = static_cast<int>(levels_.size()) - 1;
+  const int top = pyr.levels() - 1;
   double t = r.t_enter;
   // Start at the lowest level whose nodes are at least as long as the ray's footprint (fewer
   // descents for short rays); the walk climbs from there if the ray crosses into another node.
@@ -389,14 +375,13 @@ std::optional<RayHit> RayHierarchy::raycast_impl(const Lattice& g, double widen,
     const int shift = l + static_cast<int>(kLeafShift);
     x = std::clamp<std::int64_t>(
         static_cast<std::int64_t>(std::clamp(r.u0 + r.du * t, 0.0, umax)) >> shift, 0,
-        levels_[l].nx - 1);
+        pyr.nx(l) - 1);
     z = std::clamp<std::int64_t>(
         static_cast<std::int64_t>(std::clamp(r.v0 + r.dv * t, 0.0, vmax)) >> shift, 0,
-        levels_[l].nz - 1);
+        pyr.nz(l) - 1);
   }
   const int step_u = r.du > 0 ? 1 : -1, step_v = r.dv > 0 ? 1 : -1;
   for (;;) {
-    const Level& level = levels_[l];
     const double size = double(std::int64_t{1} << (l + kLeafShift));
     const double ua = double(x) * size, va = double(z) * size;
     // The far edges of the last nodes may lie past the footprint: t_exit stops the ray first.
@@ -404,7 +389,8 @@ std::optional<RayHit> RayHierarchy::raycast_impl(const Lattice& g, double widen,
     const double tnu = r.du > 0 ? (ub - r.u0) * r.inv_du : r.du < 0 ? (ua - r.u0) * r.inv_du : kInf;
     const double tnv = r.dv > 0 ? (vb - r.v0) * r.inv_dv : r.dv < 0 ? (va - r.v0) * r.inv_dv : kInf;
     const double t_out = std::max(t, std::min(std::min(tnu, tnv), r.t_exit));
-    const float node_max = level.max[level.index(x, z)];
+    float node_min, node_max;
+    if (!pyr.node(l, x, z, node_min, node_max)) return std::nullopt;
     const double ylow = r.y0 + r.dy * (r.dy < 0 ? t_out : t);
     if (ylow <= double(node_max) + widen + touch_) {
       if (l > 0) {
@@ -414,22 +400,22 @@ std::optional<RayHit> RayHierarchy::raycast_impl(const Lattice& g, double widen,
         const double u = r.u0 + r.du * t, v = r.v0 + r.dv * t;
         x = 2 * x + ((u > mu || (u == mu && r.du > 0)) ? 1 : 0);
         z = 2 * z + ((v > mv || (v == mv && r.dv > 0)) ? 1 : 0);
-        x = std::min<std::int64_t>(x, levels_[l].nx - 1);
-        z = std::min<std::int64_t>(z, levels_[l].nz - 1);
+        x = std::min<std::int64_t>(x, pyr.nx(l) - 1);
+        z = std::min<std::int64_t>(z, pyr.nz(l) - 1);
         continue;
       }
-      if (walk_leaf(g, r, std::uint32_t(x), std::uint32_t(z), t, t_out, hit)) return hit;
+      if (walk_leaf(g, touch_, r, std::uint32_t(x), std::uint32_t(z), t, t_out, hit)) return hit;
     }
     // Step to the next node along the ray.
     if (t_out >= r.t_exit) return std::nullopt;
     bool climb;
     if (tnu <= tnv) {
       x += step_u;
-      if (x < 0 || x >= level.nx) return std::nullopt;
+      if (x < 0 || x >= pyr.nx(l)) return std::nullopt;
       climb = (x & 1) == (step_u > 0 ? 0 : 1);  // crossed into another parent
     } else {
       z += step_v;
-      if (z < 0 || z >= level.nz) return std::nullopt;
+      if (z < 0 || z >= pyr.nz(l)) return std::nullopt;
       climb = (z & 1) == (step_v > 0 ? 0 : 1);
     }
     t = t_out;
@@ -443,9 +429,9 @@ std::optional<RayHit> RayHierarchy::raycast_impl(const Lattice& g, double widen,
 
 // `widen` as for raycast_impl.
 template <class Lattice>
-std::size_t RayHierarchy::boxes_impl(const Lattice& g, double widen, const Box& box,
-                                     std::vector<SurfaceTriangle>& out,
-                                     std::size_t max_triangles) const {
+std::size_t RayQueries::boxes_impl(const Lattice& g, double widen, const Box& box,
+                                   std::vector<SurfaceTriangle>& out,
+                                   std::size_t max_triangles) {
   const SurfaceLattice& at = g.at;
   const int L = g.levels;
   for (int a = 0; a < 3; ++a)
@@ -468,14 +454,15 @@ std::size_t RayHierarchy::boxes_impl(const Lattice& g, double widen, const Box& 
   const std::int64_t i0 = cell_lo(ua, umax), i1 = cell_hi(ub, umax);
   const std::int64_t j0 = cell_lo(va, vmax), j1 = cell_hi(vb, vmax);
 
-  const Level& leaf = levels_.front();
+  const Pyramid pyr{stored_of(g), stored_of(g).store};
   const int shift = L + int(kLeafShift);  // cell -> leaf block of the pyramid
   std::size_t added = 0;
   for (std::int64_t cj = j0; cj <= j1; ++cj) {
     for (std::int64_t ci = i0; ci <= i1; ++ci) {
       // Blocks whose height range (widened by the detail bound) misses the box are skipped.
-      const std::size_t block = leaf.index(ci >> shift, cj >> shift);
-      if (double(leaf.max[block]) + widen < ylo || double(leaf.min[block]) - widen > yhi) {
+      float block_min, block_max;
+      if (!pyr.node(0, ci >> shift, cj >> shift, block_min, block_max)) return added;
+      if (double(block_max) + widen < ylo || double(block_min) - widen > yhi) {
         ci |= (std::int64_t{1} << shift) - 1;  // to the block's last cell
         continue;
       }

@@ -1,0 +1,702 @@
+// The tessellator's bounds of the stored diamonds, page by page (records.h).
+//
+// A diamond's error bound starts from the exact error of its triangles (the RTIN / "martini"
+// definition: the largest vertical distance between the surface and the triangle over every
+// lattice vertex under it; both are piecewise linear over the finest triangles, so the maximum is
+// at a lattice vertex) and is made nested over the diamond hierarchy, as Lindstrom & Pascucci's
+// SOAR nests its vertex errors: a diamond's bound is at least each of its four children's. With
+// nested bounding spheres the projected bound of a diamond is then never smaller than a
+// descendant's, so the set of diamonds to split is closed under the hierarchy for every camera:
+// the mesh a threshold asks for is unique.
+//
+// The sphere of a diamond is centred at its vertex at its true height; its radius is at least
+// every child's radius plus the distance to the child's centre, so it holds every lattice vertex
+// under the diamond.
+#include "roam/records.h"
+#include "world/page_store.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <thread>
+
+#include "ridgeline/detail.h"
+#include "ridgeline/log.h"
+
+namespace ridgeline::roam {
+
+namespace {
+
+// Radius of a sphere about a diamond's vertex that holds its descendants' xz positions, in units
+// of s * hypot(spacing): 3 for square diamonds, 2 for edge diamonds (each at least its children's
+// plus the distance to them: 3 >= 2 + 1, 2 >= 3/2 + 1/2).
+double xz_radius_units(const Diamond& d) noexcept { return d.square ? 3.0 : 2.0; }
+
+// Levels of diamonds below a stored diamond of size 2^t, down to the finest (detail included).
+int levels_below(int t, bool square, std::uint32_t L) noexcept {
+  return 2 * t + 2 * int(L) + (square ? 1 : 0);
+}
+
+// True when a diamond at v with reach r has every existing descendant within samples [lo, hi]
+// along one axis (descendants past the world's first sample or its padded extent do not exist).
+bool within(std::int64_t v, std::int64_t r, std::int64_t lo, std::int64_t hi,
+            std::int64_t pad) noexcept {
+  return (v - r >= lo || lo <= 0) && (v + r <= hi || hi >= pad);
+}
+
+std::int64_t floor_div(std::int64_t n, std::int64_t d) noexcept {  // d > 0
+  return n >= 0 ? n / d : -((-n + d - 1) / d);
+}
+
+using Summaries = std::function<const PageSummary&(std::int32_t, std::int32_t)>;
+
+// Exact error against the stored lattice of a triangle in stored coordinates: the largest
+// |height - plane| over the samples inside it (edge functions in integer arithmetic, the span of
+// each row found exactly). Heights past the data repeat the edge (the accessor clamps).
+template <class H>
+float exact_triangle(const H& h, const LatticeTriangle& t) noexcept {
+  const std::int64_t x0 = std::min({t.ax, t.lx, t.rx}), x1 = std::max({t.ax, t.lx, t.rx});
+  const std::int64_t z0 = std::min({t.az, t.lz, t.rz}), z1 = std::max({t.az, t.lz, t.rz});
+  const double ha = h(t.ax, t.az), hl = h(t.lx, t.lz), hr = h(t.rx, t.rz);
+  auto cross = [](std::int64_t ux, std::int64_t uz, std::int64_t vx, std::int64_t vz) {
+    return ux * vz - uz * vx;
+  };
+  const std::int64_t w = cross(t.lx - t.ax, t.lz - t.az, t.rx - t.ax, t.rz - t.az);
+  if (w == 0) return 0.0f;
+  const double inv_w = 1.0 / double(w);
+  double worst = 0.0;
+  const std::int64_t sgn = w > 0 ? 1 : -1;
+  const std::int64_t ex[3][2] = {{t.ax, t.az}, {t.lx, t.lz}, {t.rx, t.rz}};
+  const int from[3] = {0, 1, 2}, to[3] = {1, 2, 0};
+  for (std::int64_t z = z0; z <= z1; ++z) {
+    std::int64_t lo = x0, hi = x1;
+    std::int64_t coef[3], off[3];
+    for (int k = 0; k < 3; ++k) {
+      const std::int64_t px = ex[from[k]][0], pz = ex[from[k]][1];
+      const std::int64_t ux = ex[to[k]][0] - px, uz = ex[to[k]][1] - pz;
+      // e(x) = ux * (z - pz) - uz * (x - px) = a * x + c, made >= 0 inside by the sign.
+      const std::int64_t a = -uz * sgn, c = (ux * (z - pz) + uz * px) * sgn;
+      coef[k] = a, off[k] = c;
+      if (a > 0)
+        lo = std::max(lo, -floor_div(c, a));  // x >= ceil(-c / a)
+      else if (a < 0)
+        hi = std::min(hi, floor_div(c, -a));  // x <= floor(c / -a)
+      else if (c < 0)
+        lo = hi + 1;  // edge parallel to x, row outside
+    }
+    if (lo > hi) continue;
+    for (std::int64_t x = lo; x <= hi; ++x) {
+      const std::int64_t e_ab = coef[0] * x + off[0];  // edge A->L: weight of R
+      const std::int64_t e_lr = coef[1] * x + off[1];  // edge L->R: weight of A
+      const std::int64_t e_ra = coef[2] * x + off[2];  // edge R->A: weight of L
+      const double plane =
+          (double(e_lr) * ha + double(e_ra) * hl + double(e_ab) * hr) * inv_w * double(sgn);
+      worst = std::max(worst, std::abs(double(h(x, z)) - plane));
+    }
+  }
+  return round_up(worst);  // never below the double error
+}
+
+// The heights of a level-0 page by global stored index (the entries the page holds).
+struct PageHeights {
+  const world::Page& p;
+  std::int64_t i0, j0;
+  float operator()(std::int64_t i, std::int64_t j) const noexcept {
+    return p.local(std::int32_t(i - i0), std::int32_t(j - j0));
+  }
+};
+
+
+// diamond_bound() over any height accessor.
+template <class H, class Child>
+DiamondBound bound_of(const RecordConfig& c, const H& h, std::int64_t i, std::int64_t j,
+                      const Child& child) {
+  const int L = int(c.L);
+  const Diamond d = diamond_at(i, j, c.K);
+  if (L == 0 && d.t == 0 && !d.square) {
+    const bool horizontal = (i & 1) != 0;
+    return edge_bound_of(c, h(i, j), horizontal ? h(i - 1, j) : h(i, j - 1),
+                         horizontal ? h(i + 1, j) : h(i, j + 1), i, j, horizontal);
+  }
+  const std::int64_t W = c.pad_i, Hh = c.pad_j;
+  std::int64_t hx0, hz0, hx1, hz1, ax0, az0, ax1, az1;
+  d.hypotenuse(hx0, hz0, hx1, hz1);
+  d.apexes(ax0, az0, ax1, az1);
+  const std::int64_t wi = c.last_i, hj = c.last_j;
+  double err = 0;
+  bool any_data = false, straddles = false;
+  const std::int64_t apex[2][2] = {{ax0, az0}, {ax1, az1}};
+  for (const auto& a : apex) {
+    if (a[0] < 0 || a[1] < 0 || a[0] > W || a[1] > Hh) continue;
+    const LatticeTriangle t{a[0], a[1], hx0, hz0, hx1, hz1};
+    const Landscape::LatticeBox b = Landscape::box_of(t);
+    // A triangle over the data's border must split until none does: the mesh then ends on it.
+    straddles |= (b.i0 < wi && wi < b.i1) || (b.j0 < hj && hj < b.j1);
+    if (b.i0 >= wi || b.j0 >= hj) continue;  // wholly padding: not terrain, never refined
+    any_data = true;
+    double e = exact_triangle(h, t);
+    if (L > 0)
+      e += c.detail->contribution_bound(1, std::uint32_t(L), b.i0 << L, b.j0 << L, b.i1 << L,
+                                        b.j1 << L);
+    err = std::max(err, e);
+  }
+  if (!any_data) err = 0;
+  double morph = err, radius = 0;
+  const double hv = h(i, j);
+  auto visit = [&](const DiamondBound& cb, double dist) {
+    err = std::max(err, double(cb.error));
+    morph = std::max(morph, c.growth * double(cb.morph));
+    radius = std::max(radius, double(cb.radius) + dist);
+    straddles |= cb.radius >= FLT_MAX;
+  };
+  if (d.has_children()) {
+    for (int k = 0; k < 4; ++k) {
+      std::int64_t ci, cj;
+      d.child(k, ci, cj);
+      if (ci < 0 || cj < 0 || ci > W || cj > Hh) continue;
+      const double dx = double(ci - i) * c.spacing_x, dz = double(cj - j) * c.spacing_z;
+      const double dy = double(h(ci, cj)) - hv;
+      visit(child(ci, cj), std::sqrt(dx * dx + dz * dz + dy * dy));
+    }
+  } else if (L > 0) {
+    // The finest stored diamonds' children are detail diamonds at half the stored spacing (in
+    // finest coordinates, half of 2^L): their heights are only known within the detail bound.
+    const Diamond fd = diamond_at(i << L, j << L, c.K + L);
+    const double fsx = std::ldexp(c.spacing_x, -L), fsz = std::ldexp(c.spacing_z, -L);
+    for (int k = 0; k < 4; ++k) {
+      std::int64_t ci, cj;
+      fd.child(k, ci, cj);
+      if (ci < 0 || cj < 0 || ci > (W << L) || cj > (Hh << L)) continue;
+      const double dx = double(ci - (i << L)) * fsx, dz = double(cj - (j << L)) * fsz;
+      // The child's base height: the stored cell's plane at the child (a half-cell midpoint:
+      // the mean of the two stored samples at the ends of the edge or diagonal it halves).
+      const std::int64_t e0x = (ci - (std::int64_t{1} << (L - 1))) >> L;
+      const std::int64_t e1x = (ci + (std::int64_t{1} << (L - 1))) >> L;
+      const std::int64_t e0z = (cj - (std::int64_t{1} << (L - 1))) >> L;
+      const std::int64_t e1z = (cj + (std::int64_t{1} << (L - 1))) >> L;
+      const bool midx = ((ci >> (L - 1)) & 1) != 0, midz = ((cj >> (L - 1)) & 1) != 0;
+      double base;
+      if (midx && midz) {
+        // A cell's centre: the diagonal of the diagonal rule.
+        const bool main = cell_has_main_diagonal(e0x, e0z);
+        base = main ? 0.5 * (double(h(e0x, e0z)) + double(h(e1x, e1z)))
+                    : 0.5 * (double(h(e1x, e0z)) + double(h(e0x, e1z)));
+      } else if (midx) {
+        base = 0.5 * (double(h(e0x, cj >> L)) + double(h(e1x, cj >> L)));
+      } else {
+        base = 0.5 * (double(h(ci >> L, e0z)) + double(h(ci >> L, e1z)));
+      }
+      const double dy = std::abs(base - hv) + double(c.detail_offset(ci, cj));
+      visit(c.detail_child(ci, cj), std::sqrt(dx * dx + dz * dz + dy * dy));
+    }
+  }
+  if (straddles) radius = FLT_MAX;
+  return quantized(
+      {round_up(err), round_up(morph), radius >= FLT_MAX ? FLT_MAX : round_up(radius)});
+}
+
+template <class H>
+DiamondBound edge_of(const RecordConfig& c, const H& h, std::int64_t i, std::int64_t j) {
+  // No children, and no detail: the only vertex under the two triangles but their corners is
+  // the centre, on the hypotenuse. bound_of() with no children does exactly this.
+  return bound_of(c, h, i, j, [](std::int64_t, std::int64_t) { return DiamondBound{}; });
+}
+
+// The sphere of a diamond whose descendants leave its page (records.h): its xz reach plus one
+// height range `hr` of the pages under its reach per level below, grown 2 % per level so that the
+// rounding of the quantised bounds cannot break the nesting; FLT_MAX when its reach crosses the
+// data's border (conservative: every diamond whose descendants straddle it does).
+float fallback_radius(const RecordConfig& c, const Diamond& d, double hr) noexcept {
+  const std::int64_t reach = d.reach();
+  if ((d.i - reach < c.last_i && c.last_i < d.i + reach) ||
+      (d.j - reach < c.last_j && c.last_j < d.j + reach))
+    return FLT_MAX;
+  const int below = levels_below(d.t, d.square, c.L);
+  return round_up(std::pow(1.02, below + 1) *
+                  (xz_radius_units(d) * double(d.s) * std::hypot(c.spacing_x, c.spacing_z) +
+                   double(below + 1) * hr));
+}
+
+// The height range a fallback sphere uses: over every level-0 page whose samples meet the
+// diamond's reach (monotone in the reach, so a parent's is at least its children's), widened by
+// the detail.
+double fallback_range(const RecordConfig& c, const Summaries& summary, const Diamond& d) {
+  const std::int64_t r = d.reach();
+  const std::int64_t pages_x = std::max<std::int64_t>(1, (c.last_i + kPageCells - 1) >> 8);
+  const std::int64_t pages_z = std::max<std::int64_t>(1, (c.last_j + kPageCells - 1) >> 8);
+  auto page = [](std::int64_t v, std::int64_t pages) {
+    return std::clamp<std::int64_t>(floor_div(v, kPageCells), 0, pages - 1);
+  };
+  float lo = INFINITY, hi = -INFINITY;
+  for (std::int64_t pz = page(d.j - r, pages_z); pz <= page(d.j + r, pages_z); ++pz)
+    for (std::int64_t px = page(d.i - r, pages_x); px <= page(d.i + r, pages_x); ++px) {
+      const PageSummary& s = summary(std::int32_t(px), std::int32_t(pz));
+      lo = std::min(lo, s.lo), hi = std::max(hi, s.hi);
+    }
+  return double(hi) - double(lo) + (c.L > 0 ? 2.0 * c.detail->contribution_bound(1) : 0.0);
+}
+
+}  // namespace
+
+DiamondBound diamond_bound(const RecordConfig& c, const Heights& h, std::int64_t i, std::int64_t j,
+                           const std::function<DiamondBound(std::int64_t, std::int64_t)>& child) {
+  return bound_of(c, h, i, j, child);
+}
+
+DiamondBound edge_bound(const RecordConfig& c, const Heights& h, std::int64_t i, std::int64_t j) {
+  return edge_of(c, h, i, j);
+}
+
+bool at_page_border(const RecordConfig& c, std::int64_t i, std::int64_t j, int t,
+                    bool square) noexcept {
+  const std::int64_t r = (square ? 3 : 2) << t;
+  // The first sample of the page holding the diamond along an axis (world/page.h: a sample on a
+  // page edge belongs to the page that starts there, the far edge to the last page).
+  auto out = [&](std::int64_t v, std::int64_t last, std::int64_t pad) {
+    const std::int64_t pages = std::max<std::int64_t>(1, (last + kPageCells - 1) >> 8);
+    const std::int64_t v0 = std::min(v >> 8, pages - 1) << 8;
+    const std::int64_t lo = v0 - kPageApron, hi = v0 + kPageCells + kPageApron;
+    return (v - r < lo && lo - 1 >= 0) || (v + r > hi && hi + 1 <= pad);
+  };
+  return out(i, c.last_i, c.pad_i) || out(j, c.last_j, c.pad_j);
+}
+
+// ---- encoding -----------------------------------------------------------------------------------
+
+std::vector<std::uint8_t> RecordBlock::encode() const {
+  std::vector<std::uint8_t> out(8 + values.size() * 2);
+  out[0] = 'R', out[1] = 'B', out[2] = std::uint8_t(level), out[3] = edges ? 1 : 0;
+  const std::uint32_t n = std::uint32_t(values.size());
+  std::memcpy(out.data() + 4, &n, 4);
+  std::memcpy(out.data() + 8, values.data(), values.size() * 2);
+  return out;
+}
+
+std::shared_ptr<RecordBlock> RecordBlock::decode(std::uint32_t level,
+                                                 const std::vector<std::uint8_t>& in) {
+  if (in.size() < 8 || in[0] != 'R' || in[1] != 'B' || in[2] != level) return nullptr;
+  auto b = std::make_shared<RecordBlock>();
+  b->level = level;
+  b->edges = in[3] != 0;
+  std::uint32_t n;
+  std::memcpy(&n, in.data() + 4, 4);
+  if (n != 3 * slots(level, b->edges) || in.size() != 8 + std::size_t(n) * 2) return nullptr;
+  b->values.resize(n);
+  std::memcpy(b->values.data(), in.data() + 8, std::size_t(n) * 2);
+  return b;
+}
+
+// ---- level 0, from the page alone ---------------------------------------------------------------
+
+std::shared_ptr<RecordBlock> level0_block(const RecordConfig& c, const world::Page& page,
+                                          const RecordBlock& parent_block,
+                                          const world::Page& parent, const Summaries& summary) {
+  const std::int64_t i0 = std::int64_t(page.key.px) << 8, j0 = std::int64_t(page.key.pz) << 8;
+  const PageHeights h{page, i0, j0};
+  const std::int64_t pi0 = std::int64_t(parent.key.px) << 10, pj0 = std::int64_t(parent.key.pz)
+                                                                       << 10;
+  auto block = std::make_shared<RecordBlock>();
+  block->level = 0;
+  block->edges = c.L > 0;
+  block->values.assign(3 * RecordBlock::slots(0, block->edges), 0);
+  // Every t <= 1 diamond of the page and its apron whose descendants lie on the entries, finest
+  // first, into a local table (entries -2 .. 258).
+  constexpr std::int32_t lo = -kPageApron, hi = kPageCells + kPageApron;
+  thread_local std::vector<DiamondBound> local;
+  thread_local std::vector<std::uint8_t> known;
+  local.assign(kPageEntries, DiamondBound{});
+  known.assign(kPageEntries, 0);
+  auto at = [&](std::int64_t i, std::int64_t j) -> DiamondBound {
+    const std::int32_t a = std::int32_t(i - i0), b = std::int32_t(j - j0);
+    if (a < lo || b < lo || a > hi || b > hi) return DiamondBound{};
+    const std::size_t e = world::entry_index(a, b);
+    RIDGELINE_ASSERT(known[e]);
+    return local[e];
+  };
+  // Diamonds centred outside the padded extent do not exist: bound 0 (never active).
+  auto exists = [&](std::int64_t i, std::int64_t j) {
+    return i >= 0 && j >= 0 && i <= c.pad_i && j <= c.pad_j;
+  };
+  // Kinds in order: t = 0 edge, t = 0 square, t = 1 edge, t = 1 square.
+  for (int kind = 0; kind < 4; ++kind) {
+    const int t = kind / 2;
+    const bool square = (kind & 1) != 0;
+    const std::int64_t r = (square ? 3 : 2) << t;
+    for (std::int32_t b = lo; b <= hi; ++b)
+      for (std::int32_t a = lo; a <= hi; ++a) {
+        const std::int64_t i = i0 + a, j = j0 + b;
+        if (!exists(i, j)) continue;
+        const Diamond d = diamond_at(i, j, c.K);
+        if (d.corner || d.t != t || d.square != square) continue;
+        if (!within(i, r, i0 + lo, i0 + hi, c.pad_i) || !within(j, r, j0 + lo, j0 + hi, c.pad_j))
+          continue;
+        const std::size_t e = world::entry_index(a, b);
+        local[e] = bound_of(c, h, i, j, at);
+        known[e] = 1;
+      }
+  }
+  // The fallback of a diamond whose descendants leave the page (records.h): parents first.
+  std::function<DiamondBound(std::int64_t, std::int64_t)> value;
+  auto fallback = [&](std::int64_t i, std::int64_t j) -> DiamondBound {
+    const Diamond d = diamond_at(i, j, c.K);
+    const int below = levels_below(d.t, d.square, c.L);
+    const double hr = fallback_range(c, summary, d);
+    DiamondBound out{INFINITY, INFINITY, fallback_radius(c, d, hr)};
+    if (d.top) {
+      // No parents: a bound from the page's surroundings' height range.
+      out.error = round_up(hr);
+      out.morph = round_up(hr * std::pow(c.growth, below + 1));
+      return quantized(out);
+    }
+    std::int64_t ax, az, bx, bz;
+    d.apexes(ax, az, bx, bz);
+    for (const auto& p : {std::pair{ax, az}, std::pair{bx, bz}}) {
+      if (!exists(p.first, p.second)) continue;
+      const DiamondBound pb = value(p.first, p.second);
+      out.error = std::min(out.error, pb.error);
+      out.morph = std::min(out.morph, float(double(pb.morph) / c.growth));
+    }
+    if (!std::isfinite(out.error)) out.error = round_up(hr), out.morph = round_up(hr);
+    return quantized(out);
+  };
+  value = [&](std::int64_t i, std::int64_t j) -> DiamondBound {
+    const Diamond d = diamond_at(i, j, c.K);
+    if (d.t >= 2) {
+      const std::int32_t a = std::int32_t((i - pi0) >> 2), b = std::int32_t((j - pj0) >> 2);
+      RIDGELINE_ASSERT(a >= lo && b >= lo && a <= hi && b <= hi);
+      return parent_block.get(a, b);
+    }
+    return fallback(i, j);
+  };
+  for (std::int32_t b = 0; b <= kPageCells; ++b)
+    for (std::int32_t a = 0; a <= kPageCells; ++a) {
+      const std::int64_t i = i0 + a, j = j0 + b;
+      if (!exists(i, j)) continue;
+      const Diamond d = diamond_at(i, j, c.K);
+      if (d.corner || d.t >= 2) continue;
+      if (d.t == 0 && !d.square && !block->edges) continue;
+      block->set(a, b, at_page_border(c, i, j, d.t, d.square) ? fallback(i, j) : at(i, j));
+    }
+  return block;
+}
+
+// ---- every block of a whole world ------------------------------------------------------------
+
+namespace {
+
+// Bounds on the grid of stride 4^k (positions (i, j) = (4^k m, 4^k n)), quantised.
+struct StrideGrid {
+  int shift = 0;  // log2 stride
+  std::int64_t nx = 0, nz = 0, off = 0;
+  std::vector<std::uint16_t> v;  // 3 per position
+  void init(int s, std::int64_t pad_i, std::int64_t pad_j, std::int64_t offset) {
+    shift = s, off = offset;
+    nx = ((pad_i - off) >> s) + 1, nz = ((pad_j - off) >> s) + 1;
+    v.assign(std::size_t(nx) * std::size_t(nz) * 3, 0);
+  }
+  bool has(std::int64_t i, std::int64_t j) const noexcept {
+    if (i < off || j < off) return false;
+    const std::int64_t m = (i - off) >> shift, n = (j - off) >> shift;
+    return ((i - off) & ((std::int64_t{1} << shift) - 1)) == 0 &&
+           ((j - off) & ((std::int64_t{1} << shift) - 1)) == 0 && m < nx && n < nz;
+  }
+  DiamondBound get(std::int64_t i, std::int64_t j) const noexcept {
+    if (!has(i, j)) return {};
+    const std::size_t k = 3 * (std::size_t((i - off) >> shift) + std::size_t((j - off) >> shift) * std::size_t(nx));
+    return {dequantize(v[k]), dequantize(v[k + 1]), dequantize(v[k + 2])};
+  }
+  void set(std::int64_t i, std::int64_t j, const DiamondBound& b) noexcept {
+    const std::size_t k = 3 * (std::size_t((i - off) >> shift) + std::size_t((j - off) >> shift) * std::size_t(nx));
+    v[k] = quantize_up(b.error), v[k + 1] = quantize_up(b.morph), v[k + 2] = quantize_up(b.radius);
+  }
+};
+
+// Runs fn(row) for rows [0, n) on `threads` threads.
+template <class Fn>
+void parallel_rows(std::int64_t n, unsigned threads, const Fn& fn) {
+  if (threads <= 1 || n < 16) {
+    for (std::int64_t r = 0; r < n; ++r) fn(r);
+    return;
+  }
+  std::atomic<std::int64_t> next{0};
+  std::vector<std::thread> pool;
+  for (unsigned t = 0; t < threads; ++t)
+    pool.emplace_back([&] {
+      for (std::int64_t r; (r = next.fetch_add(1)) < n;) fn(r);
+    });
+  for (auto& th : pool) th.join();
+}
+
+// True nested bounds of the t = 1 square diamonds (positions 2 mod 4), with the runtime radius
+// (the fallback's where they are at a page border): what the size-4 edge diamonds nest over.
+// Computed page by page over the page and 8 samples around it.
+template <class H, class Out>
+void t1_squares(const RecordConfig& c, const world::PageGrid& g, const H& h,
+                const Summaries& summary,
+                std::int64_t pi0, std::int64_t pj0, std::int64_t pi1, std::int64_t pj1,
+                const Out& out, unsigned threads) {
+  constexpr std::int64_t m = 8;
+  const std::int64_t npx = pi1 - pi0 + 1;
+  parallel_rows((pj1 - pj0 + 1) * npx, threads, [&](std::int64_t r) {
+    const std::int64_t px = pi0 + r % npx, pz = pj0 + r / npx;
+    if (px < 0 || pz < 0 || px >= g.px[0] || pz >= g.pz[0]) return;
+    const std::int64_t i0 = (px << 8) - m, j0 = (pz << 8) - m, n = kPageCells + 1 + 2 * m;
+    std::vector<DiamondBound> local(std::size_t(n * n));
+    std::vector<std::uint8_t> known(std::size_t(n * n), 0);
+    auto at = [&](std::int64_t i, std::int64_t j) -> DiamondBound {
+      const std::int64_t a = i - i0, b = j - j0;
+      if (a < 0 || b < 0 || a >= n || b >= n) return DiamondBound{};
+      return local[std::size_t(a + b * n)];
+    };
+    for (int kind = 0; kind < 4; ++kind) {
+      const int t = kind / 2;
+      const bool square = (kind & 1) != 0;
+      const std::int64_t reach = (square ? 3 : 2) << t;
+      for (std::int64_t b = 0; b < n; ++b)
+        for (std::int64_t a = 0; a < n; ++a) {
+          const std::int64_t i = i0 + a, j = j0 + b;
+          if (i < 0 || j < 0 || i > c.pad_i || j > c.pad_j) continue;
+          const Diamond d = diamond_at(i, j, c.K);
+          if (d.corner || d.t != t || d.square != square) continue;
+          if (!within(i, reach, i0, i0 + n - 1, c.pad_i) ||
+              !within(j, reach, j0, j0 + n - 1, c.pad_j))
+            continue;
+          DiamondBound v = bound_of(c, h, i, j, at);
+          local[std::size_t(a + b * n)] = v;
+          known[std::size_t(a + b * n)] = 1;
+          // The t = 1 squares of this page's cells: stored with the runtime radius.
+          if (kind == 3 && i >= (px << 8) && j >= (pz << 8) && i < ((px + 1) << 8) &&
+              j < ((pz + 1) << 8)) {
+            if (at_page_border(c, i, j, t, square)) {
+              v.radius = fallback_radius(c, d, fallback_range(c, summary, d));
+              v = quantized(v);
+            }
+            out(i, j, v);
+          }
+        }
+    }
+  });
+  (void)g;
+}
+
+// Level k >= 1 (t = 2k, 2k + 1) bounds of the positions of `grid` inside [i0, i1] x [j0, j1]
+// whose reach meets it (all of them for a whole world), from the heights and the grids below.
+template <class H>
+void level_bounds(const RecordConfig& c, const H& h, int k, StrideGrid& grid,
+                  const StrideGrid& below_squares, std::int64_t i0, std::int64_t j0,
+                  std::int64_t i1, std::int64_t j1, unsigned threads) {
+  const std::int64_t stride = std::int64_t{1} << (2 * k);
+  for (int kind = 0; kind < 4; ++kind) {
+    const int t = 2 * k + kind / 2;
+    const bool square = (kind & 1) != 0;
+    if (t >= c.K) break;
+    const std::int64_t s = std::int64_t{1} << t, reach = (square ? 3 : 2) * s;
+    const std::int64_t a0 = std::max<std::int64_t>(0, floor_div(i0 - reach, stride));
+    const std::int64_t a1 = std::min<std::int64_t>(c.pad_i / stride, floor_div(i1 + reach, stride) + 1);
+    const std::int64_t b0 = std::max<std::int64_t>(0, floor_div(j0 - reach, stride));
+    const std::int64_t b1 = std::min<std::int64_t>(c.pad_j / stride, floor_div(j1 + reach, stride) + 1);
+    parallel_rows(b1 - b0 + 1, threads, [&](std::int64_t r) {
+      const std::int64_t b = b0 + r;
+      for (std::int64_t a = a0; a <= a1; ++a) {
+        const std::int64_t i = a * stride, j = b * stride;
+        const Diamond d = diamond_at(i, j, c.K);
+        if (d.corner || d.t != t || d.square != square) continue;
+        if (i + reach < i0 || i - reach > i1 || j + reach < j0 || j - reach > j1) continue;
+        auto child = [&](std::int64_t ci, std::int64_t cj) -> DiamondBound {
+          if (grid.has(ci, cj)) return grid.get(ci, cj);
+          return below_squares.get(ci, cj);
+        };
+        grid.set(i, j, bound_of(c, h, i, j, child));
+      }
+    });
+  }
+}
+
+// The block of level-k page `key` (k >= 1) from the grids (apron included): the diamonds whose
+// record level (record_level()) is k, each from its own level's grid.
+std::shared_ptr<RecordBlock> slice(const RecordConfig& c, const std::vector<StrideGrid>& grids,
+                                   std::uint32_t levels, const PageKey& key) {
+  auto block = std::make_shared<RecordBlock>();
+  block->level = key.level;
+  block->values.assign(3 * kPageEntries, 0);
+  const int ls = world::level_shift(key.level);
+  const std::int64_t i0 = std::int64_t(key.px) << world::page_shift(key.level);
+  const std::int64_t j0 = std::int64_t(key.pz) << world::page_shift(key.level);
+  for (std::int32_t b = -kPageApron; b <= kPageCells + kPageApron; ++b)
+    for (std::int32_t a = -kPageApron; a <= kPageCells + kPageApron; ++a) {
+      const std::int64_t i = i0 + (std::int64_t(a) << ls), j = j0 + (std::int64_t(b) << ls);
+      if (i < 0 || j < 0 || i > c.pad_i || j > c.pad_j) continue;
+      const Diamond d = diamond_at(i, j, c.K);
+      if (d.corner || record_level(d.t, levels) != key.level) continue;
+      const std::size_t g = std::size_t(d.t / 2);
+      block->set(a, b, g < grids.size() ? grids[g].get(i, j) : DiamondBound{});
+    }
+  return block;
+}
+
+
+}  // namespace
+
+void build_all(const RecordConfig& c, const world::PageGrid& grid, const Heights& h,
+               const std::function<const PageSummary&(std::int32_t, std::int32_t)>& summary,
+               const std::function<const world::Page*(const PageKey&)>& page,
+               const std::function<void(const PageKey&, std::shared_ptr<RecordBlock>)>& out,
+               unsigned threads) {
+  const Heights& dh = h;
+  // Grids of every level >= 1, coarsest last; each built from the one below.
+  const int top_level = (c.K - 1) / 2;
+  std::vector<StrideGrid> grids(std::size_t(std::max(top_level, 0)) + 1);
+  StrideGrid squares1;  // t = 1 squares
+  squares1.init(2, c.pad_i, c.pad_j, 2);
+  t1_squares(c, grid, dh, summary, 0, 0, grid.px[0] - 1, grid.pz[0] - 1,
+             [&](std::int64_t i, std::int64_t j, const DiamondBound& v) { squares1.set(i, j, v); },
+             threads);
+  for (int k = 1; k <= top_level; ++k) {
+    grids[std::size_t(k)].init(2 * k, c.pad_i, c.pad_j, 0);
+    level_bounds(c, dh, k, grids[std::size_t(k)], k == 1 ? squares1 : grids[std::size_t(k - 1)],
+                 0, 0, c.pad_i, c.pad_j, threads);
+  }
+  // Level >= 1 blocks, then level 0 (its fallbacks read level 1).
+  std::vector<std::shared_ptr<RecordBlock>> level1(grid.count(1 < grid.levels ? 1 : 0));
+  for (std::uint32_t k = 1; k < grid.levels; ++k)
+    for (std::int32_t pz = 0; pz < grid.pz[k]; ++pz)
+      for (std::int32_t px = 0; px < grid.px[k]; ++px) {
+        const PageKey key{k, px, pz};
+        std::shared_ptr<RecordBlock> b = slice(c, grids, grid.levels, key);
+        if (k == 1) level1[std::size_t(px) + std::size_t(pz) * std::size_t(grid.px[1])] = b;
+        out(key, b);
+      }
+  const std::int64_t n0 = std::int64_t(grid.count(0));
+  parallel_rows(n0, threads, [&](std::int64_t r) {
+    const std::int32_t px = std::int32_t(r % grid.px[0]), pz = std::int32_t(r / grid.px[0]);
+    const PageKey key{0, px, pz}, up{1, px >> 2, pz >> 2};
+    const world::Page* p = page(key);
+    const world::Page* pp = page(up);
+    if (p == nullptr || pp == nullptr) return;
+    const RecordBlock& pb = *level1[std::size_t(up.px) + std::size_t(up.pz) * std::size_t(grid.px[1])];
+    out(key, level0_block(c, *p, pb, *pp, summary));
+  });
+}
+
+std::vector<std::pair<PageKey, std::shared_ptr<const RecordBlock>>> remake(
+    const RecordConfig& c, const world::PageGrid& grid, const Heights& h,
+    const std::function<const PageSummary&(std::int32_t, std::int32_t)>& summary,
+    const std::function<const world::Page*(const PageKey&)>& page,
+    const std::function<const RecordBlock*(const PageKey&)>& block, std::int64_t i0,
+    std::int64_t j0, std::int64_t i1, std::int64_t j1) {
+  const Heights& dh = h;
+  // The padding repeats the edge samples: an edited edge sample moves the padding too.
+  if (i1 >= c.last_i) i1 = c.pad_i;
+  if (j1 >= c.last_j) j1 = c.pad_j;
+  std::unordered_map<PageKey, std::shared_ptr<RecordBlock>, world::PageKeyHash> fresh;
+  auto writable = [&](const PageKey& k) -> RecordBlock* {
+    if (auto it = fresh.find(k); it != fresh.end()) return it->second.get();
+    const RecordBlock* b = block(k);
+    if (b == nullptr) return nullptr;
+    auto copy = std::make_shared<RecordBlock>(*b);
+    RecordBlock* raw = copy.get();
+    fresh.emplace(k, std::move(copy));
+    return raw;
+  };
+  const int top_level = (c.K - 1) / 2;
+  // Level by level: the positions whose reach meets the change, from the current bounds (the
+  // blocks) and the heights, then written to every block holding them (aprons included).
+  // Read-modify-write through a map keyed by position (the window is small).
+  struct Window {
+    std::unordered_map<std::uint64_t, DiamondBound> v;
+    static std::uint64_t key(std::int64_t i, std::int64_t j) {
+      return (std::uint64_t(std::uint32_t(j)) << 32) | std::uint32_t(i);
+    }
+  };
+  // The current bound of a level >= 1 diamond from its block (canonical page).
+  auto stored = [&](std::int64_t i, std::int64_t j) -> DiamondBound {
+    const Diamond d = diamond_at(i, j, c.K);
+    if (d.corner) return {};
+    const std::uint32_t k = record_level(d.t, grid.levels);
+    const PageKey key = grid.page_of(k, i, j);
+    const std::int32_t a = std::int32_t((i >> (2 * k)) - (std::int64_t(key.px) << 8));
+    const std::int32_t b = std::int32_t((j >> (2 * k)) - (std::int64_t(key.pz) << 8));
+    if (auto it = fresh.find(key); it != fresh.end()) return it->second->get(a, b);
+    const RecordBlock* bl = block(key);
+    return bl ? bl->get(a, b) : DiamondBound{};
+  };
+  auto store_everywhere = [&](std::int64_t i, std::int64_t j, std::uint32_t k, const DiamondBound& v) {
+    const int ls = world::level_shift(k);
+    const std::int64_t x = i >> ls, z = j >> ls;
+    for (std::int64_t pz = std::max<std::int64_t>(0, floor_div(z - kPageCells - kPageApron + kPageCells - 1, kPageCells));
+         pz <= std::min<std::int64_t>(grid.pz[k] - 1, floor_div(z + kPageApron, kPageCells)); ++pz)
+      for (std::int64_t px = std::max<std::int64_t>(0, floor_div(x - kPageCells - kPageApron + kPageCells - 1, kPageCells));
+           px <= std::min<std::int64_t>(grid.px[k] - 1, floor_div(x + kPageApron, kPageCells)); ++px) {
+        const std::int32_t a = std::int32_t(x - (px << 8)), b = std::int32_t(z - (pz << 8));
+        if (RecordBlock* bl = writable({k, std::int32_t(px), std::int32_t(pz)})) bl->set(a, b, v);
+      }
+  };
+  // t = 1 squares near the change: true values (runtime radius) from the heights.
+  Window t1;
+  {
+    // The pages near the change (a t = 2 edge diamond reaching the change has its children
+    // within 10 samples of it).
+    const std::int64_t w = 16;
+    t1_squares(c, grid, dh, summary, std::max<std::int64_t>(0, (i0 - w) >> 8),
+               std::max<std::int64_t>(0, (j0 - w) >> 8), (i1 + w) >> 8, (j1 + w) >> 8,
+               [&](std::int64_t i, std::int64_t j, const DiamondBound& v) {
+                 t1.v[Window::key(i, j)] = v;
+               },
+               1);
+  }
+  for (int k = 1; k <= top_level; ++k) {
+    const std::int64_t stride = std::int64_t{1} << (2 * k);
+    for (int kind = 0; kind < 4; ++kind) {
+      const int t = 2 * k + kind / 2;
+      const bool square = (kind & 1) != 0;
+      if (t >= c.K) break;
+      const std::int64_t s = std::int64_t{1} << t, reach = (square ? 3 : 2) * s;
+      const std::int64_t a0 = std::max<std::int64_t>(0, floor_div(i0 - reach, stride));
+      const std::int64_t a1 = std::min<std::int64_t>(c.pad_i / stride, floor_div(i1 + reach, stride) + 1);
+      const std::int64_t b0 = std::max<std::int64_t>(0, floor_div(j0 - reach, stride));
+      const std::int64_t b1 = std::min<std::int64_t>(c.pad_j / stride, floor_div(j1 + reach, stride) + 1);
+      for (std::int64_t b = b0; b <= b1; ++b)
+        for (std::int64_t a = a0; a <= a1; ++a) {
+          const std::int64_t i = a * stride, j = b * stride;
+          const Diamond d = diamond_at(i, j, c.K);
+          if (d.corner || d.t != t || d.square != square) continue;
+          if (i + reach < i0 || i - reach > i1 || j + reach < j0 || j - reach > j1) continue;
+          auto child = [&](std::int64_t ci, std::int64_t cj) -> DiamondBound {
+            const Diamond cd = diamond_at(ci, cj, c.K);
+            if (cd.t <= 1) {
+              auto it = t1.v.find(Window::key(ci, cj));
+              return it != t1.v.end() ? it->second : DiamondBound{};
+            }
+            return stored(ci, cj);
+          };
+          store_everywhere(i, j, record_level(t, grid.levels), bound_of(c, dh, i, j, child));
+        }
+    }
+  }
+  // Level-0 pages near the change (their own diamonds, and the fallbacks that read level 1).
+  const std::int64_t w = 16;
+  for (std::int64_t pz = std::max<std::int64_t>(0, (j0 - w) >> 8);
+       pz <= std::min<std::int64_t>(grid.pz[0] - 1, (j1 + w) >> 8); ++pz)
+    for (std::int64_t px = std::max<std::int64_t>(0, (i0 - w) >> 8);
+         px <= std::min<std::int64_t>(grid.px[0] - 1, (i1 + w) >> 8); ++px) {
+      const PageKey key{0, std::int32_t(px), std::int32_t(pz)}, up{1, std::int32_t(px >> 2),
+                                                                    std::int32_t(pz >> 2)};
+      const world::Page* p = page(key);
+      const world::Page* pp = page(up);
+      if (p == nullptr || pp == nullptr) continue;
+      const RecordBlock* pb = nullptr;
+      if (auto it = fresh.find(up); it != fresh.end())
+        pb = it->second.get();
+      else
+        pb = block(up);
+      if (pb == nullptr) continue;
+      fresh[key] = level0_block(c, *p, *pb, *pp, summary);
+    }
+  std::vector<std::pair<PageKey, std::shared_ptr<const RecordBlock>>> outv;
+  outv.reserve(fresh.size());
+  for (auto& [k, b] : fresh) outv.emplace_back(k, std::move(b));
+  return outv;
+}
+
+}  // namespace ridgeline::roam

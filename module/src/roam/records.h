@@ -1,0 +1,220 @@
+// Private: the tessellator's bounds of the stored diamonds, page by page (docs/roam.md, "Error
+// bounds"; docs/worlds.md, "Bounds in pages").
+//
+// Every stored vertex that is not a patch corner is the centre of one diamond (diamond.h) with a
+// nested error bound, a nested morph bound and a nested bounding sphere (landscape.h's
+// DiamondBound). A diamond of size 2^t lives in the pages of level k = t / 2 (whose stride 4^k
+// holds its centre; the coarsest level of the world's pyramid holds every coarser diamond too),
+// as three bfloat16 values rounded up (6 bytes): conservative, and nested
+// because every bound is computed from its children's quantised values.
+//
+// - Levels >= 1 (t >= 2): the exact nested bounds, computed once from every sample under them
+//   (in memory at Landscape::create, or by the bake, which stores them in the world).
+// - Level 0 (t = 0, 1): computed from the page alone when the page arrives (records.cpp,
+//   level0_block): the exact nested bound of every diamond whose descendants lie on the page's
+//   entries (its cells and two-entry apron), and for the few whose descendants reach further (the
+//   size-2 diamonds on and next to the page's edges) a conservative fallback that stays nested:
+//   the smallest bound of their parents (the morph bound divided by the growth per level), and a
+//   sphere of their xz reach plus one height range of the page's surroundings per level below.
+//   The bounds of level 1 are computed with those spheres, so the two stay nested. Size-1 edge
+//   diamonds (t = 0, one odd coordinate; half of all diamonds) are not stored without detail:
+//   their bound is the midpoint's offset, read from three heights.
+//
+// One definition serves the terrain held in memory and the baked world, so both draw the same
+// meshes.
+#pragma once
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cfloat>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "ridgeline/landscape.h"
+#include "roam/diamond.h"
+#include "world/page.h"
+
+namespace ridgeline {
+class DetailField;
+}
+
+namespace ridgeline::roam {
+
+/// A bound quantised to 16 bits (bfloat16) rounded towards +infinity (0 stays 0; FLT_MAX and
+/// infinity become infinity).
+inline std::uint16_t quantize_up(float v) noexcept {
+  if (!(v > 0.0f)) return 0;
+  const std::uint32_t b = std::bit_cast<std::uint32_t>(v);
+  if (b >= 0x7f7f0000u) return 0x7f80;  // at or near FLT_MAX: infinity
+  return std::uint16_t((b + 0xffffu) >> 16);
+}
+inline float dequantize(std::uint16_t q) noexcept {
+  return std::bit_cast<float>(std::uint32_t(q) << 16);
+}
+/// A bound as the records hold it (each value rounded up to bfloat16).
+inline DiamondBound quantized(const DiamondBound& b) noexcept {
+  return {dequantize(quantize_up(b.error)), dequantize(quantize_up(b.morph)),
+          dequantize(quantize_up(b.radius))};
+}
+
+/// The level of the pages holding the bounds of a stored diamond of size 2^t in a pyramid of
+/// `levels` levels.
+inline std::uint32_t record_level(int t, std::uint32_t levels) noexcept {
+  return std::min(std::uint32_t(t / 2), levels - 1);
+}
+
+/// The bounds of one page's diamonds for one tessellator configuration.
+struct RecordBlock {
+  std::uint32_t level = 0;
+  /// Level 0 with detail: the size-1 edge diamonds are stored too (their children are detail
+  /// diamonds, so three heights do not give their bound).
+  bool edges = false;
+  /// Three values (error, morph, radius) per slot (slot()).
+  std::vector<std::uint16_t> values;
+
+  /// Slots of a level-0 block: both coordinates odd (128 x 128), both even (129 x 129), then,
+  /// with `edges`, odd x (128 x 129) and odd z (129 x 128). Levels >= 1: every entry (261 x 261,
+  /// apron included).
+  static constexpr std::size_t kOdd = 128 * 128, kEven = 129 * 129, kEdge = 128 * 129;
+  static std::size_t slots(std::uint32_t level, bool edges) noexcept {
+    return level > 0 ? kPageEntries : kOdd + kEven + (edges ? 2 * kEdge : 0);
+  }
+  /// Slot of entry (a, b): level 0 for a, b in 0 .. 256 (never a size-1 edge diamond without
+  /// `edges`), levels >= 1 for a, b in -2 .. 258.
+  std::size_t slot(std::int32_t a, std::int32_t b) const noexcept {
+    if (level > 0) return world::entry_index(a, b);
+    const bool oa = (a & 1) != 0, ob = (b & 1) != 0;
+    if (oa && ob) return std::size_t(a >> 1) + std::size_t(b >> 1) * 128;
+    if (!oa && !ob) return kOdd + std::size_t(a >> 1) + std::size_t(b >> 1) * 129;
+    if (oa) return kOdd + kEven + std::size_t(a >> 1) + std::size_t(b >> 1) * 128;
+    return kOdd + kEven + kEdge + std::size_t(a >> 1) + std::size_t(b >> 1) * 129;
+  }
+  DiamondBound get(std::int32_t a, std::int32_t b) const noexcept {
+    const std::uint16_t* v = values.data() + 3 * slot(a, b);
+    return {dequantize(v[0]), dequantize(v[1]), dequantize(v[2])};
+  }
+  void set(std::int32_t a, std::int32_t b, const DiamondBound& d) noexcept {
+    std::uint16_t* v = values.data() + 3 * slot(a, b);
+    v[0] = quantize_up(d.error), v[1] = quantize_up(d.morph), v[2] = quantize_up(d.radius);
+  }
+  std::size_t bytes() const noexcept { return sizeof(*this) + values.capacity() * 2; }
+  /// The block as bytes (the bake's payload) and back (checked: size and level; null when they
+  /// do not fit).
+  std::vector<std::uint8_t> encode() const;
+  static std::shared_ptr<RecordBlock> decode(std::uint32_t level, const std::vector<std::uint8_t>& b);
+};
+
+/// What the bounds depend on besides the heights (a Landscape's configuration).
+struct RecordConfig {
+  int K = 6;                      ///< patch exponent of the stored lattice
+  double growth = 1.0;            ///< the morph bound's growth per level
+  std::int64_t last_i = 0, last_j = 0;  ///< the last stored sample
+  std::int64_t pad_i = 0, pad_j = 0;    ///< the padded extent: patches * 2^K
+  double spacing_x = 1, spacing_z = 1;  ///< stored spacing, metres
+  /// Procedural detail (L > 0): the stored diamonds' bounds include it (in memory only).
+  std::uint32_t L = 0;
+  const DetailField* detail = nullptr;
+  /// Bound of a detail diamond child of a finest stored diamond, finest-lattice centre: the
+  /// landscape's closed form (set with detail).
+  std::function<DiamondBound(std::int64_t, std::int64_t)> detail_child;
+  /// |detail| bound at a finest-lattice vertex (0 at stored ones; set with detail).
+  std::function<float(std::int64_t, std::int64_t)> detail_offset;
+};
+
+/// Local heights of stored samples by global index, clamped into the data (the padding's rule):
+/// a dense row-major array (floats, or 16-bit values times `scale`), or a function.
+struct Heights {
+  const float* f32 = nullptr;
+  const std::uint16_t* u16 = nullptr;
+  double scale = 1.0;
+  std::int64_t stride = 0, last_i = 0, last_j = 0;
+  std::function<float(std::int64_t, std::int64_t)> fn;
+
+  float operator()(std::int64_t i, std::int64_t j) const {
+    i = i < 0 ? 0 : (i > last_i ? last_i : i);
+    j = j < 0 ? 0 : (j > last_j ? last_j : j);
+    if (f32) return f32[std::size_t(i) + std::size_t(j) * std::size_t(stride)];
+    if (u16)
+      return static_cast<float>(scale * double(u16[std::size_t(i) + std::size_t(j) * std::size_t(stride)]));
+    return fn(i, j);
+  }
+};
+
+/// v rounded up to a float (never below the double).
+inline float round_up(double v) noexcept {
+  float f = static_cast<float>(v);
+  if (double(f) < v) f = std::nextafter(f, INFINITY);
+  return f;
+}
+
+/// The bound of a size-1 edge diamond (t = 0, one odd coordinate) without detail, from the
+/// heights of its centre and the two ends of its hypotenuse (horizontal when i is odd): its
+/// triangles hold no other vertex, so the bound is the centre's offset from the hypotenuse's
+/// midpoint; no descendants, so a zero sphere unless it straddles the data's border. Exactly what
+/// diamond_bound() gives.
+inline DiamondBound edge_bound_of(const RecordConfig& c, float hc, float hl, float hr,
+                                  std::int64_t i, std::int64_t j, bool horizontal) noexcept {
+  const std::int64_t along = horizontal ? i : j, across = horizontal ? j : i;
+  const std::int64_t last_along = horizontal ? c.last_i : c.last_j;
+  const std::int64_t last_across = horizontal ? c.last_j : c.last_i;
+  const std::int64_t pad_across = horizontal ? c.pad_j : c.pad_i;
+  bool any = false, straddles = false;
+  for (const std::int64_t ac : {across - 1, across + 1}) {
+    if (ac < 0 || ac > pad_across) continue;
+    straddles |= along == last_along;
+    if (along - 1 >= last_along || std::min(across, ac) >= last_across) continue;
+    any = true;
+  }
+  const float err = any ? round_up(std::abs(double(hc) - 0.5 * (double(hl) + double(hr)))) : 0.0f;
+  return quantized({err, err, straddles ? FLT_MAX : 0.0f});
+}
+
+/// The exact nested bound of the stored diamond centred at (i, j) from the heights and its
+/// children's (quantised) bounds: the largest |surface - plane| of its triangles over every
+/// sample under them, nested over the children, with its sphere (FLT_MAX when it straddles the
+/// data's border).
+DiamondBound diamond_bound(const RecordConfig& c, const Heights& h, std::int64_t i, std::int64_t j,
+                           const std::function<DiamondBound(std::int64_t, std::int64_t)>& child);
+
+/// The bound of a size-1 edge diamond (t = 0, one odd coordinate) without detail: its
+/// midpoint's offset (what diamond_bound() gives, from three heights).
+DiamondBound edge_bound(const RecordConfig& c, const Heights& h, std::int64_t i, std::int64_t j);
+
+/// True when the diamond at (i, j) (t <= 1) has descendants beyond the entries of its level-0
+/// page (its bound is then the fallback): its reach leaves the page's entries on a side where
+/// diamonds exist (inside the padded extent), not past the world's first or last samples.
+bool at_page_border(const RecordConfig& c, std::int64_t i, std::int64_t j, int t,
+                    bool square) noexcept;
+
+/// The level-0 block of `page` (computed from the page alone): `parent` is the level-1 page
+/// above it (its block for this configuration in `parent_block`), `summary(px, pz)` the level-0
+/// pages' summaries (always resident).
+std::shared_ptr<RecordBlock> level0_block(
+    const RecordConfig& c, const world::Page& page, const RecordBlock& parent_block,
+    const world::Page& parent,
+    const std::function<const PageSummary&(std::int32_t, std::int32_t)>& summary);
+
+/// Every block of a world held whole (in memory, or by the bake): level-1 and coarser blocks
+/// from the exact nested bounds, then the level-0 blocks. `h`: the heights; `summary(px, pz)`:
+/// level-0 page summaries. Calls `out(key, block)` for every page of every level (from several
+/// threads at once, `threads` of them).
+void build_all(const RecordConfig& c, const world::PageGrid& grid, const Heights& h,
+               const std::function<const PageSummary&(std::int32_t, std::int32_t)>& summary,
+               const std::function<const world::Page*(const PageKey&)>& page,
+               const std::function<void(const PageKey&, std::shared_ptr<RecordBlock>)>& out,
+               unsigned threads);
+
+/// After the stored samples [i0, i1] x [j0, j1] changed: the new blocks of every page whose
+/// bounds may have changed (coarse levels from the exact nested bounds, level 0 from the page).
+/// `block(key)` gives the current block of a page, `page(key)` the page (with its new samples).
+std::vector<std::pair<PageKey, std::shared_ptr<const RecordBlock>>> remake(
+    const RecordConfig& c, const world::PageGrid& grid, const Heights& h,
+    const std::function<const PageSummary&(std::int32_t, std::int32_t)>& summary,
+    const std::function<const world::Page*(const PageKey&)>& page,
+    const std::function<const RecordBlock*(const PageKey&)>& block, std::int64_t i0,
+    std::int64_t j0, std::int64_t i1, std::int64_t j1);
+
+}  // namespace ridgeline::roam

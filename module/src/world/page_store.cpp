@@ -1,0 +1,767 @@
+// A terrain's pages (world/page_store.h): the resident set and its snapshots, the cache that
+// pages a world in, pins, edits and the tessellator's record slots.
+//
+// The cache follows the detail cache's design (detail.h): requests are queued (urgent first),
+// loaded by workers or the engine's executor with no lock held, integrated and evicted (LRU,
+// under a byte budget) in update(), and published as an immutable snapshot that readers use
+// without a lock. A page's missing ancestors are loaded with it, coarsest first (the
+// tessellator's bounds of a page need its parent's).
+#include "world/page_store.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "format.h"
+#include "ridgeline/heightfield.h"
+#include "ridgeline/log.h"
+
+namespace ridgeline::world {
+
+using detail::fmt;
+
+struct PageStore::Cache {
+  std::size_t budget = 0;  // 0: nothing is evicted (a terrain made in memory)
+  bool synchronous = true;
+  std::function<void(std::function<void()>)> executor;
+
+  mutable std::mutex mu;
+  std::condition_variable work_cv, idle_cv;
+  bool stop = false;
+  std::vector<std::thread> workers;
+
+  struct Entry {
+    std::shared_ptr<const Page> page;
+    std::list<PageKey>::iterator lru;
+    std::uint32_t pins = 0;
+    bool forever = false;  // coarse levels and every page of a terrain made in memory
+    std::size_t bytes = 0;
+  };
+  std::unordered_map<PageKey, Entry, PageKeyHash> resident;
+  std::list<PageKey> lru;  // front: most recently used
+  std::deque<PageKey> queue;
+  std::unordered_set<PageKey, PageKeyHash> pending;  // queued or loading
+  std::unordered_set<PageKey, PageKeyHash> failed;   // the source refused: not asked again
+  std::vector<std::shared_ptr<const Page>> done;     // loaded, waiting for update()
+  std::size_t in_flight = 0;
+  std::size_t bytes = 0;
+  WorldStats stats;
+
+  std::shared_ptr<const Page> available(const PageKey& k) const {
+    if (auto it = resident.find(k); it != resident.end()) return it->second.page;
+    for (const auto& p : done)
+      if (p->key == k) return p;
+    return nullptr;
+  }
+  void touch(Entry& e) { lru.splice(lru.begin(), lru, e.lru); }
+  std::size_t page_bytes(const Page& p, const PageStore& s) const {
+    std::size_t b = p.memory_bytes();
+    for (std::size_t k = 0; k < kRecordSlots; ++k)
+      if (p.records[k] && s.makers_[k]) b += s.makers_[k]->bytes(*p.records[k]);
+    return b;
+  }
+  // Puts a page in the resident set (replacing an older version). Holds mu.
+  void insert(const std::shared_ptr<const Page>& p, const PageStore& s, bool forever) {
+    auto it = resident.find(p->key);
+    if (it != resident.end()) {
+      bytes -= it->second.bytes;
+      it->second.page = p;
+      it->second.forever |= forever || p->edited;
+      it->second.bytes = page_bytes(*p, s);
+      bytes += it->second.bytes;
+      touch(it->second);
+      return;
+    }
+    lru.push_front(p->key);
+    Entry e{p, lru.begin(), 0, forever || p->edited, page_bytes(*p, s)};
+    bytes += e.bytes;
+    resident.emplace(p->key, std::move(e));
+    pending.erase(p->key);
+  }
+  std::vector<std::shared_ptr<const Page>> all() const {
+    std::vector<std::shared_ptr<const Page>> v;
+    v.reserve(resident.size());
+    for (const auto& [k, e] : resident) v.push_back(e.page);
+    return v;
+  }
+};
+
+namespace {
+
+std::int64_t floor_div(std::int64_t n, std::int64_t d) noexcept {  // d > 0
+  return n >= 0 ? n / d : -((-n + d - 1) / d);
+}
+
+// Size of a page's samples as a source must deliver them.
+Status check_page_data(const WorldInfo& info, const PageKey& key, const PageData& d) {
+  const bool u16 = info.format == SampleFormat::kU16;
+  const std::size_t n = u16 ? d.u16.size() : d.f32.size();
+  if (n != kPageEntries || (u16 ? !d.f32.empty() : !d.u16.empty()))
+    return Error{fmt("%s: page (%u, %d, %d) holds %zu %s heights; need %zu", info.name.c_str(),
+                     key.level, key.px, key.pz, n, u16 ? "16-bit" : "float", kPageEntries)};
+  if (!d.materials.empty() && d.materials.size() != kPageEntries)
+    return Error{fmt("%s: page (%u, %d, %d) holds %zu material ids; need %zu", info.name.c_str(),
+                     key.level, key.px, key.pz, d.materials.size(), kPageEntries)};
+  if (!u16)
+    for (float v : d.f32)
+      if (!std::isfinite(v) || std::abs(v) > kMaxRelativeHeight)
+        return Error{fmt("%s: page (%u, %d, %d) holds the height %s", info.name.c_str(), key.level,
+                         key.px, key.pz, detail::num(v).c_str())};
+  return {};
+}
+
+}  // namespace
+
+// ---- creation ---------------------------------------------------------------------------------
+
+std::shared_ptr<PageStore> PageStore::from_heightfield(const Heightfield& hf, WorldInfo info) {
+  std::shared_ptr<PageStore> s(new PageStore());
+  s->info_ = std::move(info);
+  s->grid_ = PageGrid::of(hf.width(), hf.height());
+  s->cache_ = std::make_shared<Cache>();
+  const bool u16 = s->info_.format == SampleFormat::kU16;
+  std::vector<std::shared_ptr<const Page>> pages;
+  std::vector<std::uint64_t> hashes(s->grid_.count(0));
+  for (std::uint32_t k = 0; k < s->grid_.levels; ++k)
+    for (std::int32_t pz = 0; pz < s->grid_.pz[k]; ++pz)
+      for (std::int32_t px = 0; px < s->grid_.px[k]; ++px) {
+        auto p = std::make_shared<Page>();
+        p->key = {k, px, pz};
+        p->set_samples(samples_from(hf, p->key, u16), s->info_.height_scale);
+        if (k == 0) {
+          p->rays = make_rays(*p);
+          hashes[std::size_t(px) + std::size_t(pz) * std::size_t(s->grid_.px[0])] =
+              hash_page(*p, s->grid_, s->info_.has_materials);
+        }
+        pages.push_back(std::move(p));
+      }
+  s->info_.content_hash = combine_hashes(hash_header(s->info_), hashes);
+  s->summaries_.resize(s->grid_.count(0));
+  for (std::int32_t pz = 0; pz < s->grid_.pz[0]; ++pz)
+    for (std::int32_t px = 0; px < s->grid_.px[0]; ++px)
+      s->summaries_[std::size_t(px) + std::size_t(pz) * std::size_t(s->grid_.px[0])] =
+          summarize(s->grid_, px, pz,
+                    [&](std::int64_t i, std::int64_t j) { return hf.local(std::uint32_t(i), std::uint32_t(j)); });
+  s->rebuild_upper(0, 0, s->grid_.px[0] - 1, s->grid_.pz[0] - 1);
+  for (const auto& p : pages) s->cache_->insert(p, *s, true);
+  s->snapshot_ = std::make_shared<PageTable>(s->grid_);
+  s->publish(pages, {});
+  return s;
+}
+
+Result<std::shared_ptr<PageStore>> PageStore::open(std::shared_ptr<const PageSource> source,
+                                                   const WorldCacheDesc& desc) {
+  if (!source) return Error{"world: no page source given"};
+  const WorldInfo& info = source->info();
+  if (info.width < 2 || info.height < 2)
+    return Error{fmt("%s: %u x %u samples; need at least 2 x 2", info.name.c_str(), info.width,
+                     info.height)};
+  if (desc.budget_bytes < (std::size_t{4} << 20))
+    return Error{fmt("world cache: budget of %zu bytes; need at least 4 MiB (WorldCacheDesc::"
+                     "budget_bytes, ridge --cache-mb)",
+                     desc.budget_bytes)};
+  if (desc.worker_threads > 64)
+    return Error{fmt("world cache: %u worker threads; need 0..64", desc.worker_threads)};
+  std::shared_ptr<PageStore> s(new PageStore());
+  s->info_ = info;
+  s->source_ = std::move(source);
+  s->baked_ = s->source_->baked_records();
+  s->grid_ = PageGrid::of(info.width, info.height);
+  if (auto st = s->source_->summaries(s->summaries_); !st) return Error{st.message()};
+  if (s->summaries_.size() != s->grid_.count(0))
+    return Error{fmt("%s: %zu page summaries; need %zu", info.name.c_str(), s->summaries_.size(),
+                     s->grid_.count(0))};
+  s->rebuild_upper(0, 0, s->grid_.px[0] - 1, s->grid_.pz[0] - 1);
+  auto c = std::make_shared<Cache>();
+  c->budget = desc.budget_bytes;
+  c->executor = desc.executor;
+  c->synchronous = !desc.executor && desc.worker_threads == 0;
+  c->stats.budget_bytes = desc.budget_bytes;
+  s->cache_ = c;
+  s->snapshot_ = std::make_shared<PageTable>(s->grid_);
+  // The coarse levels: every page of the top `resident_levels` levels, pinned, as long as they
+  // stay within 16 MiB (about 40 pages).
+  std::vector<std::shared_ptr<const Page>> top;
+  std::size_t planned = 0;
+  for (std::uint32_t r = 0; r < desc.resident_levels && r < s->grid_.levels; ++r) {
+    const std::uint32_t k = s->grid_.levels - 1 - r;
+    planned += s->grid_.count(k);
+    if (planned > 40) break;
+    for (std::int32_t pz = 0; pz < s->grid_.pz[k]; ++pz)
+      for (std::int32_t px = 0; px < s->grid_.px[k]; ++px) {
+        const PageKey key{k, px, pz};
+        PageData d;
+        if (auto st = s->source_->load(key, d); !st) return Error{st.message()};
+        if (auto st = check_page_data(info, key, d); !st) return Error{st.message()};
+        auto p = s->make_page(key, std::move(d), [&](const PageKey& q) -> const Page* {
+          for (const auto& t : top)
+            if (t->key == q) return t.get();
+          return nullptr;
+        });
+        top.push_back(p);
+      }
+  }
+  {
+    std::lock_guard lock(c->mu);
+    for (const auto& p : top) c->insert(p, *s, true);
+    c->stats.loaded += top.size();
+  }
+  s->publish(top, {});
+  if (!c->synchronous && !c->executor) {
+    PageStore* raw = s.get();
+    for (std::uint32_t t = 0; t < desc.worker_threads; ++t)
+      c->workers.emplace_back([raw] {
+        Cache& cc = *raw->cache_;
+        for (;;) {
+          PageKey key;
+          {
+            std::unique_lock lock(cc.mu);
+            cc.work_cv.wait(lock, [&] { return cc.stop || !cc.queue.empty(); });
+            if (cc.stop) return;
+            key = cc.queue.front();
+            cc.queue.pop_front();
+            ++cc.in_flight;
+          }
+          auto pages = raw->load_chain(key);
+          std::lock_guard lock(cc.mu);
+          for (auto& p : pages)
+            if (!cc.resident.count(p->key)) cc.done.push_back(std::move(p));
+          if (pages.empty()) cc.pending.erase(key);
+          --cc.in_flight;
+          if (cc.queue.empty() && cc.in_flight == 0) cc.idle_cv.notify_all();
+        }
+      });
+  }
+  return s;
+}
+
+std::shared_ptr<PageStore> PageStore::clone() const {
+  std::shared_ptr<PageStore> s(new PageStore());
+  s->info_ = info_;
+  s->grid_ = grid_;
+  s->source_ = source_;
+  s->baked_ = baked_;
+  s->summaries_ = summaries_;
+  s->upper_ = upper_;
+  auto c = std::make_shared<Cache>();
+  {
+    std::lock_guard lock(cache_->mu);
+    c->budget = cache_->budget;
+    c->stats.budget_bytes = cache_->budget;
+    for (const auto& [k, e] : cache_->resident) c->insert(e.page, *this, e.forever || e.pins > 0);
+  }
+  s->cache_ = c;
+  s->snapshot_ = snapshot();
+  s->generation_.store(s->snapshot_->generation(), std::memory_order_release);
+  return s;
+}
+
+PageStore::~PageStore() {
+  if (!cache_) return;
+  {
+    std::lock_guard lock(cache_->mu);
+    cache_->stop = true;
+  }
+  cache_->work_cv.notify_all();
+  for (std::thread& t : cache_->workers) t.join();
+}
+
+// ---- snapshots ----------------------------------------------------------------------------------
+
+void PageStore::publish(const std::vector<std::shared_ptr<const Page>>& changed,
+                        const std::vector<PageKey>& removed) const {
+  static std::atomic<std::uint64_t> next_generation{1};
+  // One publisher at a time; what goes in is checked against the resident set under its lock,
+  // so a page evicted (or replaced) since it was made never reaches the table.
+  std::lock_guard lock(snapshot_mu_);
+  std::vector<std::shared_ptr<const Page>> all, put;
+  std::vector<PageKey> gone;
+  {
+    std::lock_guard clock(cache_->mu);
+    all = cache_->all();
+    for (const auto& p : changed)
+      if (auto it = cache_->resident.find(p->key);
+          it != cache_->resident.end() && it->second.page == p)
+        put.push_back(p);
+    for (const PageKey& k : removed)
+      if (!cache_->resident.count(k)) gone.push_back(k);
+  }
+  const std::uint64_t g = next_generation.fetch_add(1, std::memory_order_relaxed);
+  snapshot_ = snapshot_->with(put, gone, std::move(all), g);
+  generation_.store(g, std::memory_order_release);
+}
+
+std::shared_ptr<const PageTable> PageStore::snapshot() const {
+  std::lock_guard lock(snapshot_mu_);
+  return snapshot_;
+}
+
+const PageTable& PageStore::current() const {
+  // One snapshot per thread, refreshed when the store publishes (generations are unique across
+  // stores, so a thread that alternates between terrains refreshes each time).
+  thread_local std::uint64_t generation = 0;
+  thread_local std::shared_ptr<const PageTable> table;
+  const std::uint64_t g = generation_.load(std::memory_order_acquire);
+  if (g != generation || !table) {
+    table = snapshot();
+    generation = table->generation();
+  }
+  return *table;
+}
+
+// ---- loading ------------------------------------------------------------------------------------
+
+std::shared_ptr<const Page> PageStore::make_page(
+    const PageKey& key, PageData&& d, const std::function<const Page*(const PageKey&)>& find) const {
+  auto p = std::make_shared<Page>();
+  p->key = key;
+  auto samples = std::make_shared<PageSamples>();
+  samples->u16 = std::move(d.u16);
+  samples->f32 = std::move(d.f32);
+  samples->materials = std::move(d.materials);
+  p->set_samples(std::move(samples), info_.height_scale);
+  if (key.level == 0) p->rays = make_rays(*p);
+  if (!d.records.empty())
+    p->baked = std::make_shared<const std::vector<std::uint8_t>>(std::move(d.records));
+  for (std::size_t k = 0; k < kRecordSlots; ++k)
+    if (makers_[k]) p->records[k] = makers_[k]->make(*p, find);
+  return p;
+}
+
+std::vector<std::shared_ptr<const Page>> PageStore::load_chain(const PageKey& key) const {
+  const auto t0 = std::chrono::steady_clock::now();
+  // The page and its ancestors up to the first one available, coarsest loaded first.
+  std::vector<PageKey> chain{key};
+  std::vector<std::shared_ptr<const Page>> known;  // resident or loaded ancestors
+  {
+    std::lock_guard lock(cache_->mu);
+    if (auto p = cache_->available(key)) return {};
+    if (cache_->failed.count(key)) return {};
+    PageKey k = key;
+    while (k.level + 1 < grid_.levels) {
+      k = {k.level + 1, k.px >> 2, k.pz >> 2};
+      if (auto p = cache_->available(k)) {
+        known.push_back(p);
+        break;
+      }
+      chain.push_back(k);
+    }
+  }
+  std::vector<std::shared_ptr<const Page>> made;
+  auto find = [&](const PageKey& q) -> const Page* {
+    for (const auto& p : made)
+      if (p->key == q) return p.get();
+    for (const auto& p : known)
+      if (p->key == q) return p.get();
+    return current().find(q);
+  };
+  std::string error;
+  for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+    PageData d;
+    Status st = source_->load(*it, d);
+    if (st) st = check_page_data(info_, *it, d);
+    if (!st) {
+      error = st.message();
+      std::lock_guard lock(cache_->mu);
+      if (cache_->failed.insert(*it).second) {
+        ++cache_->stats.failed;
+        log_message(LogLevel::kError, error);
+      }
+      break;
+    }
+    made.push_back(make_page(*it, std::move(d), find));
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::lock_guard lock(cache_->mu);
+  cache_->stats.loaded += made.size();
+  cache_->stats.load_seconds += seconds;
+  return made;
+}
+
+const Page* PageStore::require(const PageKey& key, std::shared_ptr<const PageTable>& keep) const {
+  keep = snapshot();
+  if (const Page* p = keep->find(key)) return p;
+  if (!source_) return nullptr;
+  std::vector<std::shared_ptr<const Page>> pages;
+  {
+    std::unique_lock lock(cache_->mu);
+    // Loaded by a worker and waiting for update(): integrate it now.
+    for (auto it = cache_->done.begin(); it != cache_->done.end();)
+      if ((*it)->key.level >= key.level) {
+        pages.push_back(*it);
+        it = cache_->done.erase(it);
+      } else {
+        ++it;
+      }
+  }
+  bool have = false;
+  for (const auto& p : pages) have |= p->key == key;
+  if (!have) {
+    auto loaded = load_chain(key);
+    std::lock_guard lock(cache_->mu);
+    if (!loaded.empty()) ++cache_->stats.sync_loads;
+    for (auto& p : loaded) pages.push_back(std::move(p));
+  }
+  if (pages.empty()) return nullptr;
+  {
+    std::lock_guard lock(cache_->mu);
+    for (const auto& p : pages) cache_->insert(p, *this, false);
+  }
+  publish(pages, {});
+  keep = snapshot();
+  return keep->find(key);
+}
+
+std::size_t PageStore::request(std::span<const PageKey> keys, bool urgent) const {
+  if (!source_) return keys.size();
+  Cache& c = *cache_;
+  std::size_t resident = 0, queued = 0;
+  std::vector<PageKey> sync;
+  {
+    std::lock_guard lock(c.mu);
+    for (const PageKey& k : keys) {
+      if (auto it = c.resident.find(k); it != c.resident.end()) {
+        c.touch(it->second);
+        ++resident;
+        continue;
+      }
+      if (c.pending.count(k) || c.failed.count(k)) continue;
+      c.pending.insert(k);
+      if (c.synchronous) {
+        sync.push_back(k);
+        continue;
+      }
+      if (urgent)
+        c.queue.push_front(k);
+      else
+        c.queue.push_back(k);
+      ++queued;
+    }
+  }
+  for (const PageKey& k : sync) {
+    auto pages = load_chain(k);
+    std::lock_guard lock(c.mu);
+    for (auto& p : pages) c.done.push_back(std::move(p));
+    if (pages.empty()) c.pending.erase(k);
+  }
+  if (queued > 0) {
+    if (c.executor) {
+      for (std::size_t n = 0; n < queued; ++n) {
+        std::weak_ptr<Cache> weak = cache_;
+        const PageStore* self = this;
+        // The job takes the front key when it runs; a store destroyed meanwhile leaves it
+        // nothing to do.
+        c.executor([weak, self] {
+          auto cc = weak.lock();
+          if (!cc) return;
+          PageKey key;
+          {
+            std::lock_guard lock(cc->mu);
+            if (cc->stop || cc->queue.empty()) return;
+            key = cc->queue.front();
+            cc->queue.pop_front();
+            ++cc->in_flight;
+          }
+          auto pages = self->load_chain(key);
+          std::lock_guard lock(cc->mu);
+          for (auto& p : pages) cc->done.push_back(std::move(p));
+          if (pages.empty()) cc->pending.erase(key);
+          --cc->in_flight;
+          if (cc->queue.empty() && cc->in_flight == 0) cc->idle_cv.notify_all();
+        });
+      }
+    } else if (queued == 1) {
+      c.work_cv.notify_one();
+    } else {
+      c.work_cv.notify_all();
+    }
+  }
+  return resident;
+}
+
+void PageStore::update(std::size_t max_integrations) const {
+  if (!source_) return;
+  Cache& c = *cache_;
+  std::vector<std::shared_ptr<const Page>> changed;
+  std::vector<PageKey> removed;
+  {
+    std::lock_guard lock(c.mu);
+    std::size_t n = 0;
+    while (!c.done.empty() && (max_integrations == 0 || n < max_integrations)) {
+      auto p = std::move(c.done.front());
+      c.done.erase(c.done.begin());
+      if (!c.resident.count(p->key)) {
+        c.insert(p, *this, false);
+        changed.push_back(std::move(p));
+        ++n;
+      }
+    }
+    // Least recently used first; pinned, edited and coarse pages stay.
+    for (auto it = c.lru.end(); c.bytes > c.budget && it != c.lru.begin();) {
+      --it;
+      auto e = c.resident.find(*it);
+      if (e->second.forever || e->second.pins > 0) continue;
+      c.bytes -= e->second.bytes;
+      removed.push_back(*it);
+      c.resident.erase(e);
+      it = c.lru.erase(it);
+      ++c.stats.evicted;
+    }
+  }
+  if (!changed.empty() || !removed.empty()) publish(changed, removed);
+}
+
+bool PageStore::wait_idle(double timeout_seconds) const {
+  std::unique_lock lock(cache_->mu);
+  return cache_->idle_cv.wait_for(lock, std::chrono::duration<double>(timeout_seconds), [&] {
+    return cache_->queue.empty() && cache_->in_flight == 0;
+  });
+}
+
+void PageStore::pin(std::span<const PageKey> keys) const {
+  std::shared_ptr<const PageTable> keep;
+  for (const PageKey& k : keys) {
+    require(k, keep);
+    std::lock_guard lock(cache_->mu);
+    if (auto it = cache_->resident.find(k); it != cache_->resident.end()) ++it->second.pins;
+  }
+}
+
+void PageStore::unpin(std::span<const PageKey> keys) const {
+  std::lock_guard lock(cache_->mu);
+  for (const PageKey& k : keys)
+    if (auto it = cache_->resident.find(k); it != cache_->resident.end() && it->second.pins > 0)
+      --it->second.pins;
+}
+
+WorldStats PageStore::stats() const {
+  std::lock_guard lock(cache_->mu);
+  WorldStats s = cache_->stats;
+  s.resident_pages = cache_->resident.size();
+  s.resident_bytes = cache_->bytes;
+  s.pending = cache_->pending.size();
+  for (const auto& [k, e] : cache_->resident) {
+    s.pinned_pages += (e.forever || e.pins > 0) ? 1 : 0;
+    s.resident_samples += std::size_t(kPageCells) * kPageCells;
+  }
+  return s;
+}
+
+// ---- record slots -------------------------------------------------------------------------------
+
+int PageStore::add_slot(std::shared_ptr<const RecordMaker> maker) {
+  for (std::size_t k = 0; k < kRecordSlots; ++k)
+    if (!makers_[k]) {
+      makers_[k] = std::move(maker);
+      return int(k);
+    }
+  return -1;
+}
+
+void PageStore::remove_slot(int slot) {
+  if (slot < 0 || std::size_t(slot) >= kRecordSlots) return;
+  std::vector<std::shared_ptr<const Page>> changed;
+  {
+    std::lock_guard lock(cache_->mu);
+    for (auto& [k, e] : cache_->resident) {
+      if (!e.page->records[std::size_t(slot)]) continue;
+      auto p = e.page->copy();
+      p->records[std::size_t(slot)] = nullptr;
+      cache_->bytes -= e.bytes;
+      e.page = p;
+      e.bytes = e.page->memory_bytes();
+      cache_->bytes += e.bytes;
+      changed.push_back(e.page);
+    }
+    makers_[std::size_t(slot)] = nullptr;
+  }
+  if (!changed.empty()) publish(changed, {});
+}
+
+const RecordMaker* PageStore::maker(int slot) const noexcept {
+  return slot >= 0 && std::size_t(slot) < kRecordSlots ? makers_[std::size_t(slot)].get()
+                                                         : nullptr;
+}
+
+void PageStore::set_records(
+    int slot,
+    const std::vector<std::pair<PageKey, std::shared_ptr<const roam::RecordBlock>>>& blocks) {
+  std::vector<std::shared_ptr<const Page>> changed;
+  {
+    std::lock_guard lock(cache_->mu);
+    for (const auto& [key, block] : blocks) {
+      auto it = cache_->resident.find(key);
+      if (it == cache_->resident.end()) continue;
+      auto p = it->second.page->copy();
+      p->records[std::size_t(slot)] = block;
+      std::shared_ptr<const Page> cp = std::move(p);
+      cache_->insert(cp, *this, it->second.forever);
+      changed.push_back(std::move(cp));
+    }
+  }
+  if (!changed.empty()) publish(changed, {});
+}
+
+// ---- the pyramid above pages --------------------------------------------------------------------
+
+void PageStore::rebuild_upper(std::int32_t px0, std::int32_t pz0, std::int32_t px1,
+                              std::int32_t pz1) {
+  if (upper_.empty()) {
+    RayLevel l;
+    l.nx = grid_.px[0], l.nz = grid_.pz[0];
+    l.max.resize(std::size_t(l.nx) * l.nz), l.min.resize(l.max.size());
+    upper_.push_back(std::move(l));
+    while (upper_.back().nx > 1 || upper_.back().nz > 1) {
+      RayLevel u;
+      u.nx = (upper_.back().nx + 1) / 2, u.nz = (upper_.back().nz + 1) / 2;
+      u.max.resize(std::size_t(u.nx) * u.nz), u.min.resize(u.max.size());
+      upper_.push_back(std::move(u));
+    }
+  }
+  for (std::int32_t z = pz0; z <= pz1; ++z)
+    for (std::int32_t x = px0; x <= px1; ++x) {
+      const PageSummary& s = summary(x, z);
+      const std::size_t k = std::size_t(x) + std::size_t(z) * upper_[0].nx;
+      upper_[0].min[k] = s.lo, upper_[0].max[k] = s.hi;
+    }
+  for (std::size_t l = 1; l < upper_.size(); ++l) {
+    px0 >>= 1, px1 >>= 1, pz0 >>= 1, pz1 >>= 1;
+    const RayLevel& b = upper_[l - 1];
+    RayLevel& u = upper_[l];
+    for (std::int32_t z = pz0; z <= pz1; ++z)
+      for (std::int32_t x = px0; x <= px1; ++x) {
+        float lo = INFINITY, hi = -INFINITY;
+        for (int c = 0; c < 4; ++c) {
+          const std::int32_t cx = 2 * x + (c & 1), cz = 2 * z + (c >> 1);
+          if (cx >= b.nx || cz >= b.nz) continue;
+          const std::size_t k = std::size_t(cx) + std::size_t(cz) * b.nx;
+          lo = std::min(lo, b.min[k]), hi = std::max(hi, b.max[k]);
+        }
+        const std::size_t k = std::size_t(x) + std::size_t(z) * u.nx;
+        u.min[k] = lo, u.max[k] = hi;
+      }
+  }
+}
+
+// ---- edits --------------------------------------------------------------------------------------
+
+std::unique_ptr<PageEdit> PageStore::begin_edit() { return std::make_unique<PageEdit>(*this); }
+
+Page& PageEdit::writable(const PageKey& key) {
+  if (auto it = pages_.find(key); it != pages_.end()) return *it->second;
+  const Page* cur = store_.require(key, keep_);
+  RIDGELINE_ASSERT(cur != nullptr);
+  auto p = cur->copy();
+  // Edited pages hold floats.
+  auto s = std::make_shared<PageSamples>();
+  s->f32.resize(kPageEntries);
+  for (std::size_t e = 0; e < kPageEntries; ++e) s->f32[e] = cur->local(e);
+  s->materials = cur->samples->materials;
+  p->set_samples(s, cur->scale);
+  p->edited = true;
+  samples_[key] = s;
+  pages_[key] = p;
+  touched_[key] = {kPageCells + kPageApron, kPageCells + kPageApron, -kPageApron, -kPageApron};
+  return *p;
+}
+
+float PageEdit::height(std::int64_t i, std::int64_t j) {
+  const PageKey key = store_.grid().page_of(0, i, j);
+  const std::int32_t a = std::int32_t(i - (std::int64_t(key.px) << 8));
+  const std::int32_t b = std::int32_t(j - (std::int64_t(key.pz) << 8));
+  if (auto it = pages_.find(key); it != pages_.end()) return it->second->local(a, b);
+  const Page* p = store_.require(key, keep_);
+  return p ? p->local(a, b) : 0.0f;
+}
+
+void PageEdit::write(std::int64_t i, std::int64_t j, float h) {
+  const PageGrid& g = store_.grid();
+  for (std::uint32_t k = 0; k < g.levels; ++k) {
+    const int ls = level_shift(k);
+    const std::int64_t stride = std::int64_t{1} << ls;
+    // The positions (in this level's entries) whose clamped sample is (i, j): the sample itself
+    // when it lies on the stride, and the padding past the first and last samples.
+    auto positions = [&](std::int64_t v, std::int64_t last, std::int32_t pages) {
+      std::vector<std::int64_t> out;
+      if ((v & (stride - 1)) == 0) out.push_back(v >> ls);
+      if (v == 0) out.insert(out.end(), {-1, -2});
+      if (v == last) {
+        const std::int64_t end = std::int64_t(pages) * kPageCells + kPageApron;
+        for (std::int64_t m = (last >> ls) + 1; m <= end; ++m) out.push_back(m);
+      }
+      return out;
+    };
+    const auto xs = positions(i, g.last_i, g.px[k]);
+    const auto zs = positions(j, g.last_j, g.pz[k]);
+    for (std::int64_t z : zs)
+      for (std::int64_t x : xs) {
+        // Pages whose entries -2 .. 258 hold position x: 256 px in x - 258 .. x + 2.
+        const auto first = [](std::int64_t v) {
+          return std::int32_t(std::max<std::int64_t>(0, floor_div(v - kPageCells - kPageApron + kPageCells - 1, kPageCells)));
+        };
+        const auto last = [](std::int64_t v, std::int32_t pages) {
+          return std::int32_t(std::min<std::int64_t>(pages - 1, floor_div(v + kPageApron, kPageCells)));
+        };
+        const std::int32_t px0 = first(x), px1 = last(x, g.px[k]);
+        const std::int32_t pz0 = first(z), pz1 = last(z, g.pz[k]);
+        for (std::int32_t pz = pz0; pz <= pz1; ++pz)
+          for (std::int32_t px = px0; px <= px1; ++px) {
+            const std::int32_t a = std::int32_t(x - std::int64_t(px) * kPageCells);
+            const std::int32_t b = std::int32_t(z - std::int64_t(pz) * kPageCells);
+            if (a < -kPageApron || b < -kPageApron || a > kPageCells + kPageApron ||
+                b > kPageCells + kPageApron)
+              continue;
+            const PageKey key{k, px, pz};
+            writable(key);
+            samples_[key]->f32[entry_index(a, b)] = h;
+            auto& t = touched_[key];
+            t[0] = std::min(t[0], a), t[1] = std::min(t[1], b);
+            t[2] = std::max(t[2], a), t[3] = std::max(t[3], b);
+          }
+      }
+  }
+  WorldInfo& info = store_.info_;
+  info.min_local = std::min(info.min_local, h);
+  info.max_local = std::max(info.max_local, h);
+}
+
+std::vector<PageKey> PageEdit::commit() {
+  std::vector<std::shared_ptr<const Page>> changed;
+  std::vector<PageKey> level0;
+  std::int32_t px0 = INT32_MAX, pz0 = INT32_MAX, px1 = -1, pz1 = -1;
+  for (auto& [key, page] : pages_) {
+    if (key.level == 0) {
+      const auto& t = touched_[key];
+      auto rays = std::make_shared<PageRays>(*page->rays);
+      update_rays(*rays, *page, t[0], t[1], t[2], t[3]);
+      page->rays = std::move(rays);
+      level0.push_back(key);
+      px0 = std::min(px0, key.px), px1 = std::max(px1, key.px);
+      pz0 = std::min(pz0, key.pz), pz1 = std::max(pz1, key.pz);
+    }
+    changed.push_back(page);
+  }
+  {
+    std::lock_guard lock(store_.cache_->mu);
+    for (const auto& p : changed) store_.cache_->insert(p, store_, true);
+  }
+  store_.publish(changed, {});
+  // Summaries of every page whose widened region holds a changed sample (exact: read back).
+  if (px1 >= 0) {
+    const PageGrid& g = store_.grid_;
+    const std::int32_t sx0 = std::max(0, px0 - 1), sx1 = std::min(g.px[0] - 1, px1 + 1);
+    const std::int32_t sz0 = std::max(0, pz0 - 1), sz1 = std::min(g.pz[0] - 1, pz1 + 1);
+    for (std::int32_t pz = sz0; pz <= sz1; ++pz)
+      for (std::int32_t px = sx0; px <= sx1; ++px)
+        store_.summaries_[std::size_t(px) + std::size_t(pz) * std::size_t(g.px[0])] =
+            summarize(g, px, pz, [&](std::int64_t i, std::int64_t j) { return height(i, j); });
+    store_.rebuild_upper(sx0, sz0, sx1, sz1);
+  }
+  pages_.clear();
+  samples_.clear();
+  touched_.clear();
+  return level0;
+}
+
+}  // namespace ridgeline::world
