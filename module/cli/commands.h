@@ -14,6 +14,9 @@ struct Command {
 
 /// `ridge info`: size, extent, height range, memory, filled samples, content hash (JSON).
 Command add_info_command(CLI::App& parent);
+/// `ridge bake --out WORLD`: a heightmap, several files or a generated world baked into a world
+/// file (JSON report).
+Command add_bake_command(CLI::App& parent);
 /// `ridge query --points IN.csv`: height and face normal per point (CSV).
 Command add_query_command(CLI::App& parent);
 /// `ridge profile --from X,Z --to X,Z --steps N`: a text profile with an ASCII plot.

@@ -62,6 +62,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   std::vector<Command> commands;
   commands.push_back(add_info_command(app));
+  commands.push_back(add_bake_command(app));
   commands.push_back(add_query_command(app));
   commands.push_back(add_profile_command(app));
   commands.push_back(add_mesh_command(app));

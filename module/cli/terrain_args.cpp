@@ -10,17 +10,42 @@
 #include "ridgeline/edit.h"
 #include "ridgeline/io.h"
 #include "ridgeline/log.h"
+#include "ridgeline/world_file.h"
 
 namespace ridgeline::cli {
 
 void TerrainArgs::add_to(CLI::App& app) {
   app_ = &app;
   const std::string g = "Terrain";
-  auto* hm = app.add_option("--heightmap", heightmap_,
+  auto* hm = app.add_option("--heightmap", heightmaps_,
                             "Heightmap file: 8/16-bit greyscale PNG, 16-bit or float TIFF, float "
-                            "EXR, or headerless raw (with --raw-size, --raw-type)")
+                            "EXR, or headerless raw (with --raw-size, --raw-type). Repeat it for a "
+                            "world of several files (placed by --layout, or by their GeoTIFF "
+                            "georeferencing)")
                  ->type_name("FILE")
                  ->group(g);
+  auto* wd = app.add_option("--world", world_,
+                            "A baked world (made by ridge bake --out WORLD), paged in under "
+                            "--cache-mb")
+                 ->type_name("WORLD")
+                 ->group(g);
+  app.add_option("--layout", layout_,
+                 "Files of a world of several --heightmap files as a grid of COLS x ROWS, given "
+                 "row by row (default: by their georeferencing)")
+      ->type_name("COLSxROWS")
+      ->group(g);
+  app.add_flag("--unshared-edges", unshared_edges_,
+               "Neighbouring --heightmap files abut instead of repeating their shared edge")
+      ->group(g);
+  app.add_option("--cache-mb", cache_mb_,
+                 "Memory budget of a baked world's pages in MiB, >= 4 (default 192)")
+      ->type_name("MB")
+      ->group(g);
+  app.add_option("--cache-workers", cache_workers_,
+                 "Threads loading a baked world's pages, 0..64 (default 0 for the tools: a page "
+                 "is loaded when first needed)")
+      ->type_name("N")
+      ->group(g);
   auto* dt = app.add_flag("--default-terrain", default_terrain_,
                           "Use the built-in default terrain (1025 x 1025 samples, 2 m spacing, "
                           "seed 1337)")
@@ -32,11 +57,16 @@ void TerrainArgs::add_to(CLI::App& app) {
       ->group(g);
   hm->excludes(dt);
   dt->excludes(hm);
+  wd->excludes(hm);
+  wd->excludes(dt);
+  hm->excludes(wd);
+  dt->excludes(wd);
   // A terrain source is required: a usage error (exit 2) found after parsing, after --help.
   app.parse_complete_callback([this] {
-    if (!given("--heightmap") && !default_terrain_)
-      throw CLI::RequiredError("no terrain given: pass --heightmap FILE or --default-terrain",
-                               CLI::ExitCodes::RequiredError);
+    if (!given("--heightmap") && !given("--world") && !default_terrain_)
+      throw CLI::RequiredError(
+          "no terrain given: pass --heightmap FILE, --world WORLD or --default-terrain",
+          CLI::ExitCodes::RequiredError);
   });
   app.add_option("--raw-size", raw_size_, "Size of a raw heightmap in samples")
       ->type_name("W,H")
@@ -75,7 +105,7 @@ void TerrainArgs::add_to(CLI::App& app) {
       ->group(g);
   app.add_option("--max-samples", max_samples_,
                  "Refuse heightmaps of more samples than N, checked before allocating (default "
-                 "268435456 = 2^28)")
+                 "268468225 = 16385 x 16385; bake larger maps with ridge bake)")
       ->type_name("N")
       ->group(g);
   app.add_option("--channel", channel_,
@@ -138,7 +168,11 @@ bool TerrainArgs::given(const char* flag) const {
 }
 
 std::string TerrainArgs::source() const {
-  return default_terrain_ ? std::string("default terrain") : heightmap_;
+  if (default_terrain_) return "default terrain";
+  if (given("--world")) return world_;
+  std::string s;
+  for (const std::string& h : heightmaps_) s += (s.empty() ? "" : " + ") + h;
+  return s;
 }
 
 namespace {
@@ -213,11 +247,36 @@ Result<HeightfieldDesc> TerrainArgs::placement() const {
   return d;
 }
 
+namespace {
+
+// A size cap's message with the flag that raises it.
+Error with_cap_hint(Error e) {
+  if (e.message.find("max_samples") != std::string::npos)
+    e.message += "; raise it with --max-samples N, or bake the map with ridge bake for a world "
+                 "larger than memory";
+  return e;
+}
+
+}  // namespace
+
 Result<Heightfield> TerrainArgs::load_heightfield(io::LoadReport* report) const {
+  auto hf = load_heightfield_uncapped(report);
+  if (!hf) return with_cap_hint(hf.error());
+  return hf;
+}
+
+Result<Heightfield> TerrainArgs::load_heightfield_uncapped(io::LoadReport* report) const {
+  if (given("--world"))
+    return Error{"--world: a baked world is paged in, not loaded as one heightfield (this "
+                 "command needs --heightmap or --default-terrain)"};
   if (!given("--heightmap") && !default_terrain_)
-    return Error{"no terrain given: pass --heightmap FILE or --default-terrain"};
+    return Error{"no terrain given: pass --heightmap FILE, --world WORLD or --default-terrain"};
   auto desc = placement();
   if (!desc) return desc.error();
+  for (const char* flag : {"--cache-mb", "--cache-workers"})
+    if (given(flag)) return Error{std::string(flag) + " applies to --world"};
+  if ((given("--layout") || given("--unshared-edges")) && heightmaps_.size() < 2)
+    return Error{"--layout and --unshared-edges apply to a world of several --heightmap files"};
 
   if (given("--default-size") && !default_terrain_)
     return Error{"--default-size applies to --default-terrain"};
@@ -234,6 +293,9 @@ Result<Heightfield> TerrainArgs::load_heightfield(io::LoadReport* report) const 
     HeightfieldDesc d = *desc;
     d.width = d.height = params.size;
     d.name = "default terrain";
+    // A placement flag changes only what it names: the terrain keeps its 2 m spacing unless
+    // --spacing is given.
+    if (!given("--spacing")) d.spacing_x = d.spacing_z = params.spacing;
     // The cap and the placement are checked before the terrain is generated.
     if (auto s = validate_heightfield_desc(d); !s) return Error{s.message()};
     auto base = make_default_heightfield(params);
@@ -264,6 +326,16 @@ Result<Heightfield> TerrainArgs::load_heightfield(io::LoadReport* report) const 
     options.channel = static_cast<int>(*c);
   }
   if (!given("--raw-size") && given("--raw-type")) return Error{"--raw-type needs --raw-size W,H"};
+  io::TileLayout layout;
+  layout.shared_edges = !unshared_edges_;
+  if (given("--layout")) {
+    unsigned c = 0, r = 0;
+    char x = 0, extra = 0;
+    if (std::sscanf(layout_.c_str(), "%u%c%u%c", &c, &x, &r, &extra) != 3 || (x != 'x' && x != 'X') ||
+        c == 0 || r == 0)
+      return Error{"--layout '" + layout_ + "': expected COLSxROWS, e.g. 2x3"};
+    layout.columns = c, layout.rows = r;
+  }
   if (given("--raw-size")) {
     io::RawFormat raw;
     auto size = parse_finite_list(raw_size_, "--raw-size", 2, 2);
@@ -275,7 +347,7 @@ Result<Heightfield> TerrainArgs::load_heightfield(io::LoadReport* report) const 
     raw.height = static_cast<std::uint32_t>((*size)[1]);
     std::string type = raw_type_;
     if (!given("--raw-type")) {
-      const std::string ext = std::filesystem::path(heightmap_).extension().string();
+      const std::string ext = std::filesystem::path(heightmaps_[0]).extension().string();
       if (ext == ".r16") type = "u16";
       if (ext == ".r32") type = "f32";
     }
@@ -283,9 +355,12 @@ Result<Heightfield> TerrainArgs::load_heightfield(io::LoadReport* report) const 
     auto t = io::parse_raw_type(type);
     if (!t) return Error{"--raw-type: " + t.error().message};
     raw.type = *t;
-    return io::load_raw(heightmap_, raw, options, report);
+    if (heightmaps_.size() == 1) return io::load_raw(heightmaps_[0], raw, options, report);
+    return io::load_tiles(heightmaps_, options, layout, &raw, report);
   }
-  return io::load_heightmap(heightmap_, options, nullptr, report);
+  if (heightmaps_.size() == 1)
+    return io::load_heightmap(heightmaps_[0], options, nullptr, report);
+  return io::load_tiles(heightmaps_, options, layout, nullptr, report);
 }
 
 Result<DetailParams> TerrainArgs::detail_params() const {
@@ -334,10 +409,45 @@ Result<DetailParams> TerrainArgs::detail_params() const {
 }
 
 Result<std::shared_ptr<Terrain>> TerrainArgs::load_terrain(io::LoadReport* report) const {
-  auto hf = load_heightfield(report);
-  if (!hf) return hf.error();
   auto detail = detail_params();
   if (!detail) return detail.error();
+  if (given("--world")) {
+    // A baked world: its own placement and heights; detail is not baked into worlds.
+    for (const char* flag : {"--spacing", "--height-scale", "--height-offset", "--origin",
+                             "--nodata", "--fill", "--max-samples", "--channel", "--materials",
+                             "--raw-size", "--raw-type", "--layout", "--unshared-edges"})
+      if (given(flag))
+        return Error{std::string(flag) + " does not apply to --world (the world carries its "
+                                         "own placement and heights)"};
+    if (detail->levels > 0)
+      return Error{"--detail-levels: procedural detail over a baked world is not supported; use "
+                   "--heightmap for a terrain with detail"};
+    WorldCacheDesc desc;
+    desc.worker_threads = 0;
+    if (given("--cache-mb")) {
+      auto v = parse_count(cache_mb_, "--cache-mb", 4, 1u << 22);
+      if (!v) return v.error();
+      desc.budget_bytes = std::size_t(*v) << 20;
+    }
+    if (given("--cache-workers")) {
+      auto v = parse_count(cache_workers_, "--cache-workers", 0, 64);
+      if (!v) return v.error();
+      desc.worker_threads = std::uint32_t(*v);
+    }
+    auto source = io::open_world(world_);
+    if (!source) return source.error();
+    auto t = Terrain::open(std::move(*source), desc);
+    if (!t) return t.error();
+    if (report != nullptr) report->pixel_type = (*t)->info().format == SampleFormat::kU16 ? "uint16 (baked)" : "float (baked)";
+    std::shared_ptr<Terrain> terrain = std::move(*t);
+    if (given("--load")) {
+      auto r = load_edits(*terrain, load_);
+      if (!r) return Error{"--load: " + r.error().message};
+    }
+    return terrain;
+  }
+  auto hf = load_heightfield(report);
+  if (!hf) return hf.error();
   DetailCacheDesc cache;
   cache.worker_threads = 0;  // tools: synchronous, reproducible
   if (given("--detail-budget-mb")) {

@@ -144,4 +144,57 @@ std::vector<Camera> noise_circle() {
   return frames;
 }
 
+// ---- generated worlds ------------------------------------------------------------------------
+
+namespace {
+
+// A value in [-1, 1) per lattice point of octave o.
+inline float lattice_value(std::int64_t x, std::int64_t y, std::uint32_t seed) {
+  std::uint64_t h = std::uint64_t(x) * 0x9e3779b97f4a7c15ull ^ std::uint64_t(y) * 0xc2b2ae3d27d4eb4full ^
+                    std::uint64_t(seed) * 0x165667b19e3779f9ull;
+  h ^= h >> 29;
+  h *= 0xbf58476d1ce4e5b9ull;
+  h ^= h >> 32;
+  return float(std::int32_t(std::uint32_t(h) >> 8) - (1 << 23)) * (1.0f / float(1 << 23));
+}
+
+}  // namespace
+
+void generated_world_rows(std::uint32_t width, std::uint32_t j0, std::uint32_t j1,
+                          std::uint32_t seed, std::uint16_t* out) {
+  constexpr int kOctaves = 12;
+  std::vector<float> row(width);
+  for (std::uint32_t j = j0; j < j1; ++j) {
+    std::fill(row.begin(), row.end(), 600.0f);
+    float amp = 550.0f;
+    for (int o = 0; o < kOctaves; ++o) {
+      const int shift = 13 - o;  // wavelength 2^shift samples
+      const std::int64_t lj = std::int64_t(j) >> shift;
+      const float fy = float(j & ((1u << shift) - 1)) / float(1u << shift);
+      const float ty = fy * fy * (3.0f - 2.0f * fy);
+      const std::uint32_t s = seed * 131u + std::uint32_t(o);
+      // The two lattice rows around j blended at j, one value per lattice column, then along
+      // the row.
+      const std::int64_t cols = (std::int64_t(width) >> shift) + 2;
+      std::vector<float> col(static_cast<std::size_t>(cols));
+      for (std::int64_t c = 0; c < cols; ++c) {
+        const float v0 = lattice_value(c, lj, s), v1 = lattice_value(c, lj + 1, s);
+        col[std::size_t(c)] = v0 + (v1 - v0) * ty;
+      }
+      for (std::uint32_t i = 0; i < width; ++i) {
+        const std::int64_t c = std::int64_t(i) >> shift;
+        const float fx = float(i & ((1u << shift) - 1)) / float(1u << shift);
+        const float tx = fx * fx * (3.0f - 2.0f * fx);
+        const float v = col[std::size_t(c)] + (col[std::size_t(c + 1)] - col[std::size_t(c)]) * tx;
+        row[i] += amp * (o == 3 ? (1.0f - 2.0f * std::abs(v)) : v);
+      }
+      amp *= o < 2 ? 0.5f : 0.55f;
+    }
+    for (std::uint32_t i = 0; i < width; ++i) {
+      const float v = std::nearbyint(row[i] / float(kWorldHeightScale));
+      out[std::size_t(j - j0) * width + i] = std::uint16_t(std::clamp(v, 0.0f, 65535.0f));
+    }
+  }
+}
+
 }  // namespace ridgeline::scenes

@@ -8,7 +8,7 @@ RIDGELINE_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 # GLFW, Dear ImGui, EGL and Mesa's software renderer; xvfb + xauth give it a display in CI.
 RIDGELINE_PACKAGES=(
   g++ cmake ninja-build pkg-config git ca-certificates
-  libglm-dev libopenimageio-dev libtinygltf-dev nlohmann-json3-dev libcli11-dev
+  libglm-dev libopenimageio-dev libtinygltf-dev nlohmann-json3-dev libcli11-dev libdeflate-dev
   libgtest-dev libbenchmark-dev liblua5.4-dev lua5.4
   libglfw3-dev libimgui-dev libegl-dev libgl1-mesa-dri libegl-mesa0 libglx-mesa0
   xvfb xauth

@@ -20,6 +20,9 @@ namespace ridgeline {
 /// common GDAL one) is replaced by the fill policy before the check.
 inline constexpr double kMaxRelativeHeight = 1e5;
 
+/// HeightfieldDesc::max_samples's default: 16385 x 16385 samples.
+inline constexpr std::uint64_t kDefaultMaxSamples = std::uint64_t{16385} * 16385;
+
 /// What to do with samples that are non-finite or equal to the no-data value.
 enum class FillPolicy {
   kRefuse,    ///< creation fails, naming the first bad sample (the default)
@@ -40,9 +43,10 @@ struct HeightfieldDesc {
   std::optional<double> nodata;  ///< raw value that marks a missing sample
   FillPolicy fill = FillPolicy::kRefuse;
   double fill_constant = 0.0;  ///< raw value used by FillPolicy::kConstant; finite
-  /// Refuse sizes above this many samples (checked before allocating). Default 2^28 (1 GiB of
-  /// float heights).
-  std::uint64_t max_samples = std::uint64_t{1} << 28;
+  /// Refuse sizes above this many samples (checked before allocating). Default 16385 x 16385
+  /// (268,468,225: the largest usual 2^k + 1 map that a terrain in memory holds comfortably,
+  /// about 1 GiB of float heights); larger worlds are baked (ridgeline/world_file.h) and paged.
+  std::uint64_t max_samples = kDefaultMaxSamples;
   /// Name used in error messages (a file name, "default terrain", ...).
   std::string name = "heightfield";
 };

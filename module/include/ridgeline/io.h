@@ -128,4 +128,24 @@ Result<RawType> parse_raw_type(const std::string& text);
 Result<Heightfield> load_heightmap(const std::string& path, const LoadOptions& options,
                                    const RawFormat* raw = nullptr, LoadReport* report = nullptr);
 
+/// How the files of a world made of several heightmaps lie (load_tiles()).
+struct TileLayout {
+  /// An explicit grid: `columns` x `rows` files, given row by row (the first row at the smallest
+  /// z). 0 x 0: place every file by its own georeferencing (projected GeoTIFFs).
+  std::uint32_t columns = 0, rows = 0;
+  /// Neighbouring files repeat their shared edge of samples (the usual DEM convention: a 1025-
+  /// sample tile shares its last row with the next one's first); false: they abut.
+  bool shared_edges = true;
+};
+
+/// Loads the files of one world and joins them into one Heightfield: placed by `layout` (or by
+/// their georeferencing), each loaded as load_heightmap() does with `options` (the size cap
+/// applies to the joined field). Refused, naming the files: different spacings, height scales
+/// or offsets, a mixture of files with and without materials, files off the common sample grid,
+/// shared samples that disagree, and holes. 16-bit input stays 16-bit. One file and no layout:
+/// load_heightmap().
+Result<Heightfield> load_tiles(const std::vector<std::string>& paths, const LoadOptions& options,
+                               const TileLayout& layout, const RawFormat* raw = nullptr,
+                               LoadReport* report = nullptr);
+
 }  // namespace ridgeline::io

@@ -183,7 +183,8 @@ class RoamView {
   /// invalid camera (nothing changes then).
   Result<RoamStats> update(const Camera& camera);
 
-  /// Converges fully for a static camera (no time budget): what `ridge mesh` uses.
+  /// Converges fully for a static camera (no time budget): what `ridge mesh` uses. On a paged
+  /// world it waits for the pages the mesh needs (updating again until none is missing).
   Result<RoamStats> converge(const Camera& camera);
 
   const Landscape& landscape() const noexcept { return *landscape_; }

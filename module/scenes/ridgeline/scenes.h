@@ -69,4 +69,18 @@ Result<Heightfield> noise_field();
 /// highest stored height, looking along the circle and 0.35 rad down; 90 degrees, 1024 x 1024.
 std::vector<Camera> noise_circle();
 
+// ---- generated worlds for the world benchmark ---------------------------------------------------
+// Value-noise fBm whose features are set in samples, not stretched to the size: 12 octaves of
+// wavelength 8,192 samples down to 4 (amplitude 550 m halving, then 0.55 per octave), plus a
+// ridged octave at 1,024: any size shows the same kind of ground everywhere, as a real DEM does.
+// Stored as 16-bit values of 2 cm (heights 0 .. 1,310 m).
+
+inline constexpr double kWorldHeightScale = 0.02;  ///< metres per stored value
+
+/// Rows [j0, j1) of a generated world `width` samples wide: row-major 16-bit values into `out`
+/// ((j1 - j0) * width of them). Deterministic (integer hashing, float arithmetic in a fixed
+/// order): the same values on every machine, whatever rows a call covers.
+void generated_world_rows(std::uint32_t width, std::uint32_t j0, std::uint32_t j1,
+                          std::uint32_t seed, std::uint16_t* out);
+
 }  // namespace ridgeline::scenes

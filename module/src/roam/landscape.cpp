@@ -398,13 +398,7 @@ Result<std::shared_ptr<const Landscape>> Landscape::create(std::shared_ptr<const
                        num(baked.morph_delay).c_str(), K, num(desc.morph_window).c_str(),
                        num(desc.morph_delay).c_str())};
   }
-  if (K == 0) {
-    // 6, raised until there are at most 64 patches per side.
-    K = 6;
-    while (K < 10 && ((std::int64_t(info.width - 1) + (std::int64_t{1} << K) - 1) >> K > 64 ||
-                      (std::int64_t(info.height - 1) + (std::int64_t{1} << K) - 1) >> K > 64))
-      ++K;
-  }
+  if (K == 0) K = roam::default_patch_exponent(info.width, info.height);
   std::shared_ptr<Landscape> l(new Landscape());
   l->terrain_ = std::move(terrain);
   l->exponent_ = K;

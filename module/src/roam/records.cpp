@@ -542,7 +542,7 @@ void build_all(const RecordConfig& c, const world::PageGrid& grid, const Heights
                const std::function<const PageSummary&(std::int32_t, std::int32_t)>& summary,
                const std::function<const world::Page*(const PageKey&)>& page,
                const std::function<void(const PageKey&, std::shared_ptr<RecordBlock>)>& out,
-               unsigned threads) {
+               unsigned threads, bool level0) {
   const Heights& dh = h;
   // Grids of every level >= 1, coarsest last; each built from the one below.
   const int top_level = (c.K - 1) / 2;
@@ -567,6 +567,7 @@ void build_all(const RecordConfig& c, const world::PageGrid& grid, const Heights
         if (k == 1) level1[std::size_t(px) + std::size_t(pz) * std::size_t(grid.px[1])] = b;
         out(key, b);
       }
+  if (!level0) return;
   const std::int64_t n0 = std::int64_t(grid.count(0));
   parallel_rows(n0, threads, [&](std::int64_t r) {
     const std::int32_t px = std::int32_t(r % grid.px[0]), pz = std::int32_t(r / grid.px[0]);

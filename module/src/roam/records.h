@@ -143,6 +143,17 @@ struct Heights {
   }
 };
 
+/// The patch exponent a Landscape takes when asked for the world's (LandscapeDesc 0) and the
+/// bake's default: 6 (65 x 65 samples), raised until there are at most 64 patches per side (at
+/// most 10).
+inline std::uint32_t default_patch_exponent(std::uint32_t width, std::uint32_t height) noexcept {
+  std::uint32_t K = 6;
+  while (K < 10 && ((std::int64_t(width - 1) + (std::int64_t{1} << K) - 1) >> K > 64 ||
+                    (std::int64_t(height - 1) + (std::int64_t{1} << K) - 1) >> K > 64))
+    ++K;
+  return K;
+}
+
 /// v rounded up to a float (never below the double).
 inline float round_up(double v) noexcept {
   float f = static_cast<float>(v);
@@ -198,14 +209,15 @@ std::shared_ptr<RecordBlock> level0_block(
     const std::function<const PageSummary&(std::int32_t, std::int32_t)>& summary);
 
 /// Every block of a world held whole (in memory, or by the bake): level-1 and coarser blocks
-/// from the exact nested bounds, then the level-0 blocks. `h`: the heights; `summary(px, pz)`:
-/// level-0 page summaries. Calls `out(key, block)` for every page of every level (from several
-/// threads at once, `threads` of them).
+/// from the exact nested bounds, then (with `level0`) the level-0 blocks. `h`: the heights;
+/// `summary(px, pz)`: level-0 page summaries; `page(key)`: the pages (level 0 and 1, for the
+/// level-0 blocks). Calls `out(key, block)` for every page of every level (from several threads
+/// at once, `threads` of them).
 void build_all(const RecordConfig& c, const world::PageGrid& grid, const Heights& h,
                const std::function<const PageSummary&(std::int32_t, std::int32_t)>& summary,
                const std::function<const world::Page*(const PageKey&)>& page,
                const std::function<void(const PageKey&, std::shared_ptr<RecordBlock>)>& out,
-               unsigned threads);
+               unsigned threads, bool level0 = true);
 
 /// After the stored samples [i0, i1] x [j0, j1] changed: the new blocks of every page whose
 /// bounds may have changed (coarse levels from the exact nested bounds, level 0 from the page).

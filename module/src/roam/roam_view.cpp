@@ -107,6 +107,14 @@ Result<RoamStats> RoamView::converge(const Camera& camera) {
   s.budget_ms = 0;
   (void)set_settings(s);
   auto r = update(camera);
+  // On a paged world, splits that waited for pages go on once the pages are loaded.
+  const world::PageStore& store = detail::SurfaceAccess::store(landscape_->terrain().surface());
+  for (int round = 0; r && r->requested_pages > 0 && round < 256; ++round) {
+    store.wait_idle(60.0);
+    auto next = update(camera);
+    if (next) next->update_ms += r->update_ms;
+    r = next;
+  }
   (void)set_settings(saved);
   return r;
 }

@@ -18,8 +18,9 @@ Status validate_heightfield_desc(const HeightfieldDesc& d) {
     return Error{fmt("%s: %u x %u samples; need at least 2 x 2", n.c_str(), d.width, d.height)};
   const std::uint64_t count = std::uint64_t{d.width} * d.height;
   if (count > d.max_samples)
-    return Error{fmt("%s: %u x %u = %llu samples exceeds the limit of %llu samples", n.c_str(),
-                     d.width, d.height, static_cast<unsigned long long>(count),
+    return Error{fmt("%s: %u x %u = %llu samples exceeds the limit of %llu samples "
+                     "(HeightfieldDesc::max_samples)",
+                     n.c_str(), d.width, d.height, static_cast<unsigned long long>(count),
                      static_cast<unsigned long long>(d.max_samples))};
   auto positive = [&](double v, const char* what) -> Status {
     if (!std::isfinite(v) || v <= 0.0)

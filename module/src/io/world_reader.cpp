@@ -1,0 +1,263 @@
+// The baked world's reader (world_file.h, world_format.h): a PageSource over a world file.
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+
+#include "format.h"
+#include "io/world_format.h"
+#include "ridgeline/world_file.h"
+#include "world/page.h"
+
+namespace ridgeline::io {
+
+using detail::fmt;
+using namespace world_file;
+
+namespace {
+
+class WorldSource final : public PageSource {
+ public:
+  ~WorldSource() override {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  const WorldInfo& info() const noexcept override { return info_; }
+  BakedRecords baked_records() const noexcept override { return baked_; }
+  Status summaries(std::vector<PageSummary>& out) const override {
+    out = summaries_;
+    return {};
+  }
+  Status load(const PageKey& key, PageData& out) const override;
+
+  static Result<std::shared_ptr<const PageSource>> open(const std::string& path);
+
+ private:
+  Status read_at(std::uint64_t offset, void* into, std::size_t n) const;
+  std::string name_;
+  int fd_ = -1;
+  std::uint64_t file_bytes_ = 0;
+  WorldInfo info_;
+  BakedRecords baked_;
+  world::PageGrid grid_;
+  std::vector<PageSummary> summaries_;
+  std::vector<std::size_t> level_first_;  // index of each level's first page
+  std::vector<PageEntry> pages_;
+};
+
+Status WorldSource::read_at(std::uint64_t offset, void* into, std::size_t n) const {
+  auto* p = static_cast<std::uint8_t*>(into);
+  std::size_t done = 0;
+  while (done < n) {
+    const ssize_t r = ::pread(fd_, p + done, n - done, off_t(offset + done));
+    if (r < 0 && errno == EINTR) continue;
+    if (r < 0) return Error{fmt("%s: read failed (%s)", name_.c_str(), std::strerror(errno))};
+    if (r == 0)
+      return Error{fmt("%s: truncated (ends before byte %llu)", name_.c_str(),
+                       static_cast<unsigned long long>(offset + n))};
+    done += std::size_t(r);
+  }
+  return {};
+}
+
+Result<std::shared_ptr<const PageSource>> WorldSource::open(const std::string& path) {
+  auto s = std::make_shared<WorldSource>();
+  s->name_ = "world '" + path + "'";
+  s->fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (s->fd_ < 0) return Error{fmt("%s: %s", s->name_.c_str(), std::strerror(errno))};
+  struct stat st {};
+  if (::fstat(s->fd_, &st) != 0)
+    return Error{fmt("%s: %s", s->name_.c_str(), std::strerror(errno))};
+  s->file_bytes_ = std::uint64_t(st.st_size);
+  if (s->file_bytes_ < kDataStart)
+    return Error{fmt("%s: %llu bytes; not a Ridgeline world (too short for its header)",
+                     s->name_.c_str(), static_cast<unsigned long long>(s->file_bytes_))};
+  std::uint8_t head[kDataStart];
+  if (auto r = s->read_at(0, head, sizeof head); !r) return Error{r.message()};
+  if (!(head[0] == 'I' && head[1] == 'I' && head[2] == 43 && head[3] == 0))
+    return Error{fmt("%s: not a Ridgeline world (not a little-endian BigTIFF)", s->name_.c_str())};
+  const std::uint8_t* loc = head + kLocatorAt;
+  if (std::memcmp(loc, kMagic, 8) != 0)
+    return Error{fmt("%s: a TIFF, but not a Ridgeline world (no locator: bake it with ridge bake)",
+                     s->name_.c_str())};
+  Reader lr{std::span<const std::uint8_t>(loc + 8, kLocatorBytes - 8)};
+  const auto version = lr.get<std::uint32_t>();
+  lr.get<std::uint32_t>();
+  const auto index_at = lr.get<std::uint64_t>();
+  const auto index_bytes = lr.get<std::uint64_t>();
+  const auto index_sum = lr.get<std::uint64_t>();
+  const auto data_end = lr.get<std::uint64_t>();
+  const auto loc_sum = lr.get<std::uint64_t>();
+  if (version != kVersion)
+    return Error{fmt("%s: format version %u; this build reads version %u (bake it again)",
+                     s->name_.c_str(), version, kVersion)};
+  if (loc_sum != checksum(loc, 48))
+    return Error{fmt("%s: its header is corrupted (checksum mismatch)", s->name_.c_str())};
+  if (data_end > s->file_bytes_)
+    return Error{fmt("%s: truncated (%llu bytes of %llu)", s->name_.c_str(),
+                     static_cast<unsigned long long>(s->file_bytes_),
+                     static_cast<unsigned long long>(data_end))};
+  if (index_at < kDataStart || index_bytes > (std::uint64_t{1} << 34) ||
+      index_at + index_bytes > data_end)
+    return Error{fmt("%s: its index lies outside the file (corrupted)", s->name_.c_str())};
+  std::vector<std::uint8_t> index(index_bytes);
+  if (auto r = s->read_at(index_at, index.data(), index.size()); !r) return Error{r.message()};
+  if (checksum(index.data(), index.size()) != index_sum)
+    return Error{fmt("%s: its index is corrupted (checksum mismatch)", s->name_.c_str())};
+  Reader in{index};
+  char magic[8];
+  for (char& c : magic) c = char(in.get<std::uint8_t>());
+  if (std::memcmp(magic, "RWINDEX1", 8) != 0)
+    return Error{fmt("%s: its index is corrupted (bad magic)", s->name_.c_str())};
+  WorldInfo& w = s->info_;
+  w.width = in.get<std::uint32_t>();
+  w.height = in.get<std::uint32_t>();
+  w.spacing_x = in.get<double>();
+  w.spacing_z = in.get<double>();
+  w.origin_x = in.get<double>();
+  w.origin_z = in.get<double>();
+  w.height_offset = in.get<double>();
+  w.height_scale = in.get<double>();
+  const auto fmt_byte = in.get<std::uint8_t>();
+  w.format = fmt_byte == 0 ? SampleFormat::kU16 : SampleFormat::kF32;
+  w.min_local = in.get<float>();
+  w.max_local = in.get<float>();
+  w.has_materials = in.get<std::uint8_t>() != 0;
+  w.filled_samples = in.get<std::uint64_t>();
+  w.content_hash = in.get<std::uint64_t>();
+  const std::string name = in.get_string(4096);
+  w.name = s->name_;
+  s->baked_.patch_exponent = in.get<std::uint32_t>();
+  s->baked_.morph_window = in.get<double>();
+  s->baked_.morph_delay = in.get<double>();
+  const auto levels = in.get<std::uint32_t>();
+  HeightfieldDesc d;
+  d.width = w.width, d.height = w.height;
+  d.spacing_x = w.spacing_x, d.spacing_z = w.spacing_z;
+  d.origin_x = w.origin_x, d.origin_z = w.origin_z;
+  d.height_offset = w.height_offset;
+  d.height_scale = w.height_scale > 0 ? w.height_scale : 1.0;
+  d.max_samples = ~std::uint64_t{0};
+  d.name = s->name_;
+  if (!in.ok() || fmt_byte > 1) return Error{fmt("%s: its index is corrupted", s->name_.c_str())};
+  if (auto st2 = validate_heightfield_desc(d); !st2) return Error{st2.message()};
+  if (!std::isfinite(w.min_local) || !std::isfinite(w.max_local) || w.min_local > w.max_local)
+    return Error{fmt("%s: its height range is corrupted", s->name_.c_str())};
+  s->grid_ = world::PageGrid::of(w.width, w.height);
+  if (levels != s->grid_.levels)
+    return Error{fmt("%s: %u page levels; a %u x %u world has %u (corrupted)", s->name_.c_str(),
+                     levels, w.width, w.height, s->grid_.levels)};
+  std::size_t total = 0;
+  for (std::uint32_t k = 0; k < levels; ++k) {
+    const auto px = in.get<std::int32_t>(), pz = in.get<std::int32_t>();
+    if (px != s->grid_.px[k] || pz != s->grid_.pz[k])
+      return Error{fmt("%s: level %u has %d x %d pages; need %d x %d (corrupted)",
+                       s->name_.c_str(), k, px, pz, s->grid_.px[k], s->grid_.pz[k])};
+    s->level_first_.push_back(total);
+    total += s->grid_.count(k);
+  }
+  s->summaries_.resize(s->grid_.count(0));
+  for (PageSummary& m : s->summaries_) {
+    m.lo = in.get<float>(), m.hi = in.get<float>(), m.lo8 = in.get<float>(), m.hi8 = in.get<float>();
+    if (!(m.lo <= m.hi) || !(m.lo8 <= m.hi8))
+      return Error{fmt("%s: a page summary is corrupted", s->name_.c_str())};
+  }
+  s->pages_.resize(total);
+  for (PageEntry& e : s->pages_) {
+    e.offset = in.get<std::uint64_t>();
+    e.tile = in.get<std::uint32_t>();
+    e.apron = in.get<std::uint32_t>();
+    e.materials = in.get<std::uint32_t>();
+    e.records = in.get<std::uint32_t>();
+    e.checksum = in.get<std::uint64_t>();
+    if (in.ok() && (e.offset < kDataStart || e.offset + e.bytes() > data_end))
+      return Error{fmt("%s: a page lies outside the file (corrupted)", s->name_.c_str())};
+  }
+  if (!in.ok() || in.at != index.size())
+    return Error{fmt("%s: its index has %s bytes (corrupted)", s->name_.c_str(),
+                     in.ok() ? "trailing" : "too few")};
+  (void)name;
+  return std::shared_ptr<const PageSource>(std::move(s));
+}
+
+Status WorldSource::load(const PageKey& key, PageData& out) const {
+  if (key.level >= grid_.levels || key.px < 0 || key.pz < 0 || key.px >= grid_.px[key.level] ||
+      key.pz >= grid_.pz[key.level])
+    return Error{fmt("%s: no page (%u, %d, %d)", name_.c_str(), key.level, key.px, key.pz)};
+  const PageEntry& e =
+      pages_[level_first_[key.level] + std::size_t(key.px) +
+             std::size_t(key.pz) * std::size_t(grid_.px[key.level])];
+  std::vector<std::uint8_t> bytes(e.bytes());
+  if (auto r = read_at(e.offset, bytes.data(), bytes.size()); !r) return r;
+  if (checksum(bytes.data(), bytes.size()) != e.checksum)
+    return Error{fmt("%s: page (%u, %d, %d) is corrupted (checksum mismatch)", name_.c_str(),
+                     key.level, key.px, key.pz)};
+  const bool u16 = info_.format == SampleFormat::kU16;
+  const std::size_t sample_bytes = u16 ? 2 : 4;
+  std::vector<std::uint8_t> tile(kTileSamples * sample_bytes), apron(kApronSamples * sample_bytes);
+  const std::uint8_t* p = bytes.data();
+  auto bad = [&](const char* part) {
+    return Error{fmt("%s: page (%u, %d, %d): its %s does not decompress (corrupted)",
+                     name_.c_str(), key.level, key.px, key.pz, part)};
+  };
+  if (!inflate({p, e.tile}, tile)) return bad("tile");
+  p += e.tile;
+  if (!inflate({p, e.apron}, apron)) return bad("apron");
+  p += e.apron;
+  // The tile and the ring around it into the page's entries.
+  auto place = [&](auto* dst, const auto* t, const auto* ring) {
+    std::size_t k = 0;
+    for (std::int32_t b = -kPageApron; b <= kPageCells + kPageApron; ++b)
+      for (std::int32_t a = -kPageApron; a <= kPageCells + kPageApron; ++a) {
+        const std::size_t e2 = world::entry_index(a, b);
+        if (a >= 0 && b >= 0 && a < std::int32_t(kTile) && b < std::int32_t(kTile))
+          dst[e2] = t[std::size_t(a) + std::size_t(b) * kTile];
+        else
+          dst[e2] = ring[k++];
+      }
+  };
+  if (u16) {
+    auto* t = reinterpret_cast<std::uint16_t*>(tile.data());
+    decode_u16(t);
+    out.u16.resize(kPageEntries);
+    out.f32.clear();
+    place(out.u16.data(), t, reinterpret_cast<const std::uint16_t*>(apron.data()));
+  } else {
+    std::vector<float> t(kTileSamples);
+    decode_f32(tile.data(), t.data());
+    out.f32.resize(kPageEntries);
+    out.u16.clear();
+    place(out.f32.data(), t.data(), reinterpret_cast<const float*>(apron.data()));
+  }
+  out.materials.clear();
+  if (e.materials > 0) {
+    out.materials.resize(kPageEntries);
+    if (!inflate({p, e.materials}, out.materials)) return bad("materials");
+  }
+  p += e.materials;
+  out.records.clear();
+  if (e.records > 0) {
+    // Inflated to at most the largest block (its size is checked by the tessellator).
+    std::vector<std::uint8_t> rec(8 + kPageEntries * 3 * 2);
+    thread_local std::vector<std::uint8_t> scratch;
+    std::uint32_t raw = 0;
+    // The record part starts with its raw size (4 bytes), then the Deflate stream.
+    if (e.records < 4) return bad("tessellator bounds");
+    std::memcpy(&raw, p, 4);
+    if (raw > rec.size()) return bad("tessellator bounds");
+    rec.resize(raw);
+    if (!inflate({p + 4, e.records - 4}, rec)) return bad("tessellator bounds");
+    out.records = std::move(rec);
+  }
+  return {};
+}
+
+}  // namespace
+
+Result<std::shared_ptr<const PageSource>> open_world(const std::string& path) {
+  return WorldSource::open(path);
+}
+
+}  // namespace ridgeline::io

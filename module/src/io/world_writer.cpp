@@ -1,0 +1,598 @@
+// The bake (world_file.h): samples in memory to a world file (world_format.h). Stages: the
+// samples (checked, or quantised to a tolerance), the page summaries, the tessellator's coarse
+// bounds (records.h, from every sample), the pages of every level (cut, compressed and written
+// in parallel, in order), then the index, the TIFF directories and the locator; flushed and
+// renamed.
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <mutex>
+#include <thread>
+
+#include "format.h"
+#include "io/world_format.h"
+#include "ridgeline/world_file.h"
+#include "roam/records.h"
+#include "world/page.h"
+
+namespace ridgeline::io {
+
+using detail::fmt;
+using detail::num;
+using namespace world_file;
+
+namespace {
+
+struct Cancelled {};
+
+// The output file: a temporary beside the target, removed unless committed.
+class Output {
+ public:
+  explicit Output(std::string path) : path_(std::move(path)) {
+    tmp_ = path_ + ".tmp." + std::to_string(::getpid());
+  }
+  ~Output() {
+    if (fd_ >= 0) ::close(fd_);
+    if (!committed_) ::unlink(tmp_.c_str());
+  }
+  Status open() {
+    fd_ = ::open(tmp_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd_ < 0)
+      return Error{fmt("bake '%s': cannot create '%s' (%s)", path_.c_str(), tmp_.c_str(),
+                       std::strerror(errno))};
+    return {};
+  }
+  std::uint64_t size() const noexcept { return at_; }
+  Status write(const void* data, std::size_t n) { return pwrite(at_, data, n, true); }
+  Status pwrite(std::uint64_t offset, const void* data, std::size_t n, bool advance = false) {
+    const auto* p = static_cast<const std::uint8_t*>(data);
+    std::size_t done = 0;
+    while (done < n) {
+      const ssize_t w = ::pwrite(fd_, p + done, n - done, off_t(offset + done));
+      if (w < 0 && errno == EINTR) continue;
+      if (w <= 0) {
+        const int err = w < 0 ? errno : ENOSPC;
+        return Error{fmt("bake '%s': writing failed (%s); nothing was written to '%s'",
+                         path_.c_str(), std::strerror(err), path_.c_str())};
+      }
+      done += std::size_t(w);
+    }
+    if (advance) at_ = std::max(at_, offset + n);
+    return {};
+  }
+  Status commit() {
+    int err = ::fsync(fd_) != 0 ? errno : 0;
+    if (::close(fd_) != 0 && err == 0) err = errno;
+    fd_ = -1;
+    if (err != 0)
+      return Error{fmt("bake '%s': flushing failed (%s); nothing was written to '%s'",
+                       path_.c_str(), std::strerror(err), path_.c_str())};
+    if (::rename(tmp_.c_str(), path_.c_str()) != 0)
+      return Error{fmt("bake '%s': rename failed (%s); nothing was written", path_.c_str(),
+                       std::strerror(errno))};
+    committed_ = true;
+    const std::size_t slash = path_.find_last_of('/');
+    const std::string dir =
+        slash == std::string::npos ? "." : (slash == 0 ? "/" : path_.substr(0, slash));
+    if (const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC); dfd >= 0) {
+      ::fsync(dfd);
+      ::close(dfd);
+    }
+    return {};
+  }
+
+ private:
+  std::string path_, tmp_;
+  int fd_ = -1;
+  std::uint64_t at_ = 0;
+  bool committed_ = false;
+};
+
+// Runs fn(k) for k in [0, n) on `threads` threads.
+template <class Fn>
+void parallel_for(std::size_t n, unsigned threads, const Fn& fn) {
+  if (threads <= 1 || n < 2) {
+    for (std::size_t k = 0; k < n; ++k) fn(k);
+    return;
+  }
+  std::atomic<std::size_t> next{0};
+  std::vector<std::thread> pool;
+  for (unsigned t = 0; t < std::min<std::size_t>(threads, n); ++t)
+    pool.emplace_back([&] {
+      for (std::size_t k; (k = next.fetch_add(1)) < n;) fn(k);
+    });
+  for (auto& th : pool) th.join();
+}
+
+// One compressed page as it goes to the file.
+struct CompressedPage {
+  std::vector<std::uint8_t> tile, apron, materials, records;
+  std::uint64_t hash = 0;  // the content hash's page hash (level 0)
+};
+
+// TIFF directory entry types (BigTIFF).
+constexpr std::uint16_t kShort = 3, kLong = 4, kDouble = 12, kLong8 = 16;
+
+struct TiffEntry {
+  std::uint16_t tag, type;
+  std::uint64_t count;
+  std::vector<std::uint8_t> data;  // count values of the type
+};
+
+template <class T>
+TiffEntry entry(std::uint16_t tag, std::uint16_t type, const std::vector<T>& values) {
+  TiffEntry e{tag, type, values.size(), {}};
+  e.data.resize(values.size() * sizeof(T));
+  std::memcpy(e.data.data(), values.data(), e.data.size());
+  return e;
+}
+
+// Writes one BigTIFF directory (its out-of-line values first) at the end of `out`; returns its
+// offset. `next_at` receives where its next-directory offset lies.
+Result<std::uint64_t> write_ifd(Output& out, std::vector<TiffEntry> entries,
+                                std::uint64_t& next_at) {
+  std::sort(entries.begin(), entries.end(),
+            [](const TiffEntry& a, const TiffEntry& b) { return a.tag < b.tag; });
+  std::vector<std::uint64_t> value_at(entries.size(), 0);
+  for (std::size_t k = 0; k < entries.size(); ++k)
+    if (entries[k].data.size() > 8) {
+      std::uint64_t at = out.size();
+      if (at & 1) {
+        const std::uint8_t zero = 0;
+        if (auto s = out.write(&zero, 1); !s) return Error{s.message()};
+        ++at;
+      }
+      value_at[k] = at;
+      if (auto s = out.write(entries[k].data.data(), entries[k].data.size()); !s)
+        return Error{s.message()};
+    }
+  Writer w;
+  w.put(std::uint64_t(entries.size()));
+  for (std::size_t k = 0; k < entries.size(); ++k) {
+    const TiffEntry& e = entries[k];
+    w.put(e.tag);
+    w.put(e.type);
+    w.put(e.count);
+    std::uint8_t inline_value[8] = {};
+    if (e.data.size() <= 8)
+      std::memcpy(inline_value, e.data.data(), e.data.size());
+    else
+      std::memcpy(inline_value, &value_at[k], 8);
+    w.bytes.insert(w.bytes.end(), inline_value, inline_value + 8);
+  }
+  std::uint64_t ifd_at = out.size();
+  if (ifd_at & 1) {
+    const std::uint8_t zero = 0;
+    if (auto s = out.write(&zero, 1); !s) return Error{s.message()};
+    ++ifd_at;
+  }
+  next_at = ifd_at + w.bytes.size();
+  w.put(std::uint64_t(0));
+  if (auto s = out.write(w.bytes.data(), w.bytes.size()); !s) return Error{s.message()};
+  return ifd_at;
+}
+
+}  // namespace
+
+Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
+                              const BakeOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  WorldInfo info = in.info;
+  const std::string what = "bake '" + path + "'";
+  // ---- checks --------------------------------------------------------------------------------
+  {
+    HeightfieldDesc d;
+    d.width = info.width, d.height = info.height;
+    d.spacing_x = info.spacing_x, d.spacing_z = info.spacing_z;
+    d.origin_x = info.origin_x, d.origin_z = info.origin_z;
+    d.height_offset = info.height_offset;
+    d.height_scale = info.height_scale;
+    d.max_samples = ~std::uint64_t{0};
+    d.name = what;
+    if (auto s = validate_heightfield_desc(d); !s) return Error{s.message()};
+  }
+  const bool u16_in = info.format == SampleFormat::kU16;
+  if ((u16_in && in.u16 == nullptr) || (!u16_in && in.f32 == nullptr))
+    return Error{what + ": no samples given for the format"};
+  if (o.threads > 256) return Error{fmt("%s: %u threads; need 0..256", what.c_str(), o.threads)};
+  if (o.compression_level < 1 || o.compression_level > 12)
+    return Error{fmt("%s: compression level %d; need 1..12", what.c_str(), o.compression_level)};
+  if (o.tolerance && !(std::isfinite(*o.tolerance) && *o.tolerance > 0))
+    return Error{fmt("%s: tolerance %s m; need a finite value > 0 (--tolerance)", what.c_str(),
+                     num(o.tolerance.value_or(0)).c_str())};
+  const unsigned threads =
+      o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
+  const std::size_t n = std::size_t(info.width) * info.height;
+  auto report = [&](double f, const char* stage) {
+    if (o.progress && !o.progress(std::clamp(f, 0.0, 1.0), stage)) throw Cancelled{};
+  };
+  BakeReport rep;
+  rep.samples = n;
+  try {
+    report(0.0, "samples");
+    // ---- samples: checked, min/max, optionally quantised --------------------------------------
+    std::vector<std::uint16_t> quantised;
+    const std::uint16_t* u16 = in.u16;
+    const float* f32 = in.f32;
+    float lo = INFINITY, hi = -INFINITY;
+    {
+      const std::size_t chunks = std::max<std::size_t>(1, std::min<std::size_t>(256, n / 65536));
+      std::vector<float> clo(chunks, INFINITY), chi(chunks, -INFINITY);
+      std::vector<std::size_t> bad(chunks, n);
+      parallel_for(chunks, threads, [&](std::size_t c) {
+        const std::size_t a = n * c / chunks, b = n * (c + 1) / chunks;
+        for (std::size_t k = a; k < b; ++k) {
+          const float v = u16 ? static_cast<float>(info.height_scale * double(u16[k])) : f32[k];
+          if (!(std::abs(v) <= float(kMaxRelativeHeight))) {
+            bad[c] = std::min(bad[c], k);
+            continue;
+          }
+          clo[c] = std::min(clo[c], v), chi[c] = std::max(chi[c], v);
+        }
+      });
+      for (std::size_t c = 0; c < chunks; ++c) {
+        if (bad[c] < n) {
+          const std::size_t k = bad[c];
+          return Error{fmt("%s: sample (%zu, %zu) is %s; need a finite height within +-%.0f m of "
+                           "the offset",
+                           what.c_str(), k % info.width, k / info.width,
+                           detail::numf(u16 ? float(info.height_scale * double(u16[k])) : f32[k]).c_str(),
+                           kMaxRelativeHeight)};
+        }
+        lo = std::min(lo, clo[c]), hi = std::max(hi, chi[c]);
+      }
+    }
+    info.min_local = lo, info.max_local = hi;
+    if (!u16 && o.tolerance) {
+      // 16-bit values relative to the lowest height: local = float(step * v), offset moved.
+      const double range = double(hi) - double(lo);
+      const double step = std::max(range / 65535.0, 1e-12);
+      if (step / 2.0 > *o.tolerance)
+        return Error{fmt("%s: a tolerance of %s m needs a 16-bit step of at most %s m, but the "
+                         "heights span %s m (a step of %s m); raise --tolerance to at least %s "
+                         "m, or leave it out to keep the floats",
+                         what.c_str(), num(*o.tolerance).c_str(), num(2 * *o.tolerance).c_str(),
+                         num(range).c_str(), num(step).c_str(), num(step / 2.0).c_str())};
+      quantised.resize(n);
+      std::vector<double> worst(threads, 0.0);
+      const double new_offset = info.height_offset + double(lo);
+      parallel_for(threads, threads, [&](std::size_t t) {
+        for (std::size_t k = n * t / threads; k < n * (t + 1) / threads; ++k) {
+          const double v = std::nearbyint((double(f32[k]) - double(lo)) / step);
+          quantised[k] = std::uint16_t(std::clamp(v, 0.0, 65535.0));
+          const double stored = new_offset + double(static_cast<float>(step * quantised[k]));
+          worst[t] = std::max(worst[t], std::abs(stored - (info.height_offset + double(f32[k]))));
+        }
+      });
+      rep.max_error_m = *std::max_element(worst.begin(), worst.end());
+      if (rep.max_error_m > *o.tolerance)
+        return Error{fmt("%s: quantising to 16 bits leaves an error of %s m, above the tolerance "
+                         "of %s m (--tolerance)",
+                         what.c_str(), num(rep.max_error_m).c_str(), num(*o.tolerance).c_str())};
+      info.height_offset = new_offset;
+      info.height_scale = step;
+      info.format = SampleFormat::kU16;
+      info.min_local = 0.0f;
+      info.max_local = static_cast<float>(step * 65535.0);
+      lo = info.min_local, hi = info.max_local;
+      u16 = quantised.data();
+      f32 = nullptr;
+    }
+    rep.format = info.format;
+    const bool store_u16 = info.format == SampleFormat::kU16;
+    roam::Heights h;
+    h.u16 = u16, h.f32 = f32, h.scale = info.height_scale;
+    h.stride = info.width, h.last_i = info.width - 1, h.last_j = info.height - 1;
+    report(0.05, "summaries");
+
+    // ---- page summaries -----------------------------------------------------------------------
+    const world::PageGrid grid = world::PageGrid::of(info.width, info.height);
+    std::vector<PageSummary> summaries(grid.count(0));
+    parallel_for(summaries.size(), threads, [&](std::size_t k) {
+      summaries[k] = world::summarize(grid, std::int32_t(k % std::size_t(grid.px[0])),
+                                      std::int32_t(k / std::size_t(grid.px[0])),
+                                      [&](std::int64_t i, std::int64_t j) { return h(i, j); });
+    });
+    report(0.1, "bounds");
+
+    // ---- the tessellator's coarse bounds --------------------------------------------------------
+    const auto tb = std::chrono::steady_clock::now();
+    std::uint32_t K = o.landscape.patch_exponent;
+    if (K == 0) K = roam::default_patch_exponent(info.width, info.height);
+    if (K < 2 || K > 10)
+      return Error{fmt("%s: patch exponent %u; need 2..10 (--patch-exponent)", what.c_str(), K)};
+    const double window = o.landscape.morph_window;
+    const double delay = window > 0.0 ? o.landscape.morph_delay : 0.0;
+    if (!(window >= 0.0 && window <= 4.0) || !(delay >= 0.0 && delay <= 1.0))
+      return Error{fmt("%s: morph window %s / delay %s; need 0..4 and 0..1", what.c_str(),
+                       num(window).c_str(), num(delay).c_str())};
+    roam::RecordConfig rc;
+    rc.K = int(K);
+    rc.growth = std::sqrt(1.0 + delay + window);
+    rc.last_i = info.width - 1, rc.last_j = info.height - 1;
+    const std::int64_t P = std::int64_t{1} << K;
+    rc.pad_i = ((rc.last_i + P - 1) / P) * P, rc.pad_j = ((rc.last_j + P - 1) / P) * P;
+    rc.spacing_x = info.spacing_x, rc.spacing_z = info.spacing_z;
+    std::vector<std::size_t> level_first;
+    std::size_t total_pages = 0;
+    for (std::uint32_t k = 0; k < grid.levels; ++k) {
+      level_first.push_back(total_pages);
+      total_pages += grid.count(k);
+    }
+    std::vector<std::shared_ptr<roam::RecordBlock>> blocks(total_pages);
+    roam::build_all(
+        rc, grid, h,
+        [&](std::int32_t px, std::int32_t pz) -> const PageSummary& {
+          return summaries[std::size_t(px) + std::size_t(pz) * std::size_t(grid.px[0])];
+        },
+        [](const PageKey&) -> const world::Page* { return nullptr; },
+        [&](const PageKey& key, std::shared_ptr<roam::RecordBlock> b) {
+          blocks[level_first[key.level] + std::size_t(key.px) +
+                 std::size_t(key.pz) * std::size_t(grid.px[key.level])] = std::move(b);
+        },
+        threads, false);
+    rep.bounds_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - tb).count();
+    rep.patch_exponent = K;
+    report(0.35, "pages");
+
+    // ---- pages ------------------------------------------------------------------------------
+    Output out(path);
+    if (auto s = out.open(); !s) return Error{s.message()};
+    {
+      std::vector<std::uint8_t> zero(kDataStart, 0);
+      if (auto s = out.write(zero.data(), zero.size()); !s) return Error{s.message()};
+    }
+    std::vector<PageEntry> entries(total_pages);
+    std::vector<std::uint64_t> page_hashes(grid.count(0), 0);
+    const bool mats = in.materials != nullptr;
+    info.has_materials = mats;
+    auto make_page = [&](std::size_t idx, CompressedPage& cp) {
+      std::uint32_t k = 0;
+      while (k + 1 < grid.levels && idx >= level_first[k + 1]) ++k;
+      const std::size_t local = idx - level_first[k];
+      const PageKey key{k, std::int32_t(local % std::size_t(grid.px[k])),
+                        std::int32_t(local / std::size_t(grid.px[k]))};
+      const int ls = world::level_shift(k);
+      const std::int64_t i0 = std::int64_t(key.px) << world::page_shift(k);
+      const std::int64_t j0 = std::int64_t(key.pz) << world::page_shift(k);
+      auto sample = [&](std::int32_t a, std::int32_t b) {
+        const std::int64_t i = std::clamp<std::int64_t>(i0 + (std::int64_t(a) << ls), 0, grid.last_i);
+        const std::int64_t j = std::clamp<std::int64_t>(j0 + (std::int64_t(b) << ls), 0, grid.last_j);
+        return std::size_t(i) + std::size_t(j) * info.width;
+      };
+      auto s = std::make_shared<world::PageSamples>();
+      if (store_u16)
+        s->u16.resize(kPageEntries);
+      else
+        s->f32.resize(kPageEntries);
+      if (mats) s->materials.resize(kPageEntries);
+      for (std::int32_t b = -kPageApron; b <= kPageCells + kPageApron; ++b)
+        for (std::int32_t a = -kPageApron; a <= kPageCells + kPageApron; ++a) {
+          const std::size_t at = sample(a, b), e = world::entry_index(a, b);
+          if (store_u16)
+            s->u16[e] = u16[at];
+          else
+            s->f32[e] = f32[at];
+          if (mats) {
+            // The stored cell at the entry: sample (i, j)'s id, clamped into the cells.
+            const std::int64_t i = std::min<std::int64_t>(std::int64_t(at % info.width), info.width - 2);
+            const std::int64_t j = std::min<std::int64_t>(std::int64_t(at / info.width), info.height - 2);
+            s->materials[e] = in.materials[std::size_t(i) + std::size_t(j) * info.width];
+          }
+        }
+      world::Page page;
+      page.key = key;
+      page.set_samples(s, info.height_scale);
+      if (k == 0) cp.hash = world::hash_page(page, grid, mats);
+      // The tile (its 256 x 256 entries) with TIFF's predictor, and the ring around it.
+      if (store_u16) {
+        std::vector<std::uint16_t> tile(kTileSamples), ring;
+        ring.reserve(kApronSamples);
+        for (std::int32_t b = -kPageApron; b <= kPageCells + kPageApron; ++b)
+          for (std::int32_t a = -kPageApron; a <= kPageCells + kPageApron; ++a) {
+            const std::uint16_t v = s->u16[world::entry_index(a, b)];
+            if (a >= 0 && b >= 0 && a < std::int32_t(kTile) && b < std::int32_t(kTile))
+              tile[std::size_t(a) + std::size_t(b) * kTile] = v;
+            else
+              ring.push_back(v);
+          }
+        encode_u16(tile);
+        cp.tile = deflate({reinterpret_cast<const std::uint8_t*>(tile.data()), tile.size() * 2},
+                          o.compression_level);
+        cp.apron = deflate({reinterpret_cast<const std::uint8_t*>(ring.data()), ring.size() * 2},
+                           o.compression_level);
+      } else {
+        std::vector<float> tile(kTileSamples), ring;
+        ring.reserve(kApronSamples);
+        for (std::int32_t b = -kPageApron; b <= kPageCells + kPageApron; ++b)
+          for (std::int32_t a = -kPageApron; a <= kPageCells + kPageApron; ++a) {
+            const float v = s->f32[world::entry_index(a, b)];
+            if (a >= 0 && b >= 0 && a < std::int32_t(kTile) && b < std::int32_t(kTile))
+              tile[std::size_t(a) + std::size_t(b) * kTile] = v;
+            else
+              ring.push_back(v);
+          }
+        const std::vector<std::uint8_t> planes = encode_f32(tile);
+        cp.tile = deflate(planes, o.compression_level);
+        cp.apron = deflate({reinterpret_cast<const std::uint8_t*>(ring.data()), ring.size() * 4},
+                           o.compression_level);
+      }
+      if (mats) cp.materials = deflate(s->materials, o.compression_level);
+      if (blocks[idx]) {
+        const std::vector<std::uint8_t> raw = blocks[idx]->encode();
+        const std::uint32_t raw_size = std::uint32_t(raw.size());
+        std::vector<std::uint8_t> z = deflate(raw, o.compression_level);
+        cp.records.resize(4 + z.size());
+        std::memcpy(cp.records.data(), &raw_size, 4);
+        std::memcpy(cp.records.data() + 4, z.data(), z.size());
+        blocks[idx].reset();  // written: memory back
+      }
+    };
+    const std::size_t batch = std::max<std::size_t>(threads * 4, 8);
+    for (std::size_t first = 0; first < total_pages; first += batch) {
+      const std::size_t count = std::min(batch, total_pages - first);
+      std::vector<CompressedPage> done(count);
+      parallel_for(count, threads, [&](std::size_t k) { make_page(first + k, done[k]); });
+      for (std::size_t k = 0; k < count; ++k) {
+        CompressedPage& cp = done[k];
+        PageEntry& e = entries[first + k];
+        e.offset = out.size();
+        e.tile = std::uint32_t(cp.tile.size()), e.apron = std::uint32_t(cp.apron.size());
+        e.materials = std::uint32_t(cp.materials.size());
+        e.records = std::uint32_t(cp.records.size());
+        std::vector<std::uint8_t> all;
+        all.reserve(e.bytes());
+        for (const auto* part : {&cp.tile, &cp.apron, &cp.materials, &cp.records})
+          all.insert(all.end(), part->begin(), part->end());
+        e.checksum = checksum(all.data(), all.size());
+        if (auto s = out.write(all.data(), all.size()); !s) return Error{s.message()};
+        if (first + k < grid.count(0)) page_hashes[first + k] = cp.hash;
+      }
+      report(0.35 + 0.6 * double(first + count) / double(total_pages), "pages");
+    }
+    info.content_hash = world::combine_hashes(world::hash_header(info), page_hashes);
+    rep.content_hash = info.content_hash;
+    rep.pages = total_pages;
+    report(0.95, "index");
+
+    // ---- index ------------------------------------------------------------------------------
+    Writer w;
+    w.bytes.insert(w.bytes.end(), {'R', 'W', 'I', 'N', 'D', 'E', 'X', '1'});
+    w.put(info.width), w.put(info.height);
+    w.put(info.spacing_x), w.put(info.spacing_z), w.put(info.origin_x), w.put(info.origin_z);
+    w.put(info.height_offset), w.put(info.height_scale);
+    w.put(std::uint8_t(store_u16 ? 0 : 1));
+    w.put(info.min_local), w.put(info.max_local);
+    w.put(std::uint8_t(mats ? 1 : 0));
+    w.put(info.filled_samples), w.put(info.content_hash);
+    w.put_string(info.name);
+    w.put(K), w.put(window), w.put(delay);
+    w.put(grid.levels);
+    for (std::uint32_t k = 0; k < grid.levels; ++k) w.put(grid.px[k]), w.put(grid.pz[k]);
+    for (const PageSummary& s : summaries) w.put(s.lo), w.put(s.hi), w.put(s.lo8), w.put(s.hi8);
+    for (const PageEntry& e : entries) {
+      w.put(e.offset), w.put(e.tile), w.put(e.apron), w.put(e.materials), w.put(e.records);
+      w.put(e.checksum);
+    }
+    const std::uint64_t index_at = out.size();
+    if (auto s = out.write(w.bytes.data(), w.bytes.size()); !s) return Error{s.message()};
+
+    // ---- TIFF directories: the heights and their overviews, GeoTIFF tags on the first ---------
+    std::uint64_t first_ifd = 0, prev_next_at = 0;
+    for (std::uint32_t k = 0; k < grid.levels; ++k) {
+      const int ls = world::level_shift(k);
+      const std::uint32_t iw = std::uint32_t(((info.width - 1) >> ls) + 1);
+      const std::uint32_t ih = std::uint32_t(((info.height - 1) >> ls) + 1);
+      std::vector<std::uint64_t> offsets, counts;
+      for (std::size_t p = 0; p < grid.count(k); ++p) {
+        const PageEntry& e = entries[level_first[k] + p];
+        offsets.push_back(e.offset);
+        counts.push_back(e.tile);
+      }
+      std::vector<TiffEntry> tags = {
+          entry<std::uint32_t>(254, kLong, {k == 0 ? 0u : 1u}),
+          entry<std::uint32_t>(256, kLong, {iw}),
+          entry<std::uint32_t>(257, kLong, {ih}),
+          entry<std::uint16_t>(258, kShort, {std::uint16_t(store_u16 ? 16 : 32)}),
+          entry<std::uint16_t>(259, kShort, {8}),
+          entry<std::uint16_t>(262, kShort, {1}),
+          entry<std::uint16_t>(277, kShort, {1}),
+          entry<std::uint16_t>(284, kShort, {1}),
+          entry<std::uint16_t>(317, kShort, {std::uint16_t(store_u16 ? 2 : 3)}),
+          entry<std::uint32_t>(322, kLong, {kTile}),
+          entry<std::uint32_t>(323, kLong, {kTile}),
+          entry<std::uint64_t>(324, kLong8, offsets),
+          entry<std::uint64_t>(325, kLong8, counts),
+          entry<std::uint16_t>(339, kShort, {std::uint16_t(store_u16 ? 1 : 3)}),
+      };
+      if (k == 0) {
+        // World x is easting and z is -northing (io.h, FilePlacement): the model's y is -z.
+        tags.push_back(entry<double>(33550, kDouble, {info.spacing_x, info.spacing_z, 0.0}));
+        tags.push_back(entry<double>(33922, kDouble,
+                                     {0.0, 0.0, 0.0, info.origin_x, -info.origin_z, 0.0}));
+        // Projected, user-defined, metres; samples at pixel centres (PixelIsPoint).
+        tags.push_back(entry<std::uint16_t>(34735, kShort,
+                                            {1, 1, 0, 4, 1024, 0, 1, 1, 1025, 0, 1, 2, 3072, 0,
+                                             1, 32767, 3076, 0, 1, 9001}));
+      }
+      std::uint64_t next_at = 0;
+      auto at = write_ifd(out, std::move(tags), next_at);
+      if (!at) return at.error();
+      if (k == 0)
+        first_ifd = *at;
+      else if (auto s = out.pwrite(prev_next_at, &*at, 8); !s)
+        return Error{s.message()};
+      prev_next_at = next_at;
+    }
+
+    // ---- header and locator -------------------------------------------------------------------
+    Writer hdr;
+    hdr.bytes.insert(hdr.bytes.end(), {'I', 'I', 43, 0, 8, 0, 0, 0});
+    hdr.put(first_ifd);
+    if (auto s = out.pwrite(0, hdr.bytes.data(), hdr.bytes.size()); !s) return Error{s.message()};
+    Writer loc;
+    loc.bytes.insert(loc.bytes.end(), kMagic, kMagic + 8);
+    loc.put(kVersion);
+    loc.put(std::uint32_t(0));
+    loc.put(index_at);
+    loc.put(std::uint64_t(w.bytes.size()));
+    loc.put(checksum(w.bytes.data(), w.bytes.size()));
+    loc.put(out.size());
+    loc.put(checksum(loc.bytes.data(), 48));
+    loc.bytes.resize(kLocatorBytes, 0);
+    if (auto s = out.pwrite(kLocatorAt, loc.bytes.data(), loc.bytes.size()); !s)
+      return Error{s.message()};
+    rep.bytes = out.size();
+    if (auto s = out.commit(); !s) return Error{s.message()};
+    report(1.0, "done");
+  } catch (const Cancelled&) {
+    return Error{what + ": cancelled; nothing was written"};
+  } catch (const std::bad_alloc&) {
+    return Error{what + ": out of memory (the bake holds the samples and about 1.6 bytes a "
+                        "sample besides; bake a smaller world or use a larger machine)"};
+  }
+  rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return rep;
+}
+
+Result<BakeReport> bake_world(const Heightfield& hf, const std::string& path,
+                              const BakeOptions& options) {
+  BakeSamples s;
+  s.info.width = hf.width(), s.info.height = hf.height();
+  s.info.spacing_x = hf.spacing_x(), s.info.spacing_z = hf.spacing_z();
+  s.info.origin_x = hf.origin_x(), s.info.origin_z = hf.origin_z();
+  s.info.height_offset = hf.height_offset(), s.info.height_scale = hf.height_scale();
+  s.info.filled_samples = hf.filled_samples();
+  s.info.name = path;
+  std::vector<std::uint16_t> values;
+  if (world::fits_u16(hf)) {
+    s.info.format = SampleFormat::kU16;
+    values.resize(hf.local_heights().size());
+    for (std::size_t k = 0; k < values.size(); ++k)
+      values[k] =
+          std::uint16_t(std::nearbyint(double(hf.local_heights()[k]) / hf.height_scale()));
+    s.u16 = values.data();
+  } else {
+    s.info.format = SampleFormat::kF32;
+    s.f32 = hf.local_heights().data();
+  }
+  std::vector<std::uint8_t> mats;
+  if (hf.has_materials()) {
+    mats.resize(std::size_t(hf.width()) * hf.height());
+    for (std::uint32_t j = 0; j < hf.height(); ++j)
+      for (std::uint32_t i = 0; i < hf.width(); ++i)
+        mats[i + std::size_t(j) * hf.width()] =
+            hf.material(std::min(i, hf.width() - 2), std::min(j, hf.height() - 2));
+    s.materials = mats.data();
+  }
+  return bake_world(s, path, options);
+}
+
+}  // namespace ridgeline::io
