@@ -65,13 +65,13 @@ run; expect "no subcommand" 2 "A subcommand is required"
 run --version; expect "ridge --version" 0
 [[ "$out" =~ ^ridge\ [0-9]+\.[0-9]+\.[0-9]+$ ]] && ok || bad "--version prints 'ridge X.Y.Z'" "$out"
 run frobnicate; expect "unknown subcommand" 2 "unknown subcommand 'frobnicate' of ridge"
-[[ "$err" == *"info, query, profile"* ]] && ok || bad "unknown subcommand lists the subcommands" "$err"
+[[ "$err" == *"info, bake, query, profile"* ]] && ok || bad "unknown subcommand lists the subcommands" "$err"
 run bench frobnicate --default-terrain; expect "unknown benchmark" 2 "unknown subcommand 'frobnicate' of ridge bench"
 run info --default-terrain --no-such-flag; expect "unknown flag" 2 "--no-such-flag (see ridge info --help)"
 run bench --default-terrain; expect "bench without a benchmark" 2
 run info --default-terrain --heightmap "$PNG"; expect "--heightmap with --default-terrain" 2
 # Missing required flags are usage errors (exit 2), as docs/cli.md says.
-run info; expect "no terrain" 2 "no terrain given: pass --heightmap FILE or --default-terrain"
+run info; expect "no terrain" 2 "no terrain given: pass --heightmap FILE, --world WORLD or --default-terrain"
 run info --help; expect "--help without a terrain" 0
 run mesh --default-terrain --threshold 2; expect "mesh without --out" 2 "--out is required"
 run mesh --default-terrain --out "$T/m.glb"; expect "mesh without a LOD setting" 2 "give --threshold PX, --triangles N or --tolerance METRES"

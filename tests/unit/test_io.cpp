@@ -463,7 +463,7 @@ TEST(IoBadInput, HugeDeclaredPngSizeIsRefusedWithoutAllocating) {
   ASSERT_FALSE(hf);
   EXPECT_TRUE(contains(hf.error().message, "heightmap '" + path +
                                                "': 200000 x 150000 = 30000000000 samples exceeds "
-                                               "the limit of 268435456 samples"))
+                                               "the limit of 268468225 samples (HeightfieldDesc::max_samples)"))
       << hf.error().message;
 }
 

@@ -28,9 +28,10 @@ enum class SampleFormat : std::uint8_t { kU16 = 0, kF32 = 1 };
 /// Cells per page side at the page's own stride; pages of level k cover 256 * 4^k stored cells.
 inline constexpr std::int32_t kPageCells = 256;
 /// Entries of apron around a page on each side (copies of the neighbours' samples, so that
-/// everything about a vertex is read from one page).
-inline constexpr std::int32_t kPageApron = 2;
-/// Entries per page row (and rows per page): 256 + 1 + 2 * 2.
+/// everything about a vertex, the tessellator's bounds of its diamond included, is read from one
+/// page: the descendants of a size-2 diamond reach 6 samples from its centre).
+inline constexpr std::int32_t kPageApron = 6;
+/// Entries per page row (and rows per page): 256 + 1 + 2 * 6.
 inline constexpr std::int32_t kPageStride = kPageCells + 1 + 2 * kPageApron;
 /// Entries per page.
 inline constexpr std::size_t kPageEntries = std::size_t(kPageStride) * std::size_t(kPageStride);
@@ -67,7 +68,7 @@ struct WorldInfo {
 
 /// A page of the stored pyramid: level k >= 0 holds every 4^k-th sample; page (px, pz) of level k
 /// covers the samples (i, j) with i = (256 px + a) 4^k, j = (256 pz + b) 4^k, a and b in
-/// -2 .. 258 (its 256 x 256 cells and a two-entry apron; entries past the data repeat the
+/// -6 .. 262 (its 256 x 256 cells and a six-entry apron; entries past the data repeat the
 /// nearest sample, as the padding of docs/surface.md does).
 struct PageKey {
   std::uint32_t level = 0;

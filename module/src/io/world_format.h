@@ -9,7 +9,7 @@
 // after the BigTIFF header points at its own index (the world's header, the page summaries, and
 // for every page where its four parts lie), and every page's parts lie together:
 //   tile       the page's 256 x 256 samples exactly as the TIFF tile (what TileOffsets points at)
-//   apron      the ring of 2 entries around the tile (kPageEntries - 256^2 samples), Deflate
+//   apron      the ring of entries around the tile (kPageEntries - 256^2 samples), Deflate
 //   materials  kPageEntries material ids, Deflate (empty when the world has none)
 //   records    the tessellator's baked bounds of the page (levels >= 1), Deflate (roam/records.h)
 // Every part is covered by the page's checksum, the index by its own, and the locator by its

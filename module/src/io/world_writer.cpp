@@ -328,9 +328,6 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
     std::vector<std::shared_ptr<roam::RecordBlock>> blocks(total_pages);
     roam::build_all(
         rc, grid, h,
-        [&](std::int32_t px, std::int32_t pz) -> const PageSummary& {
-          return summaries[std::size_t(px) + std::size_t(pz) * std::size_t(grid.px[0])];
-        },
         [](const PageKey&) -> const world::Page* { return nullptr; },
         [&](const PageKey& key, std::shared_ptr<roam::RecordBlock> b) {
           blocks[level_first[key.level] + std::size_t(key.px) +

@@ -58,9 +58,7 @@ class Maker final : public world::RecordMaker {
       : store_(store), cfg_(std::move(cfg)), slot_(slot_hint) {}
   void set_slot(int s) { slot_ = s; }
 
-  std::shared_ptr<const RecordBlock> make(
-      const world::Page& page,
-      const std::function<const world::Page*(const PageKey&)>& find) const override {
+  std::shared_ptr<const RecordBlock> make(const world::Page& page) const override {
     if (page.key.level > 0) {
       if (!page.baked) return nullptr;
       auto b = RecordBlock::decode(page.key.level, *page.baked);
@@ -70,14 +68,7 @@ class Maker final : public world::RecordMaker {
                 store_.info().name.c_str(), page.key.level, page.key.px, page.key.pz));
       return b;
     }
-    const PageKey up{1, page.key.px >> 2, page.key.pz >> 2};
-    const world::Page* parent = find(up);
-    if (parent == nullptr || !parent->records[std::size_t(slot_)]) return nullptr;
-    return roam::level0_block(
-        cfg_, page, *parent->records[std::size_t(slot_)], *parent,
-        [this](std::int32_t px, std::int32_t pz) -> const PageSummary& {
-          return store_.summary(px, pz);
-        });
+    return roam::level0_block(cfg_, page);
   }
   std::size_t bytes(const RecordBlock& b) const noexcept override { return b.bytes(); }
   std::vector<std::pair<PageKey, std::shared_ptr<const RecordBlock>>> remake(
@@ -87,9 +78,6 @@ class Maker final : public world::RecordMaker {
     const int slot = slot_;
     return roam::remake(
         cfg_, store.grid(), paged_heights(store),
-        [&](std::int32_t px, std::int32_t pz) -> const PageSummary& {
-          return store.summary(px, pz);
-        },
         [&](const PageKey& k) -> const world::Page* {
           std::shared_ptr<const world::PageTable> keep;
           return store.require(k, keep);
@@ -481,9 +469,6 @@ Result<std::shared_ptr<const Landscape>> Landscape::create(std::shared_ptr<const
     std::mutex mu;
     roam::build_all(
         c, g, h,
-        [&](std::int32_t px, std::int32_t pz) -> const PageSummary& {
-          return store.summary(px, pz);
-        },
         [&](const PageKey& k) { return table->find(k); },
         [&](const PageKey& k, std::shared_ptr<RecordBlock> b) {
           std::lock_guard lock(mu);
@@ -492,15 +477,14 @@ Result<std::shared_ptr<const Landscape>> Landscape::create(std::shared_ptr<const
         },
         threads);
   } else {
-    // The pages resident now, coarsest level first (a level-0 page's bounds read its parent's);
-    // those that arrive later get theirs on arrival.
+    // The pages resident now; those that arrive later get theirs on arrival.
     for (int k = int(store.grid().levels) - 1; k >= 0; --k) {
       std::shared_ptr<const world::PageTable> table = store.snapshot();
       std::vector<std::pair<PageKey, std::shared_ptr<const RecordBlock>>> level;
       for (std::size_t n = 0; n < table->size(); ++n) {
         const world::Page& pg = table->page(n);
         if (int(pg.key.level) != k) continue;
-        auto b = maker->make(pg, [&](const PageKey& q) { return table->find(q); });
+        auto b = maker->make(pg);
         if (b) {
           m.bound_bytes += b->bytes();
           level.emplace_back(pg.key, std::move(b));

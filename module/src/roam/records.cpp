@@ -28,16 +28,6 @@ namespace ridgeline::roam {
 
 namespace {
 
-// Radius of a sphere about a diamond's vertex that holds its descendants' xz positions, in units
-// of s * hypot(spacing): 3 for square diamonds, 2 for edge diamonds (each at least its children's
-// plus the distance to them: 3 >= 2 + 1, 2 >= 3/2 + 1/2).
-double xz_radius_units(const Diamond& d) noexcept { return d.square ? 3.0 : 2.0; }
-
-// Levels of diamonds below a stored diamond of size 2^t, down to the finest (detail included).
-int levels_below(int t, bool square, std::uint32_t L) noexcept {
-  return 2 * t + 2 * int(L) + (square ? 1 : 0);
-}
-
 // True when a diamond at v with reach r has every existing descendant within samples [lo, hi]
 // along one axis (descendants past the world's first sample or its padded extent do not exist).
 bool within(std::int64_t v, std::int64_t r, std::int64_t lo, std::int64_t hi,
@@ -48,8 +38,6 @@ bool within(std::int64_t v, std::int64_t r, std::int64_t lo, std::int64_t hi,
 std::int64_t floor_div(std::int64_t n, std::int64_t d) noexcept {  // d > 0
   return n >= 0 ? n / d : -((-n + d - 1) / d);
 }
-
-using Summaries = std::function<const PageSummary&(std::int32_t, std::int32_t)>;
 
 // Exact error against the stored lattice of a triangle in stored coordinates: the largest
 // |height - plane| over the samples inside it (edge functions in integer arithmetic, the span of
@@ -203,40 +191,6 @@ DiamondBound edge_of(const RecordConfig& c, const H& h, std::int64_t i, std::int
   return bound_of(c, h, i, j, [](std::int64_t, std::int64_t) { return DiamondBound{}; });
 }
 
-// The sphere of a diamond whose descendants leave its page (records.h): its xz reach plus one
-// height range `hr` of the pages under its reach per level below, grown 2 % per level so that the
-// rounding of the quantised bounds cannot break the nesting; FLT_MAX when its reach crosses the
-// data's border (conservative: every diamond whose descendants straddle it does).
-float fallback_radius(const RecordConfig& c, const Diamond& d, double hr) noexcept {
-  const std::int64_t reach = d.reach();
-  if ((d.i - reach < c.last_i && c.last_i < d.i + reach) ||
-      (d.j - reach < c.last_j && c.last_j < d.j + reach))
-    return FLT_MAX;
-  const int below = levels_below(d.t, d.square, c.L);
-  return round_up(std::pow(1.02, below + 1) *
-                  (xz_radius_units(d) * double(d.s) * std::hypot(c.spacing_x, c.spacing_z) +
-                   double(below + 1) * hr));
-}
-
-// The height range a fallback sphere uses: over every level-0 page whose samples meet the
-// diamond's reach (monotone in the reach, so a parent's is at least its children's), widened by
-// the detail.
-double fallback_range(const RecordConfig& c, const Summaries& summary, const Diamond& d) {
-  const std::int64_t r = d.reach();
-  const std::int64_t pages_x = std::max<std::int64_t>(1, (c.last_i + kPageCells - 1) >> 8);
-  const std::int64_t pages_z = std::max<std::int64_t>(1, (c.last_j + kPageCells - 1) >> 8);
-  auto page = [](std::int64_t v, std::int64_t pages) {
-    return std::clamp<std::int64_t>(floor_div(v, kPageCells), 0, pages - 1);
-  };
-  float lo = INFINITY, hi = -INFINITY;
-  for (std::int64_t pz = page(d.j - r, pages_z); pz <= page(d.j + r, pages_z); ++pz)
-    for (std::int64_t px = page(d.i - r, pages_x); px <= page(d.i + r, pages_x); ++px) {
-      const PageSummary& s = summary(std::int32_t(px), std::int32_t(pz));
-      lo = std::min(lo, s.lo), hi = std::max(hi, s.hi);
-    }
-  return double(hi) - double(lo) + (c.L > 0 ? 2.0 * c.detail->contribution_bound(1) : 0.0);
-}
-
 }  // namespace
 
 DiamondBound diamond_bound(const RecordConfig& c, const Heights& h, std::int64_t i, std::int64_t j,
@@ -246,20 +200,6 @@ DiamondBound diamond_bound(const RecordConfig& c, const Heights& h, std::int64_t
 
 DiamondBound edge_bound(const RecordConfig& c, const Heights& h, std::int64_t i, std::int64_t j) {
   return edge_of(c, h, i, j);
-}
-
-bool at_page_border(const RecordConfig& c, std::int64_t i, std::int64_t j, int t,
-                    bool square) noexcept {
-  const std::int64_t r = (square ? 3 : 2) << t;
-  // The first sample of the page holding the diamond along an axis (world/page.h: a sample on a
-  // page edge belongs to the page that starts there, the far edge to the last page).
-  auto out = [&](std::int64_t v, std::int64_t last, std::int64_t pad) {
-    const std::int64_t pages = std::max<std::int64_t>(1, (last + kPageCells - 1) >> 8);
-    const std::int64_t v0 = std::min(v >> 8, pages - 1) << 8;
-    const std::int64_t lo = v0 - kPageApron, hi = v0 + kPageCells + kPageApron;
-    return (v - r < lo && lo - 1 >= 0) || (v + r > hi && hi + 1 <= pad);
-  };
-  return out(i, c.last_i, c.pad_i) || out(j, c.last_j, c.pad_j);
 }
 
 // ---- encoding -----------------------------------------------------------------------------------
@@ -289,19 +229,16 @@ std::shared_ptr<RecordBlock> RecordBlock::decode(std::uint32_t level,
 
 // ---- level 0, from the page alone ---------------------------------------------------------------
 
-std::shared_ptr<RecordBlock> level0_block(const RecordConfig& c, const world::Page& page,
-                                          const RecordBlock& parent_block,
-                                          const world::Page& parent, const Summaries& summary) {
+std::shared_ptr<RecordBlock> level0_block(const RecordConfig& c, const world::Page& page) {
   const std::int64_t i0 = std::int64_t(page.key.px) << 8, j0 = std::int64_t(page.key.pz) << 8;
   const PageHeights h{page, i0, j0};
-  const std::int64_t pi0 = std::int64_t(parent.key.px) << 10, pj0 = std::int64_t(parent.key.pz)
-                                                                       << 10;
   auto block = std::make_shared<RecordBlock>();
   block->level = 0;
   block->edges = c.L > 0;
   block->values.assign(3 * RecordBlock::slots(0, block->edges), 0);
   // Every t <= 1 diamond of the page and its apron whose descendants lie on the entries, finest
-  // first, into a local table (entries -2 .. 258).
+  // first, into a local table. The apron (kPageApron = 6) is the reach of a t = 1 square
+  // diamond, so every diamond of the page's own cells is among them.
   constexpr std::int32_t lo = -kPageApron, hi = kPageCells + kPageApron;
   thread_local std::vector<DiamondBound> local;
   thread_local std::vector<std::uint8_t> known;
@@ -336,39 +273,6 @@ std::shared_ptr<RecordBlock> level0_block(const RecordConfig& c, const world::Pa
         known[e] = 1;
       }
   }
-  // The fallback of a diamond whose descendants leave the page (records.h): parents first.
-  std::function<DiamondBound(std::int64_t, std::int64_t)> value;
-  auto fallback = [&](std::int64_t i, std::int64_t j) -> DiamondBound {
-    const Diamond d = diamond_at(i, j, c.K);
-    const int below = levels_below(d.t, d.square, c.L);
-    const double hr = fallback_range(c, summary, d);
-    DiamondBound out{INFINITY, INFINITY, fallback_radius(c, d, hr)};
-    if (d.top) {
-      // No parents: a bound from the page's surroundings' height range.
-      out.error = round_up(hr);
-      out.morph = round_up(hr * std::pow(c.growth, below + 1));
-      return quantized(out);
-    }
-    std::int64_t ax, az, bx, bz;
-    d.apexes(ax, az, bx, bz);
-    for (const auto& p : {std::pair{ax, az}, std::pair{bx, bz}}) {
-      if (!exists(p.first, p.second)) continue;
-      const DiamondBound pb = value(p.first, p.second);
-      out.error = std::min(out.error, pb.error);
-      out.morph = std::min(out.morph, float(double(pb.morph) / c.growth));
-    }
-    if (!std::isfinite(out.error)) out.error = round_up(hr), out.morph = round_up(hr);
-    return quantized(out);
-  };
-  value = [&](std::int64_t i, std::int64_t j) -> DiamondBound {
-    const Diamond d = diamond_at(i, j, c.K);
-    if (d.t >= 2) {
-      const std::int32_t a = std::int32_t((i - pi0) >> 2), b = std::int32_t((j - pj0) >> 2);
-      RIDGELINE_ASSERT(a >= lo && b >= lo && a <= hi && b <= hi);
-      return parent_block.get(a, b);
-    }
-    return fallback(i, j);
-  };
   for (std::int32_t b = 0; b <= kPageCells; ++b)
     for (std::int32_t a = 0; a <= kPageCells; ++a) {
       const std::int64_t i = i0 + a, j = j0 + b;
@@ -376,7 +280,7 @@ std::shared_ptr<RecordBlock> level0_block(const RecordConfig& c, const world::Pa
       const Diamond d = diamond_at(i, j, c.K);
       if (d.corner || d.t >= 2) continue;
       if (d.t == 0 && !d.square && !block->edges) continue;
-      block->set(a, b, at_page_border(c, i, j, d.t, d.square) ? fallback(i, j) : at(i, j));
+      block->set(a, b, at(i, j));
     }
   return block;
 }
@@ -428,12 +332,11 @@ void parallel_rows(std::int64_t n, unsigned threads, const Fn& fn) {
   for (auto& th : pool) th.join();
 }
 
-// True nested bounds of the t = 1 square diamonds (positions 2 mod 4), with the runtime radius
-// (the fallback's where they are at a page border): what the size-4 edge diamonds nest over.
+// True nested bounds of the t = 1 square diamonds (positions 2 mod 4): what the size-4 edge
+// diamonds nest over (the level-0 blocks hold the same values).
 // Computed page by page over the page and 8 samples around it.
 template <class H, class Out>
 void t1_squares(const RecordConfig& c, const world::PageGrid& g, const H& h,
-                const Summaries& summary,
                 std::int64_t pi0, std::int64_t pj0, std::int64_t pi1, std::int64_t pj1,
                 const Out& out, unsigned threads) {
   constexpr std::int64_t m = 8;
@@ -443,7 +346,6 @@ void t1_squares(const RecordConfig& c, const world::PageGrid& g, const H& h,
     if (px < 0 || pz < 0 || px >= g.px[0] || pz >= g.pz[0]) return;
     const std::int64_t i0 = (px << 8) - m, j0 = (pz << 8) - m, n = kPageCells + 1 + 2 * m;
     std::vector<DiamondBound> local(std::size_t(n * n));
-    std::vector<std::uint8_t> known(std::size_t(n * n), 0);
     auto at = [&](std::int64_t i, std::int64_t j) -> DiamondBound {
       const std::int64_t a = i - i0, b = j - j0;
       if (a < 0 || b < 0 || a >= n || b >= n) return DiamondBound{};
@@ -462,18 +364,11 @@ void t1_squares(const RecordConfig& c, const world::PageGrid& g, const H& h,
           if (!within(i, reach, i0, i0 + n - 1, c.pad_i) ||
               !within(j, reach, j0, j0 + n - 1, c.pad_j))
             continue;
-          DiamondBound v = bound_of(c, h, i, j, at);
+          const DiamondBound v = bound_of(c, h, i, j, at);
           local[std::size_t(a + b * n)] = v;
-          known[std::size_t(a + b * n)] = 1;
-          // The t = 1 squares of this page's cells: stored with the runtime radius.
           if (kind == 3 && i >= (px << 8) && j >= (pz << 8) && i < ((px + 1) << 8) &&
-              j < ((pz + 1) << 8)) {
-            if (at_page_border(c, i, j, t, square)) {
-              v.radius = fallback_radius(c, d, fallback_range(c, summary, d));
-              v = quantized(v);
-            }
+              j < ((pz + 1) << 8))
             out(i, j, v);
-          }
         }
     }
   });
@@ -539,7 +434,6 @@ std::shared_ptr<RecordBlock> slice(const RecordConfig& c, const std::vector<Stri
 }  // namespace
 
 void build_all(const RecordConfig& c, const world::PageGrid& grid, const Heights& h,
-               const std::function<const PageSummary&(std::int32_t, std::int32_t)>& summary,
                const std::function<const world::Page*(const PageKey&)>& page,
                const std::function<void(const PageKey&, std::shared_ptr<RecordBlock>)>& out,
                unsigned threads, bool level0) {
@@ -549,7 +443,7 @@ void build_all(const RecordConfig& c, const world::PageGrid& grid, const Heights
   std::vector<StrideGrid> grids(std::size_t(std::max(top_level, 0)) + 1);
   StrideGrid squares1;  // t = 1 squares
   squares1.init(2, c.pad_i, c.pad_j, 2);
-  t1_squares(c, grid, dh, summary, 0, 0, grid.px[0] - 1, grid.pz[0] - 1,
+  t1_squares(c, grid, dh, 0, 0, grid.px[0] - 1, grid.pz[0] - 1,
              [&](std::int64_t i, std::int64_t j, const DiamondBound& v) { squares1.set(i, j, v); },
              threads);
   for (int k = 1; k <= top_level; ++k) {
@@ -557,32 +451,24 @@ void build_all(const RecordConfig& c, const world::PageGrid& grid, const Heights
     level_bounds(c, dh, k, grids[std::size_t(k)], k == 1 ? squares1 : grids[std::size_t(k - 1)],
                  0, 0, c.pad_i, c.pad_j, threads);
   }
-  // Level >= 1 blocks, then level 0 (its fallbacks read level 1).
-  std::vector<std::shared_ptr<RecordBlock>> level1(grid.count(1 < grid.levels ? 1 : 0));
+  // Level >= 1 blocks, then level 0 (from the pages alone).
   for (std::uint32_t k = 1; k < grid.levels; ++k)
     for (std::int32_t pz = 0; pz < grid.pz[k]; ++pz)
       for (std::int32_t px = 0; px < grid.px[k]; ++px) {
         const PageKey key{k, px, pz};
-        std::shared_ptr<RecordBlock> b = slice(c, grids, grid.levels, key);
-        if (k == 1) level1[std::size_t(px) + std::size_t(pz) * std::size_t(grid.px[1])] = b;
-        out(key, b);
+        out(key, slice(c, grids, grid.levels, key));
       }
   if (!level0) return;
   const std::int64_t n0 = std::int64_t(grid.count(0));
   parallel_rows(n0, threads, [&](std::int64_t r) {
     const std::int32_t px = std::int32_t(r % grid.px[0]), pz = std::int32_t(r / grid.px[0]);
-    const PageKey key{0, px, pz}, up{1, px >> 2, pz >> 2};
-    const world::Page* p = page(key);
-    const world::Page* pp = page(up);
-    if (p == nullptr || pp == nullptr) return;
-    const RecordBlock& pb = *level1[std::size_t(up.px) + std::size_t(up.pz) * std::size_t(grid.px[1])];
-    out(key, level0_block(c, *p, pb, *pp, summary));
+    const PageKey key{0, px, pz};
+    if (const world::Page* p = page(key)) out(key, level0_block(c, *p));
   });
 }
 
 std::vector<std::pair<PageKey, std::shared_ptr<const RecordBlock>>> remake(
     const RecordConfig& c, const world::PageGrid& grid, const Heights& h,
-    const std::function<const PageSummary&(std::int32_t, std::int32_t)>& summary,
     const std::function<const world::Page*(const PageKey&)>& page,
     const std::function<const RecordBlock*(const PageKey&)>& block, std::int64_t i0,
     std::int64_t j0, std::int64_t i1, std::int64_t j1) {
@@ -639,7 +525,7 @@ std::vector<std::pair<PageKey, std::shared_ptr<const RecordBlock>>> remake(
     // The pages near the change (a t = 2 edge diamond reaching the change has its children
     // within 10 samples of it).
     const std::int64_t w = 16;
-    t1_squares(c, grid, dh, summary, std::max<std::int64_t>(0, (i0 - w) >> 8),
+    t1_squares(c, grid, dh, std::max<std::int64_t>(0, (i0 - w) >> 8),
                std::max<std::int64_t>(0, (j0 - w) >> 8), (i1 + w) >> 8, (j1 + w) >> 8,
                [&](std::int64_t i, std::int64_t j, const DiamondBound& v) {
                  t1.v[Window::key(i, j)] = v;
@@ -675,24 +561,14 @@ std::vector<std::pair<PageKey, std::shared_ptr<const RecordBlock>>> remake(
         }
     }
   }
-  // Level-0 pages near the change (their own diamonds, and the fallbacks that read level 1).
+  // Level-0 pages near the change (their apron reaches 6 samples past their cells).
   const std::int64_t w = 16;
   for (std::int64_t pz = std::max<std::int64_t>(0, (j0 - w) >> 8);
        pz <= std::min<std::int64_t>(grid.pz[0] - 1, (j1 + w) >> 8); ++pz)
     for (std::int64_t px = std::max<std::int64_t>(0, (i0 - w) >> 8);
          px <= std::min<std::int64_t>(grid.px[0] - 1, (i1 + w) >> 8); ++px) {
-      const PageKey key{0, std::int32_t(px), std::int32_t(pz)}, up{1, std::int32_t(px >> 2),
-                                                                    std::int32_t(pz >> 2)};
-      const world::Page* p = page(key);
-      const world::Page* pp = page(up);
-      if (p == nullptr || pp == nullptr) continue;
-      const RecordBlock* pb = nullptr;
-      if (auto it = fresh.find(up); it != fresh.end())
-        pb = it->second.get();
-      else
-        pb = block(up);
-      if (pb == nullptr) continue;
-      fresh[key] = level0_block(c, *p, *pb, *pp, summary);
+      const PageKey key{0, std::int32_t(px), std::int32_t(pz)};
+      if (const world::Page* p = page(key)) fresh[key] = level0_block(c, *p);
     }
   std::vector<std::pair<PageKey, std::shared_ptr<const RecordBlock>>> outv;
   outv.reserve(fresh.size());

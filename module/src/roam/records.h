@@ -11,14 +11,11 @@
 // - Levels >= 1 (t >= 2): the exact nested bounds, computed once from every sample under them
 //   (in memory at Landscape::create, or by the bake, which stores them in the world).
 // - Level 0 (t = 0, 1): computed from the page alone when the page arrives (records.cpp,
-//   level0_block): the exact nested bound of every diamond whose descendants lie on the page's
-//   entries (its cells and two-entry apron), and for the few whose descendants reach further (the
-//   size-2 diamonds on and next to the page's edges) a conservative fallback that stays nested:
-//   the smallest bound of their parents (the morph bound divided by the growth per level), and a
-//   sphere of their xz reach plus one height range of the page's surroundings per level below.
-//   The bounds of level 1 are computed with those spheres, so the two stay nested. Size-1 edge
-//   diamonds (t = 0, one odd coordinate; half of all diamonds) are not stored without detail:
-//   their bound is the midpoint's offset, read from three heights.
+//   level0_block): the descendants of those diamonds lie within 6 samples of their centre, on the
+//   page's entries (its cells and six-entry apron), so the page gives their exact nested bounds.
+//   Size-1 edge diamonds (t = 0, one odd coordinate; half of all diamonds) are not stored
+//   without detail: their bound is the midpoint's offset, read from three heights.
+// Every bound is the one a computation over the whole world would give: pages leave no trace.
 //
 // One definition serves the terrain held in memory and the baked world, so both draw the same
 // meshes.
@@ -76,14 +73,14 @@ struct RecordBlock {
   std::vector<std::uint16_t> values;
 
   /// Slots of a level-0 block: both coordinates odd (128 x 128), both even (129 x 129), then,
-  /// with `edges`, odd x (128 x 129) and odd z (129 x 128). Levels >= 1: every entry (261 x 261,
+  /// with `edges`, odd x (128 x 129) and odd z (129 x 128). Levels >= 1: every entry (269 x 269,
   /// apron included).
   static constexpr std::size_t kOdd = 128 * 128, kEven = 129 * 129, kEdge = 128 * 129;
   static std::size_t slots(std::uint32_t level, bool edges) noexcept {
     return level > 0 ? kPageEntries : kOdd + kEven + (edges ? 2 * kEdge : 0);
   }
   /// Slot of entry (a, b): level 0 for a, b in 0 .. 256 (never a size-1 edge diamond without
-  /// `edges`), levels >= 1 for a, b in -2 .. 258.
+  /// `edges`), levels >= 1 for a, b in -6 .. 262.
   std::size_t slot(std::int32_t a, std::int32_t b) const noexcept {
     if (level > 0) return world::entry_index(a, b);
     const bool oa = (a & 1) != 0, ob = (b & 1) != 0;
@@ -194,27 +191,14 @@ DiamondBound diamond_bound(const RecordConfig& c, const Heights& h, std::int64_t
 /// midpoint's offset (what diamond_bound() gives, from three heights).
 DiamondBound edge_bound(const RecordConfig& c, const Heights& h, std::int64_t i, std::int64_t j);
 
-/// True when the diamond at (i, j) (t <= 1) has descendants beyond the entries of its level-0
-/// page (its bound is then the fallback): its reach leaves the page's entries on a side where
-/// diamonds exist (inside the padded extent), not past the world's first or last samples.
-bool at_page_border(const RecordConfig& c, std::int64_t i, std::int64_t j, int t,
-                    bool square) noexcept;
-
-/// The level-0 block of `page` (computed from the page alone): `parent` is the level-1 page
-/// above it (its block for this configuration in `parent_block`), `summary(px, pz)` the level-0
-/// pages' summaries (always resident).
-std::shared_ptr<RecordBlock> level0_block(
-    const RecordConfig& c, const world::Page& page, const RecordBlock& parent_block,
-    const world::Page& parent,
-    const std::function<const PageSummary&(std::int32_t, std::int32_t)>& summary);
+/// The level-0 block of `page`, computed from the page alone.
+std::shared_ptr<RecordBlock> level0_block(const RecordConfig& c, const world::Page& page);
 
 /// Every block of a world held whole (in memory, or by the bake): level-1 and coarser blocks
 /// from the exact nested bounds, then (with `level0`) the level-0 blocks. `h`: the heights;
-/// `summary(px, pz)`: level-0 page summaries; `page(key)`: the pages (level 0 and 1, for the
-/// level-0 blocks). Calls `out(key, block)` for every page of every level (from several threads
-/// at once, `threads` of them).
+/// `page(key)`: the level-0 pages (for their blocks). Calls `out(key, block)` for every page of
+/// every level (from several threads at once, `threads` of them).
 void build_all(const RecordConfig& c, const world::PageGrid& grid, const Heights& h,
-               const std::function<const PageSummary&(std::int32_t, std::int32_t)>& summary,
                const std::function<const world::Page*(const PageKey&)>& page,
                const std::function<void(const PageKey&, std::shared_ptr<RecordBlock>)>& out,
                unsigned threads, bool level0 = true);
@@ -224,7 +208,6 @@ void build_all(const RecordConfig& c, const world::PageGrid& grid, const Heights
 /// `block(key)` gives the current block of a page, `page(key)` the page (with its new samples).
 std::vector<std::pair<PageKey, std::shared_ptr<const RecordBlock>>> remake(
     const RecordConfig& c, const world::PageGrid& grid, const Heights& h,
-    const std::function<const PageSummary&(std::int32_t, std::int32_t)>& summary,
     const std::function<const world::Page*(const PageKey&)>& page,
     const std::function<const RecordBlock*(const PageKey&)>& block, std::int64_t i0,
     std::int64_t j0, std::int64_t i1, std::int64_t j1);

@@ -3,7 +3,7 @@
 // page.
 //
 // A page of level k holds kPageStride x kPageStride entries at stride 4^k: its 256 x 256 cells,
-// the shared edges and a two-entry apron of its neighbours' samples, so that a vertex's height,
+// the shared edges and a six-entry apron of its neighbours' samples, so that a vertex's height,
 // normal, geomorph offset and bounds are all read from the one page that holds it. A page is
 // immutable once published; an edit publishes a copy (copy on write), so a snapshot taken before
 // keeps seeing the old one.
@@ -40,7 +40,7 @@ inline constexpr int kRayLeafShift = 2;
 constexpr int level_shift(std::uint32_t level) noexcept { return int(2 * level); }
 /// log2 of the stored cells a page of level k covers per side.
 constexpr int page_shift(std::uint32_t level) noexcept { return 8 + level_shift(level); }
-/// Index of entry (a, b) of a page (a, b in -2 .. 258).
+/// Index of entry (a, b) of a page (a, b in -6 .. 262).
 constexpr std::size_t entry_index(std::int32_t a, std::int32_t b) noexcept {
   return std::size_t(a + kPageApron) + std::size_t(b + kPageApron) * std::size_t(kPageStride);
 }

@@ -5,7 +5,7 @@
 // loaded by workers or the engine's executor with no lock held, integrated and evicted (LRU,
 // under a byte budget) in update(), and published as an immutable snapshot that readers use
 // without a lock. A page's missing ancestors are loaded with it, coarsest first (the
-// tessellator's bounds of a page need its parent's).
+// tessellator reads a diamond's coarser ancestors before it).
 #include "world/page_store.h"
 
 #include <algorithm>
@@ -193,12 +193,7 @@ Result<std::shared_ptr<PageStore>> PageStore::open(std::shared_ptr<const PageSou
         PageData d;
         if (auto st = s->source_->load(key, d); !st) return Error{st.message()};
         if (auto st = check_page_data(info, key, d); !st) return Error{st.message()};
-        auto p = s->make_page(key, std::move(d), [&](const PageKey& q) -> const Page* {
-          for (const auto& t : top)
-            if (t->key == q) return t.get();
-          return nullptr;
-        });
-        top.push_back(p);
+        top.push_back(s->make_page(key, std::move(d)));
       }
   }
   {
@@ -311,8 +306,7 @@ const PageTable& PageStore::current() const {
 
 // ---- loading ------------------------------------------------------------------------------------
 
-std::shared_ptr<const Page> PageStore::make_page(
-    const PageKey& key, PageData&& d, const std::function<const Page*(const PageKey&)>& find) const {
+std::shared_ptr<const Page> PageStore::make_page(const PageKey& key, PageData&& d) const {
   auto p = std::make_shared<Page>();
   p->key = key;
   auto samples = std::make_shared<PageSamples>();
@@ -324,7 +318,7 @@ std::shared_ptr<const Page> PageStore::make_page(
   if (!d.records.empty())
     p->baked = std::make_shared<const std::vector<std::uint8_t>>(std::move(d.records));
   for (std::size_t k = 0; k < kRecordSlots; ++k)
-    if (makers_[k]) p->records[k] = makers_[k]->make(*p, find);
+    if (makers_[k]) p->records[k] = makers_[k]->make(*p);
   return p;
 }
 
@@ -332,7 +326,6 @@ std::vector<std::shared_ptr<const Page>> PageStore::load_chain(const PageKey& ke
   const auto t0 = std::chrono::steady_clock::now();
   // The page and its ancestors up to the first one available, coarsest loaded first.
   std::vector<PageKey> chain{key};
-  std::vector<std::shared_ptr<const Page>> known;  // resident or loaded ancestors
   {
     std::lock_guard lock(cache_->mu);
     if (auto p = cache_->available(key)) return {};
@@ -340,21 +333,11 @@ std::vector<std::shared_ptr<const Page>> PageStore::load_chain(const PageKey& ke
     PageKey k = key;
     while (k.level + 1 < grid_.levels) {
       k = {k.level + 1, k.px >> 2, k.pz >> 2};
-      if (auto p = cache_->available(k)) {
-        known.push_back(p);
-        break;
-      }
+      if (cache_->available(k)) break;
       chain.push_back(k);
     }
   }
   std::vector<std::shared_ptr<const Page>> made;
-  auto find = [&](const PageKey& q) -> const Page* {
-    for (const auto& p : made)
-      if (p->key == q) return p.get();
-    for (const auto& p : known)
-      if (p->key == q) return p.get();
-    return current().find(q);
-  };
   std::string error;
   for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
     PageData d;
@@ -369,7 +352,7 @@ std::vector<std::shared_ptr<const Page>> PageStore::load_chain(const PageKey& ke
       }
       break;
     }
-    made.push_back(make_page(*it, std::move(d), find));
+    made.push_back(make_page(*it, std::move(d)));
   }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -696,7 +679,7 @@ void PageEdit::write(std::int64_t i, std::int64_t j, float h) {
     const auto zs = positions(j, g.last_j, g.pz[k]);
     for (std::int64_t z : zs)
       for (std::int64_t x : xs) {
-        // Pages whose entries -2 .. 258 hold position x: 256 px in x - 258 .. x + 2.
+        // Pages whose entries -6 .. 262 hold position x: 256 px in x - 262 .. x + 6.
         const auto first = [](std::int64_t v) {
           return std::int32_t(std::max<std::int64_t>(0, floor_div(v - kPageCells - kPageApron + kPageCells - 1, kPageCells)));
         };

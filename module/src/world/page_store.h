@@ -40,10 +40,9 @@ class RecordMaker {
  public:
   virtual ~RecordMaker() = default;
   /// The bounds of `page` (just loaded; not yet resident), or null when they cannot be made
-  /// (the page stays without them and the tessellator treats it as missing). `find` looks up
-  /// resident pages and the ancestors loaded with this one.
-  virtual std::shared_ptr<const roam::RecordBlock> make(
-      const Page& page, const std::function<const Page*(const PageKey&)>& find) const = 0;
+  /// (the page stays without them and the tessellator treats it as missing). From the page
+  /// alone: its apron holds every sample its diamonds' bounds read.
+  virtual std::shared_ptr<const roam::RecordBlock> make(const Page& page) const = 0;
   /// Bytes of a block this maker made.
   virtual std::size_t bytes(const roam::RecordBlock& block) const noexcept = 0;
   /// After an edit changed stored samples [i0, i1] x [j0, j1] (its pages published): the pages
@@ -149,8 +148,7 @@ class PageStore {
   // Loads `key` and the missing ancestors on this thread; returns the pages made (ancestors
   // first). Holds no lock while loading.
   std::vector<std::shared_ptr<const Page>> load_chain(const PageKey& key) const;
-  std::shared_ptr<const Page> make_page(const PageKey& key, PageData&& data,
-                                        const std::function<const Page*(const PageKey&)>& find) const;
+  std::shared_ptr<const Page> make_page(const PageKey& key, PageData&& data) const;
 
   WorldInfo info_;
   PageGrid grid_;
