@@ -49,7 +49,7 @@ struct BakeOptions {
   /// Threads, 1..256; 0: every hardware thread.
   std::uint32_t threads = 0;
   /// Deflate level, 1..12 (libdeflate): 1 fastest, 6 the TIFF writers' usual.
-  int compression_level = 4;
+  int compression_level = 2;
   /// Called now and then with the fraction done (0..1) and the stage's name, from the baking
   /// thread; return false to cancel (the bake then stops, removes its temporary file and fails
   /// with "cancelled").

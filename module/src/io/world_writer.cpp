@@ -227,6 +227,18 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
       std::vector<std::size_t> bad(chunks, n);
       parallel_for(chunks, threads, [&](std::size_t c) {
         const std::size_t a = n * c / chunks, b = n * (c + 1) / chunks;
+        if (u16) {
+          // 16-bit values are finite: their extremes give the range (the scale is > 0).
+          std::uint16_t vlo = 0xffff, vhi = 0;
+          for (std::size_t k = a; k < b; ++k)
+            vlo = std::min(vlo, u16[k]), vhi = std::max(vhi, u16[k]);
+          clo[c] = static_cast<float>(info.height_scale * double(vlo));
+          chi[c] = static_cast<float>(info.height_scale * double(vhi));
+          if (!(std::abs(chi[c]) <= float(kMaxRelativeHeight)))
+            for (std::size_t k = a; k < b && bad[c] == n; ++k)
+              if (u16[k] == vhi) bad[c] = k;
+          return;
+        }
         for (std::size_t k = a; k < b; ++k) {
           const float v = u16 ? static_cast<float>(info.height_scale * double(u16[k])) : f32[k];
           if (!(std::abs(v) <= float(kMaxRelativeHeight))) {

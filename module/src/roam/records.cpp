@@ -38,12 +38,110 @@ bool within(std::int64_t v, std::int64_t r, std::int64_t lo, std::int64_t hi,
 std::int64_t floor_div(std::int64_t n, std::int64_t d) noexcept {  // d > 0
   return n >= 0 ? n / d : -((-n + d - 1) / d);
 }
+// floor_div() by a shift when d is a power of two (the bintree's triangles' edges always are).
+std::int64_t floor_div_fast(std::int64_t n, std::int64_t d) noexcept {  // d > 0
+  if ((d & (d - 1)) == 0) return n >> __builtin_ctzll(std::uint64_t(d));
+  return floor_div(n, d);
+}
+
+// Heights of samples lo .. hi of row z into out[0 .. hi - lo]: the accessor's rule, with fast
+// paths for dense rows (the values are the accessor's, bit for bit).
+template <class H>
+void read_row(const H& h, std::int64_t z, std::int64_t lo, std::int64_t hi, float* out) {
+  for (std::int64_t x = lo; x <= hi; ++x) out[x - lo] = h(x, z);
+}
+void read_row(const Heights& h, std::int64_t z, std::int64_t lo, std::int64_t hi, float* out) {
+  if ((h.f32 == nullptr && h.u16 == nullptr) || z < 0 || z > h.last_j || lo < 0 ||
+      hi > h.last_i) {
+    for (std::int64_t x = lo; x <= hi; ++x) out[x - lo] = h(x, z);
+    return;
+  }
+  const std::size_t e = std::size_t(lo) + std::size_t(z) * std::size_t(h.stride);
+  const std::size_t n = std::size_t(hi - lo + 1);
+  if (h.f32 != nullptr) {
+    std::memcpy(out, h.f32 + e, n * sizeof(float));
+  } else {
+    const std::uint16_t* u = h.u16 + e;
+    const double scale = h.scale;
+    for (std::size_t k = 0; k < n; ++k) out[k] = static_cast<float>(scale * double(u[k]));
+  }
+}
+
+// Heights of a square block of samples copied out of an accessor (its values bit for bit): what
+// the finest diamonds' bounds read, without the accessor's clamping and branches.
+struct DenseBlock {
+  const float* p;
+  std::int64_t i0, j0, n;
+  float operator()(std::int64_t i, std::int64_t j) const noexcept {
+    RIDGELINE_ASSERT(i >= i0 && j >= j0 && i < i0 + n && j < j0 + n);
+    return p[std::size_t(i - i0) + std::size_t(j - j0) * std::size_t(n)];
+  }
+};
+
+// The samples inside the small bintree triangles (legs of at most 4 cells: the diamonds of
+// t <= 1, most of every world's diamonds), with their edge functions, by the apex's legs: a table
+// built once instead of each row's span.
+struct SmallTriangles {
+  struct Sample {
+    std::int8_t dx, dz;        // from the apex
+    std::int16_t wa, wl, wr;   // plane * |w| = wa ha + wl hl + wr hr
+  };
+  static constexpr int kMax = 4;
+  static constexpr int kSide = 2 * kMax + 1;
+  // Entry (ux, uz, turn): L - A = (ux, uz), R - A = (ux, uz) turned by +-90 degrees.
+  std::vector<Sample> samples[kSide * kSide * 2];
+  int aw[kSide * kSide * 2] = {};
+
+  static int index(std::int64_t ux, std::int64_t uz, bool left) noexcept {
+    return int((ux + kMax) + (uz + kMax) * kSide) * 2 + (left ? 1 : 0);
+  }
+  SmallTriangles() {
+    for (int uz = -kMax; uz <= kMax; ++uz)
+      for (int ux = -kMax; ux <= kMax; ++ux)
+        for (const bool left : {false, true}) {
+          if (ux == 0 && uz == 0) continue;
+          const int vx = left ? -uz : uz, vz = left ? ux : -ux;  // R - A
+          const int w = ux * vz - uz * vx;
+          const int sgn = w > 0 ? 1 : -1;
+          const int k = index(ux, uz, left);
+          aw[k] = w * sgn;
+          const int x0 = std::min({0, ux, vx}), x1 = std::max({0, ux, vx});
+          const int z0 = std::min({0, uz, vz}), z1 = std::max({0, uz, vz});
+          for (int z = z0; z <= z1; ++z)
+            for (int x = x0; x <= x1; ++x) {
+              if ((x == 0 && z == 0) || (x == ux && z == uz) || (x == vx && z == vz)) continue;
+              const int e_ab = (ux * z - uz * x) * sgn;                         // A -> L
+              const int e_lr = ((vx - ux) * (z - uz) - (vz - uz) * (x - ux)) * sgn;  // L -> R
+              const int e_ra = ((-vx) * (z - vz) - (-vz) * (x - vx)) * sgn;     // R -> A
+              if (e_ab < 0 || e_lr < 0 || e_ra < 0) continue;
+              samples[k].push_back({std::int8_t(x), std::int8_t(z), std::int16_t(e_lr),
+                                    std::int16_t(e_ra), std::int16_t(e_ab)});
+            }
+        }
+  }
+  // The table entry of triangle t, or null when it is not a small right isosceles triangle with
+  // its right angle at the apex.
+  int find(const LatticeTriangle& t) const noexcept {
+    const std::int64_t ux = t.lx - t.ax, uz = t.lz - t.az, vx = t.rx - t.ax, vz = t.rz - t.az;
+    if (ux < -kMax || ux > kMax || uz < -kMax || uz > kMax) return -1;
+    if (vx == -uz && vz == ux) return index(ux, uz, true);
+    if (vx == uz && vz == -ux) return index(ux, uz, false);
+    return -1;
+  }
+};
+
+const SmallTriangles& small_triangles() {
+  static const SmallTriangles table;
+  return table;
+}
 
 // Exact error against the stored lattice of a triangle in stored coordinates: the largest
 // |height - plane| over the samples inside it (edge functions in integer arithmetic, the span of
-// each row found exactly). Heights past the data repeat the edge (the accessor clamps).
+// each row found exactly). Heights past the data repeat the edge (the accessor clamps). The
+// plane is evaluated scaled by the triangle's doubled area w (|h w - (S x + T)|, then / |w|):
+// the products of heights and integers are exact in doubles.
 template <class H>
-float exact_triangle(const H& h, const LatticeTriangle& t) noexcept {
+float exact_triangle(const H& h, const LatticeTriangle& t) {
   const std::int64_t x0 = std::min({t.ax, t.lx, t.rx}), x1 = std::max({t.ax, t.lx, t.rx});
   const std::int64_t z0 = std::min({t.az, t.lz, t.rz}), z1 = std::max({t.az, t.lz, t.rz});
   const double ha = h(t.ax, t.az), hl = h(t.lx, t.lz), hr = h(t.rx, t.rz);
@@ -52,9 +150,21 @@ float exact_triangle(const H& h, const LatticeTriangle& t) noexcept {
   };
   const std::int64_t w = cross(t.lx - t.ax, t.lz - t.az, t.rx - t.ax, t.rz - t.az);
   if (w == 0) return 0.0f;
-  const double inv_w = 1.0 / double(w);
-  double worst = 0.0;
   const std::int64_t sgn = w > 0 ? 1 : -1;
+  const double aw = double(w * sgn);
+  const SmallTriangles& small = small_triangles();
+  if (const int k = small.find(t); k >= 0) {
+    double worst = 0.0;
+    for (const SmallTriangles::Sample& q : small.samples[k]) {
+      const double d = std::abs(double(h(t.ax + q.dx, t.az + q.dz)) * aw -
+                                (double(q.wa) * ha + double(q.wl) * hl + double(q.wr) * hr));
+      worst = d > worst ? d : worst;
+    }
+    return round_up(worst / aw);
+  }
+  thread_local std::vector<float> row;
+  if (row.size() < std::size_t(x1 - x0 + 1)) row.resize(std::size_t(x1 - x0 + 1));
+  double worst = 0.0;
   const std::int64_t ex[3][2] = {{t.ax, t.az}, {t.lx, t.lz}, {t.rx, t.rz}};
   const int from[3] = {0, 1, 2}, to[3] = {1, 2, 0};
   for (std::int64_t z = z0; z <= z1; ++z) {
@@ -67,34 +177,35 @@ float exact_triangle(const H& h, const LatticeTriangle& t) noexcept {
       const std::int64_t a = -uz * sgn, c = (ux * (z - pz) + uz * px) * sgn;
       coef[k] = a, off[k] = c;
       if (a > 0)
-        lo = std::max(lo, -floor_div(c, a));  // x >= ceil(-c / a)
+        lo = std::max(lo, -floor_div_fast(c, a));  // x >= ceil(-c / a)
       else if (a < 0)
-        hi = std::min(hi, floor_div(c, -a));  // x <= floor(c / -a)
+        hi = std::min(hi, floor_div_fast(c, -a));  // x <= floor(c / -a)
       else if (c < 0)
         lo = hi + 1;  // edge parallel to x, row outside
     }
     if (lo > hi) continue;
-    for (std::int64_t x = lo; x <= hi; ++x) {
-      const std::int64_t e_ab = coef[0] * x + off[0];  // edge A->L: weight of R
-      const std::int64_t e_lr = coef[1] * x + off[1];  // edge L->R: weight of A
-      const std::int64_t e_ra = coef[2] * x + off[2];  // edge R->A: weight of L
-      const double plane =
-          (double(e_lr) * ha + double(e_ra) * hl + double(e_ab) * hr) * inv_w * double(sgn);
-      worst = std::max(worst, std::abs(double(h(x, z)) - plane));
+    // plane(x) * |w| = e_lr(x) ha + e_ra(x) hl + e_ab(x) hr = S x + T, with x relative to lo.
+    const double S = double(coef[1]) * ha + double(coef[2]) * hl + double(coef[0]) * hr;
+    const double T = double(coef[1] * lo + off[1]) * ha + double(coef[2] * lo + off[2]) * hl +
+                     double(coef[0] * lo + off[0]) * hr;
+    read_row(h, z, lo, hi, row.data());
+    const std::int64_t n = hi - lo + 1;
+    double m0 = 0.0, m1 = 0.0;
+    std::int64_t x = 0;
+    for (; x + 1 < n; x += 2) {
+      const double d0 = std::abs(double(row[std::size_t(x)]) * aw - (S * double(x) + T));
+      const double d1 = std::abs(double(row[std::size_t(x + 1)]) * aw - (S * double(x + 1) + T));
+      m0 = d0 > m0 ? d0 : m0;
+      m1 = d1 > m1 ? d1 : m1;
     }
+    if (x < n) {
+      const double d0 = std::abs(double(row[std::size_t(x)]) * aw - (S * double(x) + T));
+      m0 = d0 > m0 ? d0 : m0;
+    }
+    worst = std::max(worst, std::max(m0, m1));
   }
-  return round_up(worst);  // never below the double error
+  return round_up(worst / aw);  // never below the double error
 }
-
-// The heights of a level-0 page by global stored index (the entries the page holds).
-struct PageHeights {
-  const world::Page& p;
-  std::int64_t i0, j0;
-  float operator()(std::int64_t i, std::int64_t j) const noexcept {
-    return p.local(std::int32_t(i - i0), std::int32_t(j - j0));
-  }
-};
-
 
 // diamond_bound() over any height accessor.
 template <class H, class Child>
@@ -229,58 +340,78 @@ std::shared_ptr<RecordBlock> RecordBlock::decode(std::uint32_t level,
 
 // ---- level 0, from the page alone ---------------------------------------------------------------
 
+namespace {
+
+// The bounds of every t <= 1 diamond whose descendants lie in the block of samples
+// [i0, i0 + n) x [j0, j0 + n) (or past the padded extent, where they do not exist), finest
+// first, into out[(i - i0) + (j - j0) n]; other entries are left as they are. `h`: the block's
+// heights. The level-0 blocks and the bake's t = 1 squares both come from here, so both hold
+// the same values.
+void small_bounds(const RecordConfig& c, const DenseBlock& h, std::vector<DiamondBound>& out) {
+  const std::int64_t i0 = h.i0, j0 = h.j0, n = h.n;
+  out.resize(std::size_t(n * n));
+  auto at = [&](std::int64_t i, std::int64_t j) -> DiamondBound {
+    const std::int64_t a = i - i0, b = j - j0;
+    if (a < 0 || b < 0 || a >= n || b >= n) return DiamondBound{};
+    return out[std::size_t(a + b * n)];
+  };
+  // Kinds in order: t = 0 edge, t = 0 square, t = 1 edge, t = 1 square; the residues of their
+  // centres (i mod m, j mod m).
+  struct Kind {
+    int t;
+    bool square;
+    std::int64_t m;
+    int count;
+    std::int64_t ri[2], rj[2];
+  };
+  static constexpr Kind kinds[4] = {{0, false, 2, 2, {1, 0}, {0, 1}},
+                                    {0, true, 2, 1, {1, 0}, {1, 0}},
+                                    {1, false, 4, 2, {2, 0}, {0, 2}},
+                                    {1, true, 4, 1, {2, 0}, {2, 0}}};
+  for (const Kind& k : kinds) {
+    const std::int64_t r = (k.square ? 3 : 2) << k.t;
+    for (int v = 0; v < k.count; ++v) {
+      auto first = [&](std::int64_t lo, std::int64_t res) {
+        return lo + (((res - lo) % k.m) + k.m) % k.m;
+      };
+      for (std::int64_t j = first(j0, k.rj[v]); j < j0 + n; j += k.m) {
+        if (j < 0 || j > c.pad_j || !within(j, r, j0, j0 + n - 1, c.pad_j)) continue;
+        for (std::int64_t i = first(i0, k.ri[v]); i < i0 + n; i += k.m) {
+          if (i < 0 || i > c.pad_i || !within(i, r, i0, i0 + n - 1, c.pad_i)) continue;
+          // The residues make (i, j) a diamond of this kind (t <= 1 < K: never a corner).
+          out[std::size_t((i - i0) + (j - j0) * n)] = bound_of(c, h, i, j, at);
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+
 std::shared_ptr<RecordBlock> level0_block(const RecordConfig& c, const world::Page& page) {
   const std::int64_t i0 = std::int64_t(page.key.px) << 8, j0 = std::int64_t(page.key.pz) << 8;
-  const PageHeights h{page, i0, j0};
   auto block = std::make_shared<RecordBlock>();
   block->level = 0;
   block->edges = c.L > 0;
   block->values.assign(3 * RecordBlock::slots(0, block->edges), 0);
-  // Every t <= 1 diamond of the page and its apron whose descendants lie on the entries, finest
-  // first, into a local table. The apron (kPageApron = 6) is the reach of a t = 1 square
-  // diamond, so every diamond of the page's own cells is among them.
-  constexpr std::int32_t lo = -kPageApron, hi = kPageCells + kPageApron;
+  // Every t <= 1 diamond of the page and its apron whose descendants lie on the entries. The
+  // apron (kPageApron = 6) is the reach of a t = 1 square diamond, so every diamond of the
+  // page's own cells is among them.
+  thread_local std::vector<float> heights;
   thread_local std::vector<DiamondBound> local;
-  thread_local std::vector<std::uint8_t> known;
+  heights.resize(kPageEntries);
+  for (std::size_t e = 0; e < kPageEntries; ++e) heights[e] = page.local(e);
+  const DenseBlock h{heights.data(), i0 - kPageApron, j0 - kPageApron, kPageStride};
   local.assign(kPageEntries, DiamondBound{});
-  known.assign(kPageEntries, 0);
-  auto at = [&](std::int64_t i, std::int64_t j) -> DiamondBound {
-    const std::int32_t a = std::int32_t(i - i0), b = std::int32_t(j - j0);
-    if (a < lo || b < lo || a > hi || b > hi) return DiamondBound{};
-    const std::size_t e = world::entry_index(a, b);
-    RIDGELINE_ASSERT(known[e]);
-    return local[e];
-  };
-  // Diamonds centred outside the padded extent do not exist: bound 0 (never active).
-  auto exists = [&](std::int64_t i, std::int64_t j) {
-    return i >= 0 && j >= 0 && i <= c.pad_i && j <= c.pad_j;
-  };
-  // Kinds in order: t = 0 edge, t = 0 square, t = 1 edge, t = 1 square.
-  for (int kind = 0; kind < 4; ++kind) {
-    const int t = kind / 2;
-    const bool square = (kind & 1) != 0;
-    const std::int64_t r = (square ? 3 : 2) << t;
-    for (std::int32_t b = lo; b <= hi; ++b)
-      for (std::int32_t a = lo; a <= hi; ++a) {
-        const std::int64_t i = i0 + a, j = j0 + b;
-        if (!exists(i, j)) continue;
-        const Diamond d = diamond_at(i, j, c.K);
-        if (d.corner || d.t != t || d.square != square) continue;
-        if (!within(i, r, i0 + lo, i0 + hi, c.pad_i) || !within(j, r, j0 + lo, j0 + hi, c.pad_j))
-          continue;
-        const std::size_t e = world::entry_index(a, b);
-        local[e] = bound_of(c, h, i, j, at);
-        known[e] = 1;
-      }
-  }
+  small_bounds(c, h, local);
   for (std::int32_t b = 0; b <= kPageCells; ++b)
     for (std::int32_t a = 0; a <= kPageCells; ++a) {
       const std::int64_t i = i0 + a, j = j0 + b;
-      if (!exists(i, j)) continue;
+      if (i > c.pad_i || j > c.pad_j) continue;
       const Diamond d = diamond_at(i, j, c.K);
       if (d.corner || d.t >= 2) continue;
       if (d.t == 0 && !d.square && !block->edges) continue;
-      block->set(a, b, at(i, j));
+      block->set(a, b, local[world::entry_index(a, b)]);
     }
   return block;
 }
@@ -339,40 +470,28 @@ template <class H, class Out>
 void t1_squares(const RecordConfig& c, const world::PageGrid& g, const H& h,
                 std::int64_t pi0, std::int64_t pj0, std::int64_t pi1, std::int64_t pj1,
                 const Out& out, unsigned threads) {
-  constexpr std::int64_t m = 8;
   const std::int64_t npx = pi1 - pi0 + 1;
   parallel_rows((pj1 - pj0 + 1) * npx, threads, [&](std::int64_t r) {
     const std::int64_t px = pi0 + r % npx, pz = pj0 + r / npx;
     if (px < 0 || pz < 0 || px >= g.px[0] || pz >= g.pz[0]) return;
-    const std::int64_t i0 = (px << 8) - m, j0 = (pz << 8) - m, n = kPageCells + 1 + 2 * m;
-    std::vector<DiamondBound> local(std::size_t(n * n));
-    auto at = [&](std::int64_t i, std::int64_t j) -> DiamondBound {
-      const std::int64_t a = i - i0, b = j - j0;
-      if (a < 0 || b < 0 || a >= n || b >= n) return DiamondBound{};
-      return local[std::size_t(a + b * n)];
-    };
-    for (int kind = 0; kind < 4; ++kind) {
-      const int t = kind / 2;
-      const bool square = (kind & 1) != 0;
-      const std::int64_t reach = (square ? 3 : 2) << t;
-      for (std::int64_t b = 0; b < n; ++b)
-        for (std::int64_t a = 0; a < n; ++a) {
-          const std::int64_t i = i0 + a, j = j0 + b;
-          if (i < 0 || j < 0 || i > c.pad_i || j > c.pad_j) continue;
-          const Diamond d = diamond_at(i, j, c.K);
-          if (d.corner || d.t != t || d.square != square) continue;
-          if (!within(i, reach, i0, i0 + n - 1, c.pad_i) ||
-              !within(j, reach, j0, j0 + n - 1, c.pad_j))
-            continue;
-          const DiamondBound v = bound_of(c, h, i, j, at);
-          local[std::size_t(a + b * n)] = v;
-          if (kind == 3 && i >= (px << 8) && j >= (pz << 8) && i < ((px + 1) << 8) &&
-              j < ((pz + 1) << 8))
-            out(i, j, v);
-        }
-    }
+    // The page's samples and its apron, as a level-0 page holds them.
+    const std::int64_t i0 = (px << 8) - kPageApron, j0 = (pz << 8) - kPageApron;
+    constexpr std::int64_t n = kPageStride;
+    thread_local std::vector<float> heights;
+    thread_local std::vector<DiamondBound> local;
+    heights.resize(std::size_t(n * n));
+    for (std::int64_t b = 0; b < n; ++b)
+      read_row(h, j0 + b, i0, i0 + n - 1, heights.data() + b * n);
+    local.assign(std::size_t(n * n), DiamondBound{});
+    small_bounds(c, DenseBlock{heights.data(), i0, j0, n}, local);
+    // The t = 1 squares of this page's cells.
+    for (std::int64_t j = (pz << 8) + 2; j < ((pz + 1) << 8) && j <= c.pad_j; j += 4)
+      for (std::int64_t i = (px << 8) + 2; i < ((px + 1) << 8) && i <= c.pad_i; i += 4) {
+        const Diamond d = diamond_at(i, j, c.K);
+        if (d.corner || d.t != 1 || !d.square) continue;
+        out(i, j, local[std::size_t((i - i0) + (j - j0) * n)]);
+      }
   });
-  (void)g;
 }
 
 // Level k >= 1 (t = 2k, 2k + 1) bounds of the positions of `grid` inside [i0, i1] x [j0, j1]

@@ -27,6 +27,7 @@
 #include <cfloat>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -154,7 +155,11 @@ inline std::uint32_t default_patch_exponent(std::uint32_t width, std::uint32_t h
 /// v rounded up to a float (never below the double).
 inline float round_up(double v) noexcept {
   float f = static_cast<float>(v);
-  if (double(f) < v) f = std::nextafter(f, INFINITY);
+  if (double(f) < v) {  // the next float up (std::nextafter's answer, without the library call)
+    if (f == 0.0f) return std::numeric_limits<float>::denorm_min();
+    const std::uint32_t b = std::bit_cast<std::uint32_t>(f);
+    f = std::bit_cast<float>(f > 0.0f ? b + 1 : b - 1);
+  }
   return f;
 }
 
