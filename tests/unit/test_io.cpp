@@ -1148,6 +1148,50 @@ TEST(IoGeoTiff, UnusablePlacementTagsAreIgnoredWithAWarning) {
   }
 }
 
+// A key whose value sits in GeoDoubleParams (location 34736) names an index into that tag's
+// doubles: the last one is read, one past it is refused (never read: the doubles end there).
+// Projected metres in a user-defined unit (ProjLinearUnitsGeoKey 32767) whose size in metres
+// (ProjLinearUnitSizeGeoKey 3077) is the double at `index` of {1.5, 2.0, 0.25}.
+TEST(IoGeoTiff, GeoDoubleParamsAreReadUpToTheirLastEntryAndNoFurther) {
+  auto file = [](double index) {
+    const Tag dir{34735, 3, {1, 1, 0, 3, 1024, 0, 1, 1, 3076, 0, 1, 32767, 3077, 34736, 1, index}};
+    const Tag doubles{34736, 12, {1.5, 2.0, 0.25}};
+    return tiff_with_tags(3, 2, kSix,
+                          {pixel_scale(30, 20), tiepoint(0, 0, 1000, 2000), dir, doubles});
+  };
+  {  // The last entry: 0.25 m per unit.
+    const auto path = tmp_path("doubles_last.tif");
+    write_bytes(path, file(2));
+    io::LoadReport report;
+    LogCapture log;
+    auto hf = io::load_image(path, from_file(), &report);
+    ASSERT_TRUE(hf) << hf.error().message;
+    ASSERT_TRUE(report.file_placement) << (log.messages.empty() ? "" : log.messages[0]);
+    EXPECT_EQ(hf->spacing_x(), 7.5) << "30 units of the double at index 2 (0.25 m)";
+    EXPECT_EQ(hf->spacing_z(), 5.0);
+    EXPECT_EQ(hf->origin_x(), 253.75);  // (1000 + 15) * 0.25
+    EXPECT_EQ(hf->origin_z(), -497.5);  // -(2000 - 10) * 0.25
+    EXPECT_TRUE(report.warnings.empty());
+  }
+  for (const double index : {3.0, 4.0, 65535.0}) {  // one past the last, and further
+    const auto path = tmp_path("doubles_past.tif");
+    write_bytes(path, file(index));
+    io::LoadReport report;
+    LogCapture log;
+    auto o = from_file();
+    o.placement.spacing_x = o.placement.spacing_z = 2;
+    auto hf = io::load_image(path, o, &report);
+    ASSERT_TRUE(hf) << hf.error().message;
+    EXPECT_FALSE(report.file_placement) << "index " << index << " of 3 doubles was read";
+    EXPECT_EQ(hf->spacing_x(), 2.0) << "index " << index;
+    ASSERT_EQ(log.messages.size(), 1u);
+    EXPECT_TRUE(contains(log.messages[0], "geo key 3077 refers to GeoDoubleParams entry " +
+                                              std::to_string(int(index)) +
+                                              ", which the file lacks"))
+        << log.messages[0];
+  }
+}
+
 TEST(IoGeoTiff, APlacementBeyondTheLimitsIsRefused) {
   // Metres from the file pass the same checks as given ones: a spacing whose extent overflows.
   const auto path = tmp_path("huge.tif");
