@@ -87,6 +87,28 @@ TEST(LuaHost, MemoryBombEndsTheCallOnly) {
   expect_alive(*host);
 }
 
+// A reallocation gives its old block back: growing a table's array part from 2^18 to 2^19
+// entries (4 MiB to 8 MiB) holds 8 MiB afterwards, not 12. Under a 10 MiB cap (11.25 MiB with
+// the headroom) that table must be allowed; counting the old block as still held refuses it.
+TEST(LuaHost, AGrowingTableIsChargedWhatItHoldsAfterTheReallocation) {
+  HostOptions o;
+  o.memory_limit = 10 << 20;
+  auto host = make_host(o);
+  const auto s = host->run(R"(
+    local t = {}
+    for i = 1, 1 << 19 do t[i] = i end
+    assert(#t == 1 << 19))",
+                           "grow.lua");
+  EXPECT_TRUE(s.ok()) << "a table of 2^19 entries (8 MiB) was refused under a 10 MiB cap "
+                         "(the old block counted as held during its reallocation?): "
+                      << s.message();
+  // Twice the size is beyond the cap and is refused.
+  const auto big = host->run("local t = {} for i = 1, 1 << 20 do t[i] = i end", "grow2.lua");
+  EXPECT_FALSE(big.ok());
+  EXPECT_NE(big.message().find("memory limit exceeded"), std::string::npos) << big.message();
+  expect_alive(*host);
+}
+
 TEST(LuaHost, DeepRecursionIsContained) {
   auto host = make_host();
   const auto s = host->run("local function f() return 1 + f() end\nf()", "deep.lua");
