@@ -218,6 +218,7 @@ int setup_state(lua_State* L) {
     luaL_openlibs(L);
     ModuleConfig config;
     config.max_samples = o.max_samples;
+    config.object_memory_limit = o.object_memory_limit;
     open_module(L, config);
     lua_setglobal(L, "ridgeline");
     lua_pushglobaltable(L);
@@ -287,6 +288,7 @@ int setup_state(lua_State* L) {
   config.confine_paths = true;
   config.root = o.data_root.c_str();
   config.max_samples = o.max_samples;
+  config.object_memory_limit = o.object_memory_limit;
   open_module(L, config);
   lua_setfield(L, env, "ridgeline");
   lua_pushvalue(L, env);
@@ -491,6 +493,9 @@ Status Host::set_global(const char* name) {
 
 std::size_t Host::memory_used() const noexcept {
   return owned_ ? limits_->used : 0;
+}
+std::size_t Host::object_memory_used() const noexcept {
+  return ridgeline::lua::object_memory_used(L_);
 }
 std::uint64_t Host::last_instructions() const noexcept {
   return limits_->instructions;

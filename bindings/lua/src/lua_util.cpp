@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <string>
@@ -254,6 +255,62 @@ bool resolve_path(bool confine_paths, const char* config_root, const char* name,
 void account_memory(lua_State* L, std::size_t bytes) {
   const int kb = static_cast<int>(std::min<std::size_t>(bytes / 1024, 1 << 20));
   if (kb > 0) lua_gc(L, LUA_GCSTEP, kb);
+}
+
+namespace {
+char kConfigKey;  // registry key (light userdata address) of the last opened module's config
+}  // namespace
+
+void register_config(lua_State* L, int index) {
+  lua_pushvalue(L, index);
+  lua_rawsetp(L, LUA_REGISTRYINDEX, &kConfigKey);
+}
+
+std::shared_ptr<ObjectBudget> object_budget_of(lua_State* L) {
+  lua_rawgetp(L, LUA_REGISTRYINDEX, &kConfigKey);
+  const auto* config = static_cast<const ConfigBox*>(lua_touserdata(L, -1));
+  lua_pop(L, 1);
+  return config != nullptr ? config->budget : nullptr;
+}
+
+int object_budget_error(lua_State* L, const ObjectBudget& budget, const char* what,
+                        const char* detail) {
+  constexpr double kMiB = 1024.0 * 1024.0;
+  char text[512];
+  std::snprintf(text, sizeof text,
+                "%s: C++ object memory budget exceeded (%s): %.1f MiB of %.1f MiB held by the "
+                "terrains, landscapes and views made by scripts; release objects (obj:release(), "
+                "a <close> variable) or ask the host to raise its object_memory_limit",
+                what, detail, double(budget.used) / kMiB, double(budget.limit) / kMiB);
+  return luaL_error(L, "%s", text);
+}
+
+bool make_room(lua_State* L, const std::shared_ptr<ObjectBudget>& budget, std::size_t bytes,
+               std::size_t own) {
+  if (!budget || budget->limit == 0) return true;
+  const ObjectBudget& b = *budget;
+  if (b.used - std::min(own, b.used) + bytes <= b.limit) return true;
+  lua_gc(L, LUA_GCCOLLECT, 0);
+  return b.used - std::min(own, b.used) + bytes <= b.limit;
+}
+
+void reserve_objects(lua_State* L, const std::shared_ptr<ObjectBudget>& budget, std::size_t bytes,
+                     const char* what, std::size_t own) {
+  if (make_room(L, budget, bytes, own)) return;
+  char detail[96];
+  std::snprintf(detail, sizeof detail, "%.1f MiB more needed", double(bytes) / (1024.0 * 1024.0));
+  object_budget_error(L, *budget, what, detail);
+}
+
+std::size_t terrain_charge_bytes(const Terrain& terrain, std::size_t cache_bytes) {
+  const Heightfield& hf = terrain.heightfield();
+  // The edit layer keeps the original heights of every 32 x 32-sample chunk an edit touched
+  // (module/src/edit/edit_layer.h): at most every chunk, with its map node.
+  const std::size_t chunks =
+      ((std::size_t{hf.width()} + 31) / 32) * ((std::size_t{hf.height()} + 31) / 32);
+  const std::size_t edit_layer = chunks * (32 * 32 * sizeof(float) + 96);
+  const std::size_t change_log = kChangeLogCapacity * (sizeof(TerrainChange) + 16);
+  return terrain.memory_bytes() + edit_layer + change_log + cache_bytes;
 }
 
 }  // namespace ridgeline::lua::detail

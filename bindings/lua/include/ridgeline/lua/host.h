@@ -32,8 +32,18 @@ struct HostOptions {
   /// Bytes the Lua state may hold (owned states only; 0 = no limit). Above it the next hook
   /// check ends the call with an error and a traceback; a single allocation that would pass the
   /// limit plus a headroom of max(1 MiB, limit / 8) is refused (Lua's "not enough memory").
-  /// C++ terrain data is not counted here: `max_samples` bounds it.
+  /// C++ objects made for scripts are not counted here: see object_memory_limit.
   std::size_t memory_limit = std::size_t{64} << 20;
+  /// Bytes of C++ memory that the terrains, landscapes and views scripts make may hold together
+  /// (each terrain counted with the most its edit layer, change log and detail cache can grow
+  /// to; each view with what its last update holds); 0 = no limit. It applies to owned and
+  /// attached states, sandboxed or not; an engine's own terrains handed in with push_terrain()
+  /// are not counted. A call that would pass it raises "C++ object memory budget exceeded"
+  /// naming the sizes (after one garbage collection to reclaim dropped objects), and a view's
+  /// update is held to the triangles that fit (the call then raises the same error). Objects
+  /// give their share back when released (`release()`, `<close>`) or collected. The default
+  /// holds about 24 copies of the default terrain, or one 4096 x 4096 terrain with a view.
+  std::size_t object_memory_limit = std::size_t{256} << 20;
   /// Folder sandboxed scripts may read from (ridgeline.load); empty: no file access. Paths given
   /// by scripts are relative to it, without `..`, never absolute. Unused without the sandbox.
   std::string data_root;
@@ -78,6 +88,8 @@ class Host {
 
   /// Bytes held by an owned state (0 for an attached one).
   std::size_t memory_used() const noexcept;
+  /// Bytes charged to the object budget by the terrains, landscapes and views scripts hold.
+  std::size_t object_memory_used() const noexcept;
   /// Instructions counted during the last call (in steps of 1000).
   std::uint64_t last_instructions() const noexcept;
 
