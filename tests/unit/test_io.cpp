@@ -375,10 +375,34 @@ TEST(IoBadInput, CorruptPngDataIsRefused) {
   auto bytes = read_bytes(path);
   for (std::size_t k = bytes.size() / 2; k < bytes.size() / 2 + 64; ++k) bytes[k] ^= 0x5a;
   write_bytes(path, bytes);
+  testing::internal::CaptureStderr();
   auto hf = io::load_image(path, options());
+  const std::string printed = testing::internal::GetCapturedStderr();
   ASSERT_FALSE(hf) << "a corrupt PNG loaded";
-  EXPECT_TRUE(contains(hf.error().message, "heightmap '" + path + "': cannot read the pixels"))
+  EXPECT_TRUE(contains(hf.error().message,
+                       "heightmap '" + path + "': corrupt PNG file: chunk 'IDAT' at byte "))
       << hf.error().message;
+  EXPECT_TRUE(contains(hf.error().message, "fails its CRC check")) << hf.error().message;
+  EXPECT_EQ(printed, "") << "printed beside the error";
+}
+
+// A PNG cut short anywhere is refused with one message naming the chunk where it ends, and
+// nothing is printed beside it (libpng prints its own line for a read error it meets).
+TEST(IoBadInput, ATruncatedPngIsOneMessageAndNothingPrinted) {
+  const auto full = read_bytes(std::string(RIDGELINE_TEST_DATA) + "/ramp16.png");
+  ASSERT_GT(full.size(), 60u);
+  for (std::size_t n = 8; n < full.size(); ++n) {
+    const auto path = tmp_path("cut.png");
+    write_bytes(path, std::vector<char>(full.begin(), full.begin() + std::ptrdiff_t(n)));
+    testing::internal::CaptureStderr();
+    auto hf = io::load_image(path, options());
+    const std::string printed = testing::internal::GetCapturedStderr();
+    ASSERT_FALSE(hf) << n << " of " << full.size() << " bytes loaded";
+    const std::string& m = hf.error().message;
+    EXPECT_EQ(m.rfind("heightmap '" + path + "': truncated PNG file: ", 0), 0u) << m;
+    EXPECT_EQ(m.find("truncated", m.find("truncated") + 1), std::string::npos) << m;
+    EXPECT_EQ(printed, "") << n << " bytes: printed beside the error";
+  }
 }
 
 TEST(IoBadInput, ColourImageNeedsAChannel) {
@@ -1096,6 +1120,9 @@ TEST(IoGeoTiff, UnusablePlacementTagsAreIgnoredWithAWarning) {
       {"tie points alone", {tiepoint(0, 0, 0, 0), keys}, "a grid of tie points"},
       {"negative scale", {pixel_scale(30, -30), tiepoint(0, 0, 0, 0), keys}, "need positive"},
       {"zero scale", {pixel_scale(0, 30), tiepoint(0, 0, 0, 0), keys}, "need positive"},
+      {"pixels below a micrometre",
+       {pixel_scale(30, 1e-7), tiepoint(0, 0, 0, 0), keys},
+       "pixel size 30 x 1e-07 m is below 1e-6 m"},
       {"short tie point",
        {pixel_scale(30, 30), Tag{33922, 12, {0, 0, 0, 1}}, keys},
        "holds 4 values (need 6 per tie point)"},

@@ -45,11 +45,24 @@ struct LoadArgs {
   bool has_amplitude = false, has_gain = false;
 };
 
+std::string fmt_spacing(double v) {
+  char text[128];
+  std::snprintf(text, sizeof text, "spacing %g m is outside 1e-6 .. 1e6 m", v);
+  return text;
+}
+
 bool do_load(const ConfigBox& config, const LoadArgs& a, TerrainBox* box, std::size_t* charge_bytes,
              char* err) noexcept {
   try {
     char path[4096];
     if (!resolve_path(config, a.heightmap, path, sizeof path, err)) return false;
+    // The range of docs/data_model.md ("Placement"), as `ridge --spacing` checks it (values
+    // <= 0 get the heightfield's own message).
+    for (const double v : a.spacing)
+      if (a.has_spacing && v > 0 && (v < 1e-6 || v > 1e6)) {
+        copy_error(err, fmt_spacing(v).c_str());
+        return false;
+      }
     io::LoadOptions options;
     HeightfieldDesc& p = options.placement;
     p.spacing_x = a.spacing[0];
