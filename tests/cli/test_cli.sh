@@ -199,7 +199,7 @@ run info --default-terrain --spacing 4 --origin 100,200 --height-offset 1000
 expect "default terrain placed" 0
 [[ "$(tr -d ' \n' <<< "$out")" == *'"extent":[4096.0,4096.0]'* ]] && ok || bad "placed extent"
 
-# ---- GeoTIFF placement (real DEMs from Debian's r-cran-terra, fetched by scripts/test.sh) ----------
+# ---- GeoTIFF placement (real DEMs from Debian's r-cran-terra, fetched by the ctest fixture) ------
 EX=${EXTERNAL_DATA:-}/terra/usr/lib/R/site-library/terra/ex
 if [ -f "$EX/elev.tif" ] && [ -f "$EX/meuse.tif" ]; then
   # elev.tif: 1/120-degree cells at 49.8 N, about 598.8 x 926.7 m; 46 % no-data outside Luxembourg.
@@ -229,7 +229,7 @@ if [ -f "$EX/elev.tif" ] && [ -f "$EX/meuse.tif" ]; then
   contains "--origin overrides the file" '"origin_source": "flag"'
   contains "--origin keeps the file's spacing" '"spacing_source": "geotiff"'
 else
-  echo "note: $EX/elev.tif or meuse.tif missing (scripts/test.sh fetches r-cran-terra): GeoTIFF checks skipped"
+  bad "$EX/elev.tif or meuse.tif missing: the ctest fixture fetch_terra_data fetches r-cran-terra"
 fi
 run info --default-terrain; contains "default terrain pixel type" '"pixel_type": "float (generated)"'
 contains "default terrain spacing source" '"spacing_source": "default"'

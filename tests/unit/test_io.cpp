@@ -1257,8 +1257,9 @@ TEST(IoGeoTiff, ReaderIsBoundedOnEveryTruncation) {
 }
 
 // Real data: Debian's r-cran-terra ships elev.tif (Luxembourg, 1/120-degree cells, WGS 84) and
-// meuse.tif (the Netherlands' RD New projection, 40 m cells). scripts/test.sh fetches them into
-// RIDGELINE_TEST_EXTERNAL_DATA (apt-get download r-cran-terra; dpkg -x).
+// meuse.tif (the Netherlands' RD New projection, 40 m cells). The ctest fixture fetch_terra_data
+// fetches them into RIDGELINE_TEST_EXTERNAL_DATA (apt-get download r-cran-terra; dpkg -x); a
+// missing file fails the test (it never skips).
 std::string terra_file(const char* name) {
   return std::string(RIDGELINE_TEST_EXTERNAL_DATA) + "/terra/usr/lib/R/site-library/terra/ex/" +
          name;
@@ -1266,9 +1267,9 @@ std::string terra_file(const char* name) {
 
 TEST(IoGeoTiff, RealGeographicDem) {
   const std::string path = terra_file("elev.tif");
-  if (!fs::exists(path))
-    GTEST_SKIP() << path << " is missing: scripts/test.sh fetches it (apt-get download "
-                 << "r-cran-terra, dpkg -x into " << RIDGELINE_TEST_EXTERNAL_DATA << "/terra)";
+  ASSERT_TRUE(fs::exists(path))
+      << path << " is missing: the ctest fixture fetch_terra_data fetches it (apt-get download "
+      << "r-cran-terra, dpkg -x into " << RIDGELINE_TEST_EXTERNAL_DATA << "/terra)";
   io::LoadReport report;
   auto o = from_file();
   o.placement.fill = FillPolicy::kNearest;
@@ -1296,9 +1297,9 @@ TEST(IoGeoTiff, RealGeographicDem) {
 
 TEST(IoGeoTiff, RealProjectedDem) {
   const std::string path = terra_file("meuse.tif");
-  if (!fs::exists(path))
-    GTEST_SKIP() << path << " is missing: scripts/test.sh fetches it (apt-get download "
-                 << "r-cran-terra, dpkg -x into " << RIDGELINE_TEST_EXTERNAL_DATA << "/terra)";
+  ASSERT_TRUE(fs::exists(path))
+      << path << " is missing: the ctest fixture fetch_terra_data fetches it (apt-get download "
+      << "r-cran-terra, dpkg -x into " << RIDGELINE_TEST_EXTERNAL_DATA << "/terra)";
   io::LoadReport report;
   auto o = from_file();
   o.placement.fill = FillPolicy::kNearest;
