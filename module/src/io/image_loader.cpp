@@ -125,7 +125,12 @@ Status read_channel(ImageInput& in, int c, TypeDesc type, std::vector<T>& out,
                     const std::string& name) {
   const ImageSpec& spec = in.spec();
   out.resize(static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height));
-  const bool ok = in.read_image(0, 0, c, c + 1, type, out.data());
+  // A single channel in its stored type goes straight into `out`; anything else needs
+  // OpenImageIO's conversion buffer, which it sizes for large images whatever the image's size
+  // (tens of MB mapped and freed per read, most of the time a small load takes under ASan).
+  const bool native =
+      spec.nchannels == 1 && c == 0 && type == spec.format && spec.channelformats.empty();
+  const bool ok = in.read_image(0, 0, c, c + 1, native ? TypeDesc::UNKNOWN : type, out.data());
   // Some readers report a problem (a short strip, a bad CRC) and still return true.
   if (!ok || in.has_error()) {
     out.clear();
