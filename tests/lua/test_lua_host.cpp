@@ -227,6 +227,31 @@ TEST(LuaHost, AnEnginesTerrainIsNotChargedButItsViewsAre) {
   EXPECT_GT(host->object_memory_used(), before + (std::size_t{1} << 20));
 }
 
+// Host::reset() gives scripts the globals they had at creation and frees what only the old
+// ones held (the fuzz target reuses one host across inputs this way).
+TEST(LuaHost, ResetGivesScriptsThePristineGlobals) {
+  auto host = make_host();
+  ASSERT_TRUE(host->run("x = 1\nstring.rep = nil\nridgeline.load = nil\n_G.print = nil\n"
+                        "t = ridgeline.default_terrain()",
+                        "dirty.lua")
+                  .ok());
+  const std::size_t held = host->object_memory_used();
+  ASSERT_TRUE(host->reset().ok());
+  const auto s = host->run(
+      "assert(x == nil and t == nil and print and _G == _ENV)\n"
+      "assert(string.rep and ('x'):rep(2) == 'xx' and ridgeline.load and "
+      "ridgeline.default_terrain)",
+      "clean.lua");
+  EXPECT_TRUE(s.ok()) << s.message();
+  EXPECT_LT(host->object_memory_used(), held) << "the dropped terrain was not collected";
+  expect_alive(*host);
+  HostOptions open;
+  open.sandbox = false;
+  auto unsandboxed = Host::create(open);
+  ASSERT_TRUE(unsandboxed.ok());
+  EXPECT_FALSE((*unsandboxed)->reset().ok());
+}
+
 TEST(LuaHost, DeepRecursionIsContained) {
   auto host = make_host();
   const auto s = host->run("local function f() return 1 + f() end\nf()", "deep.lua");

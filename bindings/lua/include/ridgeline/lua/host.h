@@ -81,6 +81,15 @@ class Host {
   /// Calls global function `name` with no arguments and no results (a game callback).
   Status call_global(const char* name);
 
+  /// Sandboxed hosts: gives scripts a fresh global environment, as at creation: the library
+  /// tables and the `ridgeline` table copied again from pristine copies (a script's changes to
+  /// them are gone), every global a script or set_global() made gone, then a full garbage
+  /// collection (objects only the old globals held are freed and give back their share of the
+  /// object budget). What stays: the state, its limits, the module's cached default terrain, and
+  /// anything the engine keeps referenced. For reloading a game's scripts, and for the fuzz
+  /// target that reuses one host across inputs. Fails without the sandbox.
+  Status reset();
+
   /// Pops the value on top of the stack and stores it as global `name` of the scripts'
   /// environment (the sandbox table, or the real globals without the sandbox): how an engine
   /// hands its own API (a `game` table) to its scripts. Fails only for memory or an empty stack.
@@ -100,6 +109,7 @@ class Host {
   Status setup(const HostOptions& options);
   lua_State* L_ = nullptr;
   bool owned_ = false;
+  bool sandbox_ = false;
   std::unique_ptr<Limits> limits_;
 };
 
