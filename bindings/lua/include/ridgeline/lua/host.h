@@ -42,7 +42,7 @@ struct HostOptions {
   /// naming the sizes (after one garbage collection to reclaim dropped objects), and a view's
   /// update is held to the triangles that fit (the call then raises the same error). Objects
   /// give their share back when released (`release()`, `<close>`) or collected. The default
-  /// holds about 24 copies of the default terrain, or one 4096 x 4096 terrain with a view.
+  /// holds about 24 copies of the default terrain, or one 2048 x 2048 terrain with a view.
   std::size_t object_memory_limit = std::size_t{256} << 20;
   /// Folder sandboxed scripts may read from (ridgeline.load); empty: no file access. Paths given
   /// by scripts are relative to it, without `..`, never absolute. Unused without the sandbox.
