@@ -14,6 +14,11 @@
 
 namespace ridgeline::cli {
 
+namespace {
+// The spacings --spacing accepts, metres (docs/data_model.md, "Placement").
+constexpr double kMinSpacingM = 1e-6, kMaxSpacingM = 1e6;
+}  // namespace
+
 void TerrainArgs::add_to(CLI::App& app) {
   app_ = &app;
   const std::string g = "Terrain";
@@ -77,8 +82,8 @@ void TerrainArgs::add_to(CLI::App& app) {
       ->type_name("u16|f32")
       ->group(g);
   app.add_option("--spacing", spacing_,
-                 "Metres between samples: one value for both axes or SX,SZ (default: a GeoTIFF's "
-                 "own placement, else 1)")
+                 "Metres between samples, 1e-6 .. 1e6: one value for both axes or SX,SZ "
+                 "(default: a GeoTIFF's own placement, else 1)")
       ->type_name("S|SX,SZ")
       ->group(g);
   app.add_option(
@@ -203,6 +208,11 @@ Result<HeightfieldDesc> TerrainArgs::placement() const {
     d.spacing_z = v->size() == 2 ? (*v)[1] : (*v)[0];
     if (d.spacing_x <= 0 || d.spacing_z <= 0)
       return Error{"--spacing '" + spacing_ + "': spacing must be > 0"};
+    // docs/data_model.md, "Placement": below a micrometre the lattice's float positions and
+    // normals lose their meaning; above 1,000 km a sample is no longer terrain.
+    for (const double s : {d.spacing_x, d.spacing_z})
+      if (s < kMinSpacingM || s > kMaxSpacingM)
+        return Error{"--spacing '" + spacing_ + "': spacing must be within 1e-6 .. 1e6 metres"};
   }
   if (given("--height-scale")) {
     auto v = parse_finite(height_scale_, "--height-scale");

@@ -34,8 +34,9 @@ ensure_packages() {
 # fetch_test_data [DIR]: data no one here made, for the tests that read real files (default
 # build/test-data, the tests' RIDGELINE_TEST_EXTERNAL_DATA): Debian's r-cran-terra example
 # rasters (elev.tif: a real DEM in degrees; meuse.tif: one in projected metres), taken from the
-# package without installing R (apt-get download, dpkg -x). Prints a note and returns 0 when the
-# package cannot be fetched: those tests then skip, naming the missing file.
+# package without installing R (apt-get download, dpkg -x). The ctest fixture fetch_terra_data
+# runs it too. Returns 1 with a message when the package cannot be fetched (those tests then
+# fail, naming the missing file).
 fetch_test_data() {
   local dir=${1:-$RIDGELINE_ROOT/build/test-data}
   local ex=$dir/terra/usr/lib/R/site-library/terra/ex
@@ -47,8 +48,11 @@ fetch_test_data() {
     { apt-get download r-cran-terra > /dev/null 2>&1 ||
       { "${sudo[@]}" apt-get update -qq > /dev/null && apt-get download r-cran-terra > /dev/null; }; } &&
     rm -rf terra && dpkg -x r-cran-terra_*.deb terra && rm -f r-cran-terra_*.deb) ||
-    echo "note: could not fetch r-cran-terra; the tests on elev.tif and meuse.tif will be skipped"
-  return 0
+    { echo "error: could not fetch r-cran-terra (apt-get download); the tests on elev.tif and" \
+        "meuse.tif need it"; return 1; }
+  [ -f "$ex/elev.tif" ] && [ -f "$ex/meuse.tif" ] ||
+    { echo "error: r-cran-terra holds no $ex/elev.tif or meuse.tif"; return 1; }
+  echo "r-cran-terra's example rasters: fetched into $dir/terra"
 }
 
 # configure_and_build BUILD_DIR [cmake args...]

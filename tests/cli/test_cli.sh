@@ -157,6 +157,15 @@ run info --heightmap "$T/missing.png"; expect "missing file" 1 "heightmap '$T/mi
 run info --heightmap "$T"; expect "directory" 1 "is a directory"
 head -c 60 "$PNG" > "$T/truncated.png"
 run info --heightmap "$T/truncated.png"; expect "truncated png" 1 "heightmap '$T/truncated.png'"
+# One message, one line: nothing printed before it (libpng's own line) and no repeated reason.
+if [ "$err" = "ridge: error: heightmap '$T/truncated.png': truncated PNG file: it ends inside the header of chunk 3 at byte 54 (60 bytes in all)" ]; then ok; else bad "truncated png: not one clear line" "stderr: $err"; fi
+for n in 8 20 40 70 100 105; do
+  head -c $n "$PNG" > "$T/cut.png"
+  run info --heightmap "$T/cut.png"
+  expect "png cut at $n bytes" 1 "ridge: error: heightmap '$T/cut.png': truncated PNG file: "
+  [ "$(printf '%s\n' "$err" | wc -l)" = 1 ] && [ "$(grep -o truncated <<< "$err" | wc -l)" = 1 ] &&
+    ok || bad "png cut at $n bytes: not one message on one line" "stderr: $err"
+done
 printf 'this is not a png at all, not even close.........' > "$T/garbage.png"
 run info --heightmap "$T/garbage.png"; expect "garbage png" 1 "not a readable image"
 run info --heightmap "$RGB"; expect "rgb refused" 1 "3 channels (R, G, B)"
@@ -173,19 +182,24 @@ for args in "--spacing nan" "--spacing inf" "--spacing -1" "--spacing 0" "--spac
             "--spacing 1,nan" "--spacing abc" "--height-scale 0" "--height-scale -inf" \
             "--height-offset nan" "--origin 1" "--origin 1,2,3" "--origin nan,0" "--nodata nan" \
             "--fill sideways" "--fill constant:" "--fill constant:nan" "--max-samples 1.5" \
-            "--max-samples -3" "--height-offset 1e999"; do
+            "--max-samples -3" "--height-offset 1e999" "--spacing 1e-300" "--spacing 1e-7" \
+            "--spacing 1,1e-300" "--spacing 2e6"; do
   # shellcheck disable=SC2086
   run info --default-terrain $args
   flag=${args%% *}
   expect "info $args" 1 "${flag%%=*}"
 done
+run info --default-terrain --spacing 1e-300
+expect "absurd spacing names the range" 1 "--spacing '1e-300': spacing must be within 1e-6 .. 1e6 metres"
+run info --heightmap "$PNG" --spacing 1e-6; expect "spacing of a micrometre" 0
+run info --heightmap "$PNG" --spacing 1e6,1; expect "spacing of 1,000 km" 0
 run info --default-terrain --spacing=; expect "empty --spacing=" 2
 run info --default-terrain --spacing ""; expect "empty --spacing" 1 "--spacing"
 run info --default-terrain --spacing 4 --origin 100,200 --height-offset 1000
 expect "default terrain placed" 0
 [[ "$(tr -d ' \n' <<< "$out")" == *'"extent":[4096.0,4096.0]'* ]] && ok || bad "placed extent"
 
-# ---- GeoTIFF placement (real DEMs from Debian's r-cran-terra, fetched by scripts/test.sh) ----------
+# ---- GeoTIFF placement (real DEMs from Debian's r-cran-terra, fetched by the ctest fixture) ------
 EX=${EXTERNAL_DATA:-}/terra/usr/lib/R/site-library/terra/ex
 if [ -f "$EX/elev.tif" ] && [ -f "$EX/meuse.tif" ]; then
   # elev.tif: 1/120-degree cells at 49.8 N, about 598.8 x 926.7 m; 46 % no-data outside Luxembourg.
@@ -215,7 +229,7 @@ if [ -f "$EX/elev.tif" ] && [ -f "$EX/meuse.tif" ]; then
   contains "--origin overrides the file" '"origin_source": "flag"'
   contains "--origin keeps the file's spacing" '"spacing_source": "geotiff"'
 else
-  echo "note: $EX/elev.tif or meuse.tif missing (scripts/test.sh fetches r-cran-terra): GeoTIFF checks skipped"
+  bad "$EX/elev.tif or meuse.tif missing: the ctest fixture fetch_terra_data fetches r-cran-terra"
 fi
 run info --default-terrain; contains "default terrain pixel type" '"pixel_type": "float (generated)"'
 contains "default terrain spacing source" '"spacing_source": "default"'

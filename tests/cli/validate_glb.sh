@@ -1,11 +1,16 @@
 #!/usr/bin/env bash
 # `ridge mesh` writes a .glb that Khronos' glTF-Validator (npm package gltf-validator) accepts.
-# Skipped (exit 77) where node or the validator is not available; scripts/test.sh installs the
-# validator when npm exists.
+# The validator comes from the ctest fixture install_gltf_validator (tests/cli/
+# install_gltf_validator.sh); without node or the validator this test fails, naming what is
+# missing (it never skips).
 set -uo pipefail
 validator_dir=${GLTF_VALIDATOR_DIR:-}
-if ! command -v node >/dev/null || [ -z "$validator_dir" ] || [ ! -d "$validator_dir/node_modules/gltf-validator" ]; then
-  echo "skipped: node or gltf-validator not available"; exit 77
+if ! command -v node >/dev/null; then
+  echo "FAIL: node not found (apt-get install nodejs npm)"; exit 1
+fi
+if [ -z "$validator_dir" ] || [ ! -d "$validator_dir/node_modules/gltf-validator" ]; then
+  echo "FAIL: no gltf-validator in '$validator_dir' (tests/cli/install_gltf_validator.sh installs it)"
+  exit 1
 fi
 out=$TMPDIR/validate_glb
 mkdir -p "$out"

@@ -2,7 +2,9 @@
 // keeps running; callbacks; attaching to an engine's state; symbolic links out of the folder.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -12,6 +14,8 @@
 
 #include "../unit/file_limit_child.h"
 #include "ridgeline/lua/host.h"
+#include "ridgeline/lua/module.h"
+#include "ridgeline/terrain.h"
 
 namespace {
 
@@ -85,6 +89,172 @@ TEST(LuaHost, MemoryBombEndsTheCallOnly) {
   const auto cat = host->run("local s = 'x' while true do s = s .. s end", "cat.lua");
   EXPECT_FALSE(cat.ok());
   expect_alive(*host);
+}
+
+// A reallocation gives its old block back: growing a table's array part from 2^18 to 2^19
+// entries (4 MiB to 8 MiB) holds 8 MiB afterwards, not 12. Under a 10 MiB cap (11.25 MiB with
+// the headroom) that table must be allowed; counting the old block as still held refuses it.
+TEST(LuaHost, AGrowingTableIsChargedWhatItHoldsAfterTheReallocation) {
+  HostOptions o;
+  o.memory_limit = 10 << 20;
+  auto host = make_host(o);
+  const auto s = host->run(R"(
+    local t = {}
+    for i = 1, 1 << 19 do t[i] = i end
+    assert(#t == 1 << 19))",
+                           "grow.lua");
+  EXPECT_TRUE(s.ok()) << "a table of 2^19 entries (8 MiB) was refused under a 10 MiB cap "
+                         "(the old block counted as held during its reallocation?): "
+                      << s.message();
+  // Twice the size is beyond the cap and is refused.
+  const auto big = host->run("local t = {} for i = 1, 1 << 20 do t[i] = i end", "grow2.lua");
+  EXPECT_FALSE(big.ok());
+  EXPECT_NE(big.message().find("memory limit exceeded"), std::string::npos) << big.message();
+  expect_alive(*host);
+}
+
+// This process's resident memory from /proc/self/status: "VmHWM" (the peak since the last
+// reset_peak_rss()) or "VmRSS" (now), bytes.
+std::size_t status_bytes(const char* field) {
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind(field, 0) == 0)
+      return std::size_t(std::stoull(line.substr(line.find(':') + 1))) << 10;
+  return 0;
+}
+// Resets VmHWM to the current RSS (Linux 4.0+: "5" to clear_refs), so that tests run in one
+// process do not see each other's peaks. False when the kernel refuses.
+bool reset_peak_rss() {
+  std::ofstream out("/proc/self/clear_refs");
+  out << "5";
+  out.flush();
+  return bool(out);
+}
+
+// C++ objects made for scripts are charged to the host's object budget (HostOptions::
+// object_memory_limit, 256 MiB by default): a script under the default 64 MiB Lua cap that
+// hoards 300 copies of the default terrain (about 1.8 GB) fails with an error naming the budget
+// and how to raise it, the process stays far below that, and the host runs on; released objects
+// give their share back.
+TEST(LuaHost, TerrainsAScriptHoardsAreChargedToTheHost) {
+  const bool peak = reset_peak_rss();
+  auto host = make_host();
+  const auto s = host->run("keep = {}\nfor i = 1, 300 do keep[i] = ridgeline.default_terrain() end",
+                           "hoard.lua");
+  ASSERT_FALSE(s.ok()) << "300 default terrains fitted in the object budget";
+  EXPECT_NE(s.message().find("hoard.lua:2: default_terrain: C++ object memory budget exceeded"),
+            std::string::npos)
+      << s.message();
+  EXPECT_NE(s.message().find("of 256.0 MiB held by the terrains, landscapes and views"),
+            std::string::npos)
+      << s.message();
+  EXPECT_NE(s.message().find("object_memory_limit"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("stack traceback:"), std::string::npos) << s.message();
+  EXPECT_LE(host->object_memory_used(), std::size_t{256} << 20);
+  EXPECT_GT(host->object_memory_used(), std::size_t{200} << 20);
+  const std::size_t rss = status_bytes(peak ? "VmHWM" : "VmRSS");
+  EXPECT_LT(rss, std::size_t{512} << 20) << (peak ? "peak" : "current") << " RSS";
+  std::printf("object budget: %zu bytes charged, %s RSS %zu MiB\n", host->object_memory_used(),
+              peak ? "peak" : "current", rss >> 20);
+  // The host runs on; released terrains give their share back (the module keeps its original).
+  ASSERT_TRUE(host->run("assert(#keep > 15 and #keep < 300, #keep)\n"
+                        "for i = 1, #keep do keep[i]:release() end\nkeep = nil",
+                        "release.lua")
+                  .ok());
+  EXPECT_LT(host->object_memory_used(), std::size_t{16} << 20);
+  expect_alive(*host);
+  // Dropped terrains come back through the collector, however many are made in turn.
+  const auto churn = host->run(R"(
+    for i = 1, 100 do
+      local t = ridgeline.default_terrain()
+      assert(t:deform{brush = "crater", x = 500 + i, z = 500, radius = 5})
+    end)",
+                               "churn.lua");
+  EXPECT_TRUE(churn.ok()) << churn.message();
+}
+
+// A view's memory grows with its triangles: under the budget an update is held to the triangles
+// that fit and raises the same error; lowering the view's own cap makes it fit again.
+TEST(LuaHost, AViewIsHeldToTheTrianglesTheObjectBudgetHasRoomFor) {
+  const bool peak = reset_peak_rss();
+  const std::size_t before = status_bytes("VmRSS");  // ASan's quarantine may hold earlier tests'
+  HostOptions o;
+  o.object_memory_limit = std::size_t{80} << 20;
+  auto host = make_host(o);
+  const auto s = host->run(R"(
+    t = ridgeline.default_terrain()
+    v = t:new_view{eye = {100, 30, 100}, target = {1000, 0, 1000}, fov_y = 90, threshold = 0,
+                   triangles = 0}
+    local ok, err = pcall(v.update, v)
+    assert(not ok, "a view of 4,000,000 triangles fitted in 80 MiB")
+    assert(err:find("view:update: C++ object memory budget exceeded (the view was held to", 1, true), err)
+    local s = v:stats()
+    assert(s.stop == "triangle_budget" and s.triangles > 50000 and s.triangles < 400000, s.triangles)
+    v:set_budget{triangles = 20000}
+    s = v:update()
+    assert(s.triangles <= 20000))",
+                           "view.lua");
+  EXPECT_TRUE(s.ok()) << s.message();
+  EXPECT_LE(host->object_memory_used(), std::size_t{80} << 20);
+  // The script's objects (80 MiB charged) and ASan's shadow and redzones around them.
+  const std::size_t rss = status_bytes(peak ? "VmHWM" : "VmRSS");
+  EXPECT_LT(rss - std::min(rss, before), std::size_t{200} << 20)
+      << (peak ? "peak" : "current") << " RSS grew from " << (before >> 20) << " MiB to "
+      << (rss >> 20) << " MiB";
+  // Another view of the same terrain shares its landscape: only its own part is charged.
+  const std::size_t charged = host->object_memory_used();
+  ASSERT_TRUE(
+      host->run("w = t:new_view{eye = {100, 300, 100}, target = {1000, 0, 1000}} w:update()",
+                "second.lua")
+          .ok());
+  EXPECT_LT(host->object_memory_used() - charged, std::size_t{8} << 20);
+  // The terrain's handle released, its views keep it (and its charge) alive.
+  ASSERT_TRUE(host->run("t:release() t = nil collectgarbage()", "drop.lua").ok());
+  EXPECT_GT(host->object_memory_used(), std::size_t{30} << 20);
+  ASSERT_TRUE(
+      host->run("v:release() w:release() v, w = nil, nil collectgarbage()", "drop2.lua").ok());
+  EXPECT_LT(host->object_memory_used(), std::size_t{16} << 20);
+}
+
+// An engine's own terrain handed to scripts is not charged; what scripts build on it is.
+TEST(LuaHost, AnEnginesTerrainIsNotChargedButItsViewsAre) {
+  auto host = make_host();
+  auto hf = ridgeline::make_default_heightfield({.size = 257});
+  ASSERT_TRUE(hf);
+  auto terrain = ridgeline::Terrain::create(std::move(*hf)).value();
+  ridgeline::lua::push_terrain(host->state(), terrain);
+  ASSERT_TRUE(host->set_global("engine_terrain").ok());
+  const std::size_t before = host->object_memory_used();
+  ASSERT_TRUE(host->run("assert(engine_terrain:height(10, 10))", "query").ok());
+  EXPECT_EQ(host->object_memory_used(), before);
+  ASSERT_TRUE(host->run("v = engine_terrain:new_view{} v:update()", "view").ok());
+  EXPECT_GT(host->object_memory_used(), before + (std::size_t{1} << 20));
+}
+
+// Host::reset() gives scripts the globals they had at creation and frees what only the old
+// ones held (the fuzz target reuses one host across inputs this way).
+TEST(LuaHost, ResetGivesScriptsThePristineGlobals) {
+  auto host = make_host();
+  ASSERT_TRUE(host->run("x = 1\nstring.rep = nil\nridgeline.load = nil\n_G.print = nil\n"
+                        "t = ridgeline.default_terrain()",
+                        "dirty.lua")
+                  .ok());
+  const std::size_t held = host->object_memory_used();
+  ASSERT_TRUE(host->reset().ok());
+  const auto s = host->run(
+      "assert(x == nil and t == nil and print and _G == _ENV)\n"
+      "assert(string.rep and ('x'):rep(2) == 'xx' and ridgeline.load and "
+      "ridgeline.default_terrain)",
+      "clean.lua");
+  EXPECT_TRUE(s.ok()) << s.message();
+  EXPECT_LT(host->object_memory_used(), held) << "the dropped terrain was not collected";
+  expect_alive(*host);
+  HostOptions open;
+  open.sandbox = false;
+  auto unsandboxed = Host::create(open);
+  ASSERT_TRUE(unsandboxed.ok());
+  EXPECT_FALSE((*unsandboxed)->reset().ok());
 }
 
 TEST(LuaHost, DeepRecursionIsContained) {

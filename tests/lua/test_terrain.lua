@@ -105,6 +105,12 @@ T.case("expected misses return nil, message", function()
   T.truthy(err:find("no_such_file.png", 1, true), "message names the file: " .. err)
   t, err = ridgeline.load{heightmap = DATA .. "ramp16.png", spacing = -1}
   T.eq(t, nil, "bad spacing"); T.truthy(err:find("spacing", 1, true), "message names spacing: " .. err)
+  for _, s in ipairs{1e-300, 1e-7, 2e6} do
+    t, err = ridgeline.load{heightmap = DATA .. "ramp16.png", spacing = {1, s}}
+    T.eq(t, nil, "absurd spacing " .. s)
+    T.truthy(err:find("is outside 1e-6 .. 1e6 m", 1, true), "message gives the range: " .. err)
+  end
+  T.truthy(ridgeline.load{heightmap = DATA .. "ramp16.png", spacing = 1e-6}, "a micrometre")
   t, err = ridgeline.load{heightmap = DATA .. "rgb8.png"}
   T.eq(t, nil, "three channels"); T.truthy(#err > 0)
 end)

@@ -373,6 +373,31 @@ TEST(BudgetController, IsolatedSlowFramesAreOutliers) {
   EXPECT_EQ(c.state().reversals, 0u);
 }
 
+// Right after the warm-up the ring of recent frames fills one frame at a time. While it holds an
+// even count the filter takes the lower median, so one slow frame among the first two is still an
+// outlier: 33 ms then one 200 ms frame must hold, for every filter length.
+TEST(BudgetController, OneSlowFrameWhileTheFilterFillsIsAnOutlier) {
+  for (const std::uint32_t n : {3u, 5u, 7u, 15u}) {
+    BudgetControllerDesc d;
+    d.median_frames = n;
+    BudgetController c = make(d);
+    for (std::uint32_t i = 0; i < d.warmup_frames; ++i) c.update(33, kDt);
+    ASSERT_TRUE(c.state().warming_up);
+    c.update(33, 0.033);
+    ASSERT_FALSE(c.state().warming_up);
+    c.update(200, 0.2);
+    EXPECT_EQ(c.state().filtered_ms, 33.0)
+        << "median of {33, 200} with a filter of " << n
+        << " frames: the upper median let the slow frame through";
+    EXPECT_STREQ(ridgeline::to_string(c.state().action), "hold") << n << " frames";
+    EXPECT_EQ(c.threshold(), 2.0) << n << " frames: one slow frame raised the threshold";
+    // The third frame: the median of {33, 200, 33} is 33 whichever rule.
+    c.update(33, 0.033);
+    EXPECT_EQ(c.state().filtered_ms, 33.0);
+    EXPECT_EQ(c.threshold(), 2.0) << n << " frames";
+  }
+}
+
 TEST(BudgetController, ALastingChangeOfLoadIsNotAnOutlier) {
   // Three slow frames in a row are a change of load: the median follows within three frames.
   BudgetController c = make();

@@ -375,10 +375,34 @@ TEST(IoBadInput, CorruptPngDataIsRefused) {
   auto bytes = read_bytes(path);
   for (std::size_t k = bytes.size() / 2; k < bytes.size() / 2 + 64; ++k) bytes[k] ^= 0x5a;
   write_bytes(path, bytes);
+  testing::internal::CaptureStderr();
   auto hf = io::load_image(path, options());
+  const std::string printed = testing::internal::GetCapturedStderr();
   ASSERT_FALSE(hf) << "a corrupt PNG loaded";
-  EXPECT_TRUE(contains(hf.error().message, "heightmap '" + path + "': cannot read the pixels"))
+  EXPECT_TRUE(contains(hf.error().message,
+                       "heightmap '" + path + "': corrupt PNG file: chunk 'IDAT' at byte "))
       << hf.error().message;
+  EXPECT_TRUE(contains(hf.error().message, "fails its CRC check")) << hf.error().message;
+  EXPECT_EQ(printed, "") << "printed beside the error";
+}
+
+// A PNG cut short anywhere is refused with one message naming the chunk where it ends, and
+// nothing is printed beside it (libpng prints its own line for a read error it meets).
+TEST(IoBadInput, ATruncatedPngIsOneMessageAndNothingPrinted) {
+  const auto full = read_bytes(std::string(RIDGELINE_TEST_DATA) + "/ramp16.png");
+  ASSERT_GT(full.size(), 60u);
+  for (std::size_t n = 8; n < full.size(); ++n) {
+    const auto path = tmp_path("cut.png");
+    write_bytes(path, std::vector<char>(full.begin(), full.begin() + std::ptrdiff_t(n)));
+    testing::internal::CaptureStderr();
+    auto hf = io::load_image(path, options());
+    const std::string printed = testing::internal::GetCapturedStderr();
+    ASSERT_FALSE(hf) << n << " of " << full.size() << " bytes loaded";
+    const std::string& m = hf.error().message;
+    EXPECT_EQ(m.rfind("heightmap '" + path + "': truncated PNG file: ", 0), 0u) << m;
+    EXPECT_EQ(m.find("truncated", m.find("truncated") + 1), std::string::npos) << m;
+    EXPECT_EQ(printed, "") << n << " bytes: printed beside the error";
+  }
 }
 
 TEST(IoBadInput, ColourImageNeedsAChannel) {
@@ -1096,6 +1120,9 @@ TEST(IoGeoTiff, UnusablePlacementTagsAreIgnoredWithAWarning) {
       {"tie points alone", {tiepoint(0, 0, 0, 0), keys}, "a grid of tie points"},
       {"negative scale", {pixel_scale(30, -30), tiepoint(0, 0, 0, 0), keys}, "need positive"},
       {"zero scale", {pixel_scale(0, 30), tiepoint(0, 0, 0, 0), keys}, "need positive"},
+      {"pixels below a micrometre",
+       {pixel_scale(30, 1e-7), tiepoint(0, 0, 0, 0), keys},
+       "pixel size 30 x 1e-07 m is below 1e-6 m"},
       {"short tie point",
        {pixel_scale(30, 30), Tag{33922, 12, {0, 0, 0, 1}}, keys},
        "holds 4 values (need 6 per tie point)"},
@@ -1148,6 +1175,50 @@ TEST(IoGeoTiff, UnusablePlacementTagsAreIgnoredWithAWarning) {
   }
 }
 
+// A key whose value sits in GeoDoubleParams (location 34736) names an index into that tag's
+// doubles: the last one is read, one past it is refused (never read: the doubles end there).
+// Projected metres in a user-defined unit (ProjLinearUnitsGeoKey 32767) whose size in metres
+// (ProjLinearUnitSizeGeoKey 3077) is the double at `index` of {1.5, 2.0, 0.25}.
+TEST(IoGeoTiff, GeoDoubleParamsAreReadUpToTheirLastEntryAndNoFurther) {
+  auto file = [](double index) {
+    const Tag dir{34735, 3, {1, 1, 0, 3, 1024, 0, 1, 1, 3076, 0, 1, 32767, 3077, 34736, 1, index}};
+    const Tag doubles{34736, 12, {1.5, 2.0, 0.25}};
+    return tiff_with_tags(3, 2, kSix,
+                          {pixel_scale(30, 20), tiepoint(0, 0, 1000, 2000), dir, doubles});
+  };
+  {  // The last entry: 0.25 m per unit.
+    const auto path = tmp_path("doubles_last.tif");
+    write_bytes(path, file(2));
+    io::LoadReport report;
+    LogCapture log;
+    auto hf = io::load_image(path, from_file(), &report);
+    ASSERT_TRUE(hf) << hf.error().message;
+    ASSERT_TRUE(report.file_placement) << (log.messages.empty() ? "" : log.messages[0]);
+    EXPECT_EQ(hf->spacing_x(), 7.5) << "30 units of the double at index 2 (0.25 m)";
+    EXPECT_EQ(hf->spacing_z(), 5.0);
+    EXPECT_EQ(hf->origin_x(), 253.75);  // (1000 + 15) * 0.25
+    EXPECT_EQ(hf->origin_z(), -497.5);  // -(2000 - 10) * 0.25
+    EXPECT_TRUE(report.warnings.empty());
+  }
+  for (const double index : {3.0, 4.0, 65535.0}) {  // one past the last, and further
+    const auto path = tmp_path("doubles_past.tif");
+    write_bytes(path, file(index));
+    io::LoadReport report;
+    LogCapture log;
+    auto o = from_file();
+    o.placement.spacing_x = o.placement.spacing_z = 2;
+    auto hf = io::load_image(path, o, &report);
+    ASSERT_TRUE(hf) << hf.error().message;
+    EXPECT_FALSE(report.file_placement) << "index " << index << " of 3 doubles was read";
+    EXPECT_EQ(hf->spacing_x(), 2.0) << "index " << index;
+    ASSERT_EQ(log.messages.size(), 1u);
+    EXPECT_TRUE(contains(log.messages[0], "geo key 3077 refers to GeoDoubleParams entry " +
+                                              std::to_string(int(index)) +
+                                              ", which the file lacks"))
+        << log.messages[0];
+  }
+}
+
 TEST(IoGeoTiff, APlacementBeyondTheLimitsIsRefused) {
   // Metres from the file pass the same checks as given ones: a spacing whose extent overflows.
   const auto path = tmp_path("huge.tif");
@@ -1186,8 +1257,9 @@ TEST(IoGeoTiff, ReaderIsBoundedOnEveryTruncation) {
 }
 
 // Real data: Debian's r-cran-terra ships elev.tif (Luxembourg, 1/120-degree cells, WGS 84) and
-// meuse.tif (the Netherlands' RD New projection, 40 m cells). scripts/test.sh fetches them into
-// RIDGELINE_TEST_EXTERNAL_DATA (apt-get download r-cran-terra; dpkg -x).
+// meuse.tif (the Netherlands' RD New projection, 40 m cells). The ctest fixture fetch_terra_data
+// fetches them into RIDGELINE_TEST_EXTERNAL_DATA (apt-get download r-cran-terra; dpkg -x); a
+// missing file fails the test (it never skips).
 std::string terra_file(const char* name) {
   return std::string(RIDGELINE_TEST_EXTERNAL_DATA) + "/terra/usr/lib/R/site-library/terra/ex/" +
          name;
@@ -1195,9 +1267,9 @@ std::string terra_file(const char* name) {
 
 TEST(IoGeoTiff, RealGeographicDem) {
   const std::string path = terra_file("elev.tif");
-  if (!fs::exists(path))
-    GTEST_SKIP() << path << " is missing: scripts/test.sh fetches it (apt-get download "
-                 << "r-cran-terra, dpkg -x into " << RIDGELINE_TEST_EXTERNAL_DATA << "/terra)";
+  ASSERT_TRUE(fs::exists(path))
+      << path << " is missing: the ctest fixture fetch_terra_data fetches it (apt-get download "
+      << "r-cran-terra, dpkg -x into " << RIDGELINE_TEST_EXTERNAL_DATA << "/terra)";
   io::LoadReport report;
   auto o = from_file();
   o.placement.fill = FillPolicy::kNearest;
@@ -1225,9 +1297,9 @@ TEST(IoGeoTiff, RealGeographicDem) {
 
 TEST(IoGeoTiff, RealProjectedDem) {
   const std::string path = terra_file("meuse.tif");
-  if (!fs::exists(path))
-    GTEST_SKIP() << path << " is missing: scripts/test.sh fetches it (apt-get download "
-                 << "r-cran-terra, dpkg -x into " << RIDGELINE_TEST_EXTERNAL_DATA << "/terra)";
+  ASSERT_TRUE(fs::exists(path))
+      << path << " is missing: the ctest fixture fetch_terra_data fetches it (apt-get download "
+      << "r-cran-terra, dpkg -x into " << RIDGELINE_TEST_EXTERNAL_DATA << "/terra)";
   io::LoadReport report;
   auto o = from_file();
   o.placement.fill = FillPolicy::kNearest;

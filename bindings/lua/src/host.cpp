@@ -34,8 +34,9 @@ struct Host::Limits {
 namespace {
 
 constexpr int kHookStep = 1000;
-char kLimitsKey;   // registry key (light userdata address) of the Limits
-char kSandboxKey;  // registry key of the sandbox environment table
+char kLimitsKey;    // registry key (light userdata address) of the Limits
+char kSandboxKey;   // registry key of the sandbox environment table
+char kTemplateKey;  // registry key of the sandbox's pristine globals (Host::reset)
 
 void* limited_alloc(void* ud, void* ptr, std::size_t osize, std::size_t nsize) {
   auto* lim = static_cast<Host::Limits*>(ud);
@@ -210,6 +211,31 @@ struct SetupArgs {
   const HostOptions* options;
 };
 
+// Copies the globals in table `from` into table `to` (stack indices), every table value copied
+// one level deep (the libraries' functions and the module's are shared), `_G` left out.
+void copy_globals(lua_State* L, int from, int to) {
+  lua_pushnil(L);
+  while (lua_next(L, from) != 0) {  // key -2, value -1
+    if (lua_type(L, -2) == LUA_TSTRING && std::strcmp(lua_tostring(L, -2), "_G") == 0) {
+      lua_pop(L, 1);
+      continue;
+    }
+    if (lua_type(L, -1) == LUA_TTABLE) {
+      lua_newtable(L);
+      lua_pushnil(L);
+      while (lua_next(L, -3) != 0) {
+        lua_pushvalue(L, -2);
+        lua_insert(L, -2);
+        lua_rawset(L, -4);
+      }
+      lua_replace(L, -2);
+    }
+    lua_pushvalue(L, -2);
+    lua_insert(L, -2);
+    lua_rawset(L, to);
+  }
+}
+
 // Opens the libraries and builds the sandbox environment; runs under lua_pcall.
 int setup_state(lua_State* L) {
   const auto* args = static_cast<const SetupArgs*>(lua_touserdata(L, 1));
@@ -218,6 +244,7 @@ int setup_state(lua_State* L) {
     luaL_openlibs(L);
     ModuleConfig config;
     config.max_samples = o.max_samples;
+    config.object_memory_limit = o.object_memory_limit;
     open_module(L, config);
     lua_setglobal(L, "ridgeline");
     lua_pushglobaltable(L);
@@ -287,8 +314,28 @@ int setup_state(lua_State* L) {
   config.confine_paths = true;
   config.root = o.data_root.c_str();
   config.max_samples = o.max_samples;
+  config.object_memory_limit = o.object_memory_limit;
   open_module(L, config);
   lua_setfield(L, env, "ridgeline");
+  lua_pushvalue(L, env);
+  lua_rawsetp(L, LUA_REGISTRYINDEX, &kSandboxKey);
+  // The pristine globals, for Host::reset: every table (the library copies, `ridgeline`) copied
+  // once more, so that a script's changes to its copies never reach the template.
+  lua_newtable(L);
+  copy_globals(L, env, lua_gettop(L));
+  lua_rawsetp(L, LUA_REGISTRYINDEX, &kTemplateKey);
+  return 0;
+}
+
+// A fresh sandbox environment from the template (runs under lua_pcall).
+int reset_state(lua_State* L) {
+  lua_rawgetp(L, LUA_REGISTRYINDEX, &kTemplateKey);
+  const int from = lua_gettop(L);
+  lua_newtable(L);
+  const int env = lua_gettop(L);
+  copy_globals(L, from, env);
+  lua_pushvalue(L, env);
+  lua_setfield(L, env, "_G");
   lua_pushvalue(L, env);
   lua_rawsetp(L, LUA_REGISTRYINDEX, &kSandboxKey);
   return 0;
@@ -392,6 +439,7 @@ Status Host::setup(const HostOptions& options) {
   }
   lua_sethook(L, count_hook, LUA_MASKCOUNT, kHookStep);
   lim.active = true;
+  sandbox_ = options.sandbox;
   return {};
 }
 
@@ -405,6 +453,27 @@ Host::~Host() {
     lua_pushnil(L_);
     lua_rawsetp(L_, LUA_REGISTRYINDEX, &kLimitsKey);
   }
+}
+
+Status Host::reset() {
+  if (!sandbox_) return Error{"lua host: reset needs a sandboxed host"};
+  lua_State* L = L_;
+  if (!lua_checkstack(L, 8)) return Error{"lua host: stack overflow"};
+  limits_->active = false;  // the host's own work: not charged to the next call
+  lua_pushcfunction(L, reset_state);
+  const int rc = lua_pcall(L, 0, 0, 0);
+  std::string msg;
+  if (rc != LUA_OK) {
+    msg = lua_tostring(L, -1) != nullptr ? lua_tostring(L, -1) : "error";
+    lua_pop(L, 1);
+  } else {
+    // Whatever only the old globals held (terrains, views, coroutines) goes now, and with it
+    // their share of the object budget.
+    lua_gc(L, LUA_GCCOLLECT, 0);
+  }
+  limits_->active = true;
+  if (rc != LUA_OK) return Error{"lua host: reset: " + msg};
+  return {};
 }
 
 Status Host::call(int nargs, int nresults) {
@@ -491,6 +560,9 @@ Status Host::set_global(const char* name) {
 
 std::size_t Host::memory_used() const noexcept {
   return owned_ ? limits_->used : 0;
+}
+std::size_t Host::object_memory_used() const noexcept {
+  return ridgeline::lua::object_memory_used(L_);
 }
 std::uint64_t Host::last_instructions() const noexcept {
   return limits_->instructions;

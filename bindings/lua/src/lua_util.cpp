@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <string>
@@ -254,6 +255,63 @@ bool resolve_path(bool confine_paths, const char* config_root, const char* name,
 void account_memory(lua_State* L, std::size_t bytes) {
   const int kb = static_cast<int>(std::min<std::size_t>(bytes / 1024, 1 << 20));
   if (kb > 0) lua_gc(L, LUA_GCSTEP, kb);
+}
+
+namespace {
+char kConfigKey;  // registry key (light userdata address) of the last opened module's config
+}  // namespace
+
+void register_config(lua_State* L, int index) {
+  lua_pushvalue(L, index);
+  lua_rawsetp(L, LUA_REGISTRYINDEX, &kConfigKey);
+}
+
+std::shared_ptr<ObjectBudget> object_budget_of(lua_State* L) {
+  lua_rawgetp(L, LUA_REGISTRYINDEX, &kConfigKey);
+  const auto* config = static_cast<const ConfigBox*>(lua_touserdata(L, -1));
+  lua_pop(L, 1);
+  return config != nullptr ? config->budget : nullptr;
+}
+
+int object_budget_error(lua_State* L, const ObjectBudget& budget, const char* what,
+                        const char* detail) {
+  constexpr double kMiB = 1024.0 * 1024.0;
+  char text[512];
+  std::snprintf(text, sizeof text,
+                "%s: C++ object memory budget exceeded (%s): %.1f MiB of %.1f MiB held by the "
+                "terrains, landscapes and views made by scripts; release objects (obj:release(), "
+                "a <close> variable) or ask the host to raise its object_memory_limit",
+                what, detail, double(budget.used) / kMiB, double(budget.limit) / kMiB);
+  return luaL_error(L, "%s", text);
+}
+
+bool make_room(lua_State* L, const std::shared_ptr<ObjectBudget>& budget, std::size_t bytes,
+               std::size_t own) {
+  if (!budget || budget->limit == 0) return true;
+  const ObjectBudget& b = *budget;
+  if (b.used - std::min(own, b.used) + bytes <= b.limit) return true;
+  lua_gc(L, LUA_GCCOLLECT, 0);
+  return b.used - std::min(own, b.used) + bytes <= b.limit;
+}
+
+void reserve_objects(lua_State* L, const std::shared_ptr<ObjectBudget>& budget, std::size_t bytes,
+                     const char* what, std::size_t own) {
+  if (make_room(L, budget, bytes, own)) return;
+  char detail[96];
+  std::snprintf(detail, sizeof detail, "%.1f MiB more needed", double(bytes) / (1024.0 * 1024.0));
+  object_budget_error(L, *budget, what, detail);
+}
+
+std::size_t terrain_charge_bytes(const Terrain& terrain, std::size_t cache_bytes, bool shared) {
+  const WorldInfo& info = terrain.info();
+  // An edit copies the pages holding the samples it changes (copy on write, their coarser levels
+  // too): at most every level-0 page once more, its samples as floats, its apron and its ray
+  // bounds, plus a third for the coarser levels.
+  const std::size_t pages = ((std::size_t{info.width} + kPageCells - 1) / kPageCells) *
+                            ((std::size_t{info.height} + kPageCells - 1) / kPageCells);
+  const std::size_t edit_layer = pages * kPageEntries * (sizeof(float) + 2) * 4 / 3;
+  const std::size_t change_log = kChangeLogCapacity * (sizeof(TerrainChange) + 16);
+  return (shared ? 0 : terrain.memory_bytes()) + edit_layer + change_log + cache_bytes;
 }
 
 }  // namespace ridgeline::lua::detail

@@ -1,5 +1,7 @@
 // The `ridgeline` module table: loading terrains; the per-module configuration userdata.
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <exception>
 #include <new>
@@ -13,6 +15,20 @@ namespace {
 
 ConfigBox* config_of(lua_State* L) {
   return static_cast<ConfigBox*>(lua_touserdata(L, lua_upvalueindex(1)));
+}
+
+// Charges a terrain made for a script to the module's budget (no Lua calls).
+bool charge_terrain(TerrainBox* box, const std::shared_ptr<ObjectBudget>& budget, std::size_t bytes,
+                    char* err) noexcept {
+  try {
+    box->budget = budget;
+    box->terrain_charge = std::make_shared<Charge>(budget, bytes);
+    return true;
+  } catch (const std::exception& e) {
+    box->terrain.reset();
+    copy_error(err, e.what());
+    return false;
+  }
 }
 
 // Plain data read from the option table of ridgeline.load before any C++ object exists.
@@ -29,10 +45,24 @@ struct LoadArgs {
   bool has_amplitude = false, has_gain = false;
 };
 
-bool do_load(const ConfigBox& config, const LoadArgs& a, TerrainBox* box, char* err) noexcept {
+std::string fmt_spacing(double v) {
+  char text[128];
+  std::snprintf(text, sizeof text, "spacing %g m is outside 1e-6 .. 1e6 m", v);
+  return text;
+}
+
+bool do_load(const ConfigBox& config, const LoadArgs& a, TerrainBox* box, std::size_t* charge_bytes,
+             char* err) noexcept {
   try {
     char path[4096];
     if (!resolve_path(config, a.heightmap, path, sizeof path, err)) return false;
+    // The range of docs/data_model.md ("Placement"), as `ridge --spacing` checks it (values
+    // <= 0 get the heightfield's own message).
+    for (const double v : a.spacing)
+      if (a.has_spacing && v > 0 && (v < 1e-6 || v > 1e6)) {
+        copy_error(err, fmt_spacing(v).c_str());
+        return false;
+      }
     io::LoadOptions options;
     HeightfieldDesc& p = options.placement;
     p.spacing_x = a.spacing[0];
@@ -68,12 +98,17 @@ bool do_load(const ConfigBox& config, const LoadArgs& a, TerrainBox* box, char* 
     // Scripts never wait for tiles: two workers generate them; views hold coarser meanwhile.
     DetailCacheDesc cache;
     cache.worker_threads = 2;
+    // Under an object budget the tiles get a quarter of it (charged in full: the cache may fill).
+    if (config.budget && config.budget->limit != 0)
+      cache.budget_bytes =
+          std::min(cache.budget_bytes, std::max(config.budget->limit / 4, std::size_t{4} << 20));
     auto t = Terrain::create(std::move(*hf), detail, cache);
     if (!t) {
       copy_error(err, t.error().message.c_str());
       return false;
     }
     box->terrain = std::move(*t);
+    *charge_bytes = terrain_charge_bytes(*box->terrain, detail.levels > 0 ? cache.budget_bytes : 0);
     set_path_rules(box, config);
     return true;
   } catch (const std::exception& e) {
@@ -132,28 +167,50 @@ int r_load(lua_State* L) {
   a.has_gain = get_number_field(L, 1, "detail_gain", &a.detail_gain);
   TerrainBox* box = push_terrain_box(L);
   char err[kErrSize];
-  if (!do_load(*config, a, box, err)) {
+  std::size_t bytes = 0;
+  if (!do_load(*config, a, box, &bytes, err)) {
     lua_pushnil(L);
     lua_pushstring(L, err);
     return 2;
   }
+  // The size is known once loaded: a terrain past the budget is dropped before the error.
+  if (!make_room(L, config->budget, bytes)) {
+    box->terrain.reset();
+    char detail[96];
+    std::snprintf(detail, sizeof detail, "the terrain needs %.1f MiB",
+                  double(bytes) / (1024.0 * 1024.0));
+    return object_budget_error(L, *config->budget, "load", detail);
+  }
+  if (!charge_terrain(box, config->budget, bytes, err)) return luaL_error(L, "load: %s", err);
   account_memory(L, box->terrain->memory_bytes());
   return 1;
 }
 
-bool make_default(ConfigBox* config, TerrainBox* box, char* err) noexcept {
+// Generates the pristine default terrain once per module table, charged to its budget for the
+// module's lifetime.
+bool make_original(ConfigBox* config, char* err) noexcept {
   try {
-    if (!config->default_terrain) {
-      auto hf = make_default_heightfield();
-      if (!hf) {
-        copy_error(err, hf.error().message.c_str());
-        return false;
-      }
-      config->default_terrain = Terrain::create(std::move(*hf)).value();
+    if (config->default_terrain) return true;
+    auto hf = make_default_heightfield();
+    if (!hf) {
+      copy_error(err, hf.error().message.c_str());
+      return false;
     }
+    config->default_terrain = Terrain::create(std::move(*hf)).value();
+    config->default_charge =
+        std::make_shared<Charge>(config->budget, config->default_terrain->memory_bytes());
+    return true;
+  } catch (const std::exception& e) {
+    copy_error(err, e.what());
+    return false;
+  }
+}
+
+bool make_default(ConfigBox* config, TerrainBox* box, std::size_t bytes, char* err) noexcept {
+  try {
     box->terrain = config->default_terrain->clone();
     set_path_rules(box, *config);
-    return true;
+    return charge_terrain(box, config->budget, bytes, err);
   } catch (const std::exception& e) {
     copy_error(err, e.what());
     return false;
@@ -165,9 +222,13 @@ bool make_default(ConfigBox* config, TerrainBox* box, char* err) noexcept {
 // edit one script makes is never seen by another and a released terrain is simply gone.
 int r_default_terrain(lua_State* L) {
   ConfigBox* config = config_of(L);
-  TerrainBox* box = push_terrain_box(L);
   char err[kErrSize];
-  if (!make_default(config, box, err)) return luaL_error(L, "default_terrain: %s", err);
+  if (!make_original(config, err)) return luaL_error(L, "default_terrain: %s", err);
+  // A copy shares the original's pages (charged once, with the module) until it edits them.
+  const std::size_t bytes = terrain_charge_bytes(*config->default_terrain, 0, true);
+  reserve_objects(L, config->budget, bytes, "default_terrain");
+  TerrainBox* box = push_terrain_box(L);
+  if (!make_default(config, box, bytes, err)) return luaL_error(L, "default_terrain: %s", err);
   account_memory(L, box->terrain->memory_bytes());
   return 1;
 }
@@ -175,6 +236,8 @@ int r_default_terrain(lua_State* L) {
 int config_gc(lua_State* L) {
   auto* c = static_cast<ConfigBox*>(luaL_checkudata(L, 1, kConfigMeta));
   c->default_terrain.reset();
+  c->default_charge.reset();
+  c->budget.reset();
   return 0;
 }
 
@@ -193,7 +256,14 @@ namespace ridgeline::lua {
 
 void push_terrain(lua_State* L, std::shared_ptr<Terrain> terrain) {
   detail::TerrainBox* box = detail::push_terrain_box(L);
-  box->terrain = std::move(terrain);  // no Lua call after the push: nothing can longjmp here
+  // No Lua call after the push that can raise: nothing can longjmp over these.
+  box->terrain = std::move(terrain);
+  box->budget = detail::object_budget_of(L);
+}
+
+std::size_t object_memory_used(lua_State* L) {
+  const std::shared_ptr<detail::ObjectBudget> budget = detail::object_budget_of(L);
+  return budget ? budget->used : 0;
 }
 
 int open_module(lua_State* L, const ModuleConfig& config) {
@@ -210,6 +280,14 @@ int open_module(lua_State* L, const ModuleConfig& config) {
   lua_setmetatable(L, -2);
   box->confine_paths = config.confine_paths;
   box->max_samples = config.max_samples;
+  try {
+    box->budget = std::make_shared<ObjectBudget>();
+  } catch (const std::exception&) {
+    box->budget.reset();
+  }
+  if (!box->budget) return luaL_error(L, "ridgeline: not enough memory");
+  box->budget->limit = config.object_memory_limit;
+  register_config(L, -1);
   std::strncpy(box->root, config.root != nullptr ? config.root : "", sizeof box->root - 1);
   luaL_setfuncs(L, kFunctions, 1);  // the config is upvalue 1 of every function
   lua_pushinteger(L, static_cast<lua_Integer>(kMaxBatchPoints));

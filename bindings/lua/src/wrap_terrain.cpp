@@ -370,6 +370,9 @@ int t_release(lua_State* L) {
   box->terrain.reset();
   box->landscape.reset();
   box->root.reset();
+  box->terrain_charge.reset();
+  box->landscape_charge.reset();
+  box->budget.reset();
   return 0;
 }
 

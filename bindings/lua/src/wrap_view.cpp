@@ -1,4 +1,5 @@
 // Lua userdata `ridgeline.view`: the ROAM mesh of one camera over a terrain (docs/roam.md).
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <new>
@@ -60,6 +61,37 @@ std::uint32_t clamp_triangles(double t) {
   return static_cast<std::uint32_t>(t);
 }
 
+// ---- the object budget (ModuleConfig::object_memory_limit) ----
+// A view's memory (RoamStats::memory_bytes + output_bytes) is a part per patch plus a part per
+// leaf triangle: measured on the default terrain, about 2.6 KiB a patch and 110 bytes a triangle
+// (up to 170 with the vectors' spare capacity); the estimates below are above both.
+constexpr std::size_t kViewBytesPerPatch = 3 << 10, kViewBytesPerTriangle = 192;
+constexpr std::size_t kLandscapeLogBytes = 64 << 10;  // the landscape's log of changed regions
+
+std::size_t patches_of(const Terrain& t, std::uint32_t exponent) {
+  const std::size_t p = std::size_t{1} << exponent;
+  const WorldInfo& info = t.info();
+  return ((info.width - 1 + p - 1) / p) * ((info.height - 1 + p - 1) / p);
+}
+
+// The patches of a landscape made with the default exponent (6, raised until at most 64 patches
+// a side).
+std::size_t default_patches(const Terrain& t) {
+  return std::min<std::size_t>(patches_of(t, 6), 64 * 64);
+}
+
+// Before a landscape exists: its bounds are 6 bytes a stored diamond of the level-0 pages (about
+// half the samples, aprons included) plus the coarser levels' (docs/roam.md, "Error bounds"):
+// under 4 bytes a sample.
+std::size_t landscape_estimate(const Terrain& t) {
+  const WorldInfo& info = t.info();
+  return std::size_t{info.width} * info.height * 4 + kLandscapeLogBytes;
+}
+
+std::size_t view_base_bytes(const Landscape& l) {
+  return std::size_t{l.patch_count()} * kViewBytesPerPatch + (64 << 10);
+}
+
 bool build_view(TerrainBox* terrain, ViewBox* view, const RoamSettings& settings,
                 char* err) noexcept {
   try {
@@ -70,6 +102,8 @@ bool build_view(TerrainBox* terrain, ViewBox* view, const RoamSettings& settings
         return false;
       }
       terrain->landscape = std::move(*landscape);
+      terrain->landscape_charge = std::make_shared<Charge>(
+          terrain->budget, terrain->landscape->bound_bytes() + kLandscapeLogBytes);
     }
     auto created = RoamView::create(terrain->landscape, settings);
     if (!created) {
@@ -77,8 +111,13 @@ bool build_view(TerrainBox* terrain, ViewBox* view, const RoamSettings& settings
       return false;
     }
     view->view = std::move(*created);
+    view->budget = terrain->budget;
+    view->terrain_charge = terrain->terrain_charge;
+    view->landscape_charge = terrain->landscape_charge;
+    view->charge = std::make_shared<Charge>(terrain->budget, view_base_bytes(*terrain->landscape));
     return true;
   } catch (const std::exception& e) {
+    view->view.reset();
     copy_error(err, e.what());
     return false;
   }
@@ -95,15 +134,31 @@ bool apply_settings(ViewBox* box, const RoamSettings& settings, char* err) noexc
   }
 }
 
-bool run_update(ViewBox* box, char* err) noexcept {
+// Updates the view. `cap` (0: none) is the most leaf triangles the object budget leaves room
+// for: when it is below the view's own cap, this update runs under it and `held` says whether
+// it stopped there. The view's charge follows its memory afterwards.
+bool run_update(ViewBox* box, std::uint32_t cap, bool* held, char* err) noexcept {
   try {
+    const RoamSettings own = box->view->settings();
+    const bool limited = cap != 0 && cap < own.max_triangles;
+    if (limited) {
+      RoamSettings s = own;
+      s.max_triangles = cap;
+      if (const Status st = box->view->set_settings(s); !st) {
+        copy_error(err, st.message().c_str());
+        return false;
+      }
+    }
     auto stats = box->view->update(box->camera);
+    if (limited) (void)box->view->set_settings(own);
     if (!stats) {
       copy_error(err, stats.error().message.c_str());
       return false;
     }
     box->last = *stats;
     box->has_stats = true;
+    *held = limited && stats->stop == StopReason::kTriangleBudget;
+    if (box->charge) box->charge->set(stats->memory_bytes + stats->output_bytes);
     return true;
   } catch (const std::exception& e) {
     copy_error(err, e.what());
@@ -154,8 +209,32 @@ int v_set_camera(lua_State* L) {
 // view:update() -> stats table
 int v_update(lua_State* L) {
   ViewBox* box = live_view(L);
+  std::uint32_t cap = 0;
+  char detail[160];
+  if (box->budget && box->budget->limit != 0) {
+    // Room for this view: the limit less what every other object holds.
+    const std::size_t own = box->charge ? box->charge->bytes() : 0;
+    const std::size_t base = view_base_bytes(box->view->landscape());
+    reserve_objects(L, box->budget, base, "view:update", own);
+    const ObjectBudget& b = *box->budget;
+    const std::size_t room = (b.limit - (b.used - own) - base) / kViewBytesPerTriangle;
+    cap = static_cast<std::uint32_t>(std::min<std::size_t>(room, kMaxViewTriangles));
+    if (cap < box->view->landscape().root_count()) {
+      std::snprintf(detail, sizeof detail, "no room for this view's %u root triangles",
+                    box->view->landscape().root_count());
+      return object_budget_error(L, b, "view:update", detail);
+    }
+  }
   char err[kErrSize];
-  if (!run_update(box, err)) return luaL_error(L, "view:update: %s", err);
+  bool held = false;
+  if (!run_update(box, cap, &held, err)) return luaL_error(L, "view:update: %s", err);
+  if (held || (box->budget && box->budget->limit != 0 && box->budget->used > box->budget->limit)) {
+    std::snprintf(detail, sizeof detail,
+                  "the view was held to %u triangles, below its budget of %u; view:stats() has "
+                  "the update's figures",
+                  box->last.triangles, box->view->settings().max_triangles);
+    return object_budget_error(L, *box->budget, "view:update", detail);
+  }
   push_stats(L, box->last);
   return 1;
 }
@@ -216,6 +295,10 @@ int v_budget(lua_State* L) {
 int v_release(lua_State* L) {
   auto* box = static_cast<ViewBox*>(check_self(L, kViewMeta));
   box->view.reset();
+  box->charge.reset();
+  box->terrain_charge.reset();
+  box->landscape_charge.reset();
+  box->budget.reset();
   return 0;
 }
 
@@ -284,6 +367,14 @@ int new_view(lua_State* L) {
       luaL_argerror(L, 2, "field 'budget_ms': milliseconds in 0 .. 60000 expected");
     settings.budget_ms = v;
   }
+  // The landscape (built by the first view of a terrain) and the view's own start.
+  const std::size_t bytes =
+      (terrain->landscape ? 0 : landscape_estimate(*terrain->terrain)) +
+      (terrain->landscape ? std::size_t{terrain->landscape->patch_count()}
+                          : default_patches(*terrain->terrain)) *
+          kViewBytesPerPatch +
+      (64 << 10);
+  reserve_objects(L, terrain->budget, bytes, "new_view");
   ViewBox* box = push_view_box(L);
   box->camera = cam;
   char err[kErrSize];

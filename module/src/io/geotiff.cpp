@@ -187,6 +187,10 @@ GeoTiffPlacement geotiff_placement(const std::vector<TiffTag>& tags, std::uint32
     if (!std::isfinite(p.origin_x) || !std::isfinite(p.origin_z) || !std::isfinite(p.spacing_x) ||
         !std::isfinite(p.spacing_z) || p.spacing_x <= 0 || p.spacing_z <= 0)
       return fail("the placement in metres is not finite");
+    // The smallest spacing the tools accept (docs/data_model.md, "Placement"); a spacing too
+    // large for the coordinates is refused with the placement's extent.
+    if (p.spacing_x < 1e-6 || p.spacing_z < 1e-6)
+      return fail("pixel size " + g(p.spacing_x) + " x " + g(p.spacing_z) + " m is below 1e-6 m");
     p.description =
         fmt("GeoTIFF %s, %s, %s: %s x %s m pixels, sample (0, 0) at easting %s, northing %s (world "
             "x %s, z %s: z = -northing)",

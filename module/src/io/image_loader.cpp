@@ -9,10 +9,13 @@
 #include <cctype>
 #include <filesystem>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "format.h"
 #include "io/geotiff.h"
 #include "io/loader_common.h"
+#include "io/png_check.h"
 #include "io/tiff_tags.h"
 #include "ridgeline/log.h"
 
@@ -47,11 +50,32 @@ using OIIO::ImageInput;
 using OIIO::ImageSpec;
 using OIIO::TypeDesc;
 
-// OIIO messages may span lines and end in a newline; keep them on one line.
-std::string one_line(std::string s) {
-  std::replace(s.begin(), s.end(), '\n', ' ');
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\r')) s.pop_back();
-  return s.empty() ? std::string("unknown error") : s;
+// OIIO's error text holds one message per line, and a reader often reports one problem twice
+// (libpng's read callback, then its error handler quoting it: "Read error: hit end of file" and
+// "PNG read error: IDAT: Read error: hit end of file"). Keep each message once, on one line,
+// dropping those that another one repeats.
+std::string one_line(const std::string& text) {
+  std::vector<std::string> lines;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    std::size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    std::string line = text.substr(start, end - start);
+    while (!line.empty() && (line.back() == ' ' || line.back() == '\r')) line.pop_back();
+    if (!line.empty()) lines.push_back(std::move(line));
+    start = end + 1;
+  }
+  std::string out;
+  for (std::size_t k = 0; k < lines.size(); ++k) {
+    bool repeated = false;
+    for (std::size_t o = 0; o < lines.size() && !repeated; ++o)
+      repeated =
+          o != k && lines[o].find(lines[k]) != std::string::npos && (lines[o] != lines[k] || o < k);
+    if (repeated) continue;
+    if (!out.empty()) out += "; ";
+    out += lines[k];
+  }
+  return out.empty() ? std::string("unknown error") : out;
 }
 
 std::string channel_list(const ImageSpec& spec) {
@@ -73,6 +97,7 @@ struct OpenImage {
 
 Result<OpenImage> open_image(const std::string& path, const std::string& name) {
   if (auto s = detail::check_regular_file(path, name); !s) return Error{s.message()};
+  if (auto s = detail::check_png_chunks(path, name); !s) return Error{s.message()};
   // Keep colour values as stored: OIIO would otherwise premultiply grey by alpha.
   ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);
@@ -100,7 +125,12 @@ Status read_channel(ImageInput& in, int c, TypeDesc type, std::vector<T>& out,
                     const std::string& name) {
   const ImageSpec& spec = in.spec();
   out.resize(static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height));
-  const bool ok = in.read_image(0, 0, c, c + 1, type, out.data());
+  // A single channel in its stored type goes straight into `out`; anything else needs
+  // OpenImageIO's conversion buffer, which it sizes for large images whatever the image's size
+  // (tens of MB mapped and freed per read, most of the time a small load takes under ASan).
+  const bool native =
+      spec.nchannels == 1 && c == 0 && type == spec.format && spec.channelformats.empty();
+  const bool ok = in.read_image(0, 0, c, c + 1, native ? TypeDesc::UNKNOWN : type, out.data());
   // Some readers report a problem (a short strip, a bad CRC) and still return true.
   if (!ok || in.has_error()) {
     out.clear();

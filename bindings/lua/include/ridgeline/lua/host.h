@@ -32,8 +32,18 @@ struct HostOptions {
   /// Bytes the Lua state may hold (owned states only; 0 = no limit). Above it the next hook
   /// check ends the call with an error and a traceback; a single allocation that would pass the
   /// limit plus a headroom of max(1 MiB, limit / 8) is refused (Lua's "not enough memory").
-  /// C++ terrain data is not counted here: `max_samples` bounds it.
+  /// C++ objects made for scripts are not counted here: see object_memory_limit.
   std::size_t memory_limit = std::size_t{64} << 20;
+  /// Bytes of C++ memory that the terrains, landscapes and views scripts make may hold together
+  /// (each terrain counted with the most its edit layer, change log and detail cache can grow
+  /// to; each view with what its last update holds); 0 = no limit. It applies to owned and
+  /// attached states, sandboxed or not; an engine's own terrains handed in with push_terrain()
+  /// are not counted. A call that would pass it raises "C++ object memory budget exceeded"
+  /// naming the sizes (after one garbage collection to reclaim dropped objects), and a view's
+  /// update is held to the triangles that fit (the call then raises the same error). Objects
+  /// give their share back when released (`release()`, `<close>`) or collected. The default
+  /// holds about 24 copies of the default terrain, or one 2048 x 2048 terrain with a view.
+  std::size_t object_memory_limit = std::size_t{256} << 20;
   /// Folder sandboxed scripts may read from (ridgeline.load); empty: no file access. Paths given
   /// by scripts are relative to it, without `..`, never absolute. Unused without the sandbox.
   std::string data_root;
@@ -71,6 +81,15 @@ class Host {
   /// Calls global function `name` with no arguments and no results (a game callback).
   Status call_global(const char* name);
 
+  /// Sandboxed hosts: gives scripts a fresh global environment, as at creation: the library
+  /// tables and the `ridgeline` table copied again from pristine copies (a script's changes to
+  /// them are gone), every global a script or set_global() made gone, then a full garbage
+  /// collection (objects only the old globals held are freed and give back their share of the
+  /// object budget). What stays: the state, its limits, the module's cached default terrain, and
+  /// anything the engine keeps referenced. For reloading a game's scripts, and for the fuzz
+  /// target that reuses one host across inputs. Fails without the sandbox.
+  Status reset();
+
   /// Pops the value on top of the stack and stores it as global `name` of the scripts'
   /// environment (the sandbox table, or the real globals without the sandbox): how an engine
   /// hands its own API (a `game` table) to its scripts. Fails only for memory or an empty stack.
@@ -78,6 +97,8 @@ class Host {
 
   /// Bytes held by an owned state (0 for an attached one).
   std::size_t memory_used() const noexcept;
+  /// Bytes charged to the object budget by the terrains, landscapes and views scripts hold.
+  std::size_t object_memory_used() const noexcept;
   /// Instructions counted during the last call (in steps of 1000).
   std::uint64_t last_instructions() const noexcept;
 
@@ -88,6 +109,7 @@ class Host {
   Status setup(const HostOptions& options);
   lua_State* L_ = nullptr;
   bool owned_ = false;
+  bool sandbox_ = false;
   std::unique_ptr<Limits> limits_;
 };
 

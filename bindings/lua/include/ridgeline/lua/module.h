@@ -35,6 +35,12 @@ struct ModuleConfig {
   const char* root = "";
   /// Largest heightmap ridgeline.load accepts, in samples (checked before allocating).
   std::uint64_t max_samples = std::uint64_t{1} << 26;
+  /// Bytes of C++ memory the objects scripts make through this module table may hold together
+  /// (terrains with their edit layers, change logs and detail caches, landscapes, views; 0 = no
+  /// limit, the stock interpreter's default). Lua's allocator does not see this memory. A call
+  /// that would go past it raises "C++ object memory budget exceeded"; a view's update is held
+  /// to the triangles that fit. Objects give their share back when released or collected.
+  std::size_t object_memory_limit = 0;
 };
 
 /// Pushes a new `ridgeline` module table on the stack of `L` (the bound types' metatables are
@@ -43,8 +49,13 @@ struct ModuleConfig {
 int open_module(lua_State* L, const ModuleConfig& config);
 
 /// Pushes a `ridgeline.terrain` userdata that shares `terrain` with the engine (the engine's own
-/// terrain, so that scripts query what the game simulates). May raise a Lua error (memory).
+/// terrain, so that scripts query what the game simulates). May raise a Lua error (memory). The
+/// terrain itself is not charged to the object budget (the engine made it); landscapes and views
+/// scripts build on it are.
 void push_terrain(lua_State* L, std::shared_ptr<Terrain> terrain);
+
+/// Bytes charged to the object budget of the module table last opened in `L` (0 when none).
+std::size_t object_memory_used(lua_State* L);
 
 }  // namespace ridgeline::lua
 
