@@ -199,11 +199,12 @@ void TerrainShape::processAllTriangles(btTriangleCallback* callback, const btVec
   // Tiles with edges on lattice lines: every triangle lies within one tile's column and row and
   // is reported by that tile alone (the one holding its centroid); the outermost tiles take what
   // touches the box beyond them.
+  // (Clamped in double before the conversion: a box may reach 1e30 m.)
   const auto first = [](double a, std::int64_t cells) {
-    return std::clamp<std::int64_t>(std::int64_t(std::floor(a)), 0, cells - 1);
+    return std::int64_t(std::clamp(std::floor(a), 0.0, double(cells - 1)));
   };
   const auto last = [](double b, std::int64_t lo, std::int64_t cells) {
-    return std::clamp<std::int64_t>(std::int64_t(std::ceil(b)), lo + 1, cells);
+    return std::int64_t(std::clamp(std::ceil(b), double(lo + 1), double(cells)));
   };
   const std::int64_t a0 = first(u0, cells_x_), a1 = last(u1, a0, cells_x_);
   const std::int64_t b0 = first(v0, cells_z_), b1 = last(v1, b0, cells_z_);
@@ -243,8 +244,8 @@ bool TerrainShape::report_ray(btTriangleRaycastCallback& callback) const {
   // The triangle hit: the one under the hit point (on the far edge, the last cell).
   const double u = (hit->point.x - lattice_x0_) * inv_cell_x_;
   const double v = (hit->point.z - lattice_z0_) * inv_cell_z_;
-  const auto i = std::clamp<std::int64_t>(std::int64_t(std::floor(u)), 0, cells_x_ - 1);
-  const auto j = std::clamp<std::int64_t>(std::int64_t(std::floor(v)), 0, cells_z_ - 1);
+  const auto i = std::int64_t(std::clamp(std::floor(u), 0.0, double(cells_x_ - 1)));
+  const auto j = std::int64_t(std::clamp(std::floor(v), 0.0, double(cells_z_ - 1)));
   const float fu = std::clamp(float(u - double(i)), 0.0f, 1.0f);
   const float fv = std::clamp(float(v - double(j)), 0.0f, 1.0f);
   const std::int64_t index = (i + j * cells_x_) * 2 + locate_in_cell(i, j, fu, fv).which;
