@@ -1,8 +1,8 @@
--- Artillery: every 2 seconds a shell lands beside the convoy's road, 15 .. 40 m ahead of a convoy
--- vehicle (the lead one more often than not, so the follow camera sees it) and 14 .. 26 m to one
+-- Artillery: every 2 seconds a shell lands beside the convoy's road, 12 .. 35 m ahead of a convoy
+-- vehicle (the lead one four times in five, so the follow camera sees it) and 13 .. 22 m to one
 -- side, never on the road. Each crater throws out boulders and debris (Bullet bodies on the
--- terrain, docs/game_scripting.md "Loose bodies"): two are hurled at the nearest vehicle, where it
--- will be when they come down, the rest scatter around the rim and roll back into the crater. A
+-- terrain, docs/game_scripting.md "Loose bodies"): two are thrown towards the nearest vehicle and
+-- bounce and roll into its path, the rest scatter around the rim and roll back into the crater. A
 -- small deterministic generator (not math.random, which Lua seeds at random) keeps runs
 -- reproducible.
 local interval = 2.0      -- seconds between shells
@@ -25,13 +25,13 @@ game.on("tick", function(dt, t)
   local targets = convoy()
   if #targets == 0 then return end
   local v = targets[1]
-  if rand() >= 0.6 then v = targets[1 + math.floor(rand() * #targets) % #targets] end
+  if rand() >= 0.8 then v = targets[1 + math.floor(rand() * #targets) % #targets] end
   if not v:alive() then return end
   local s = v:state()
   local fx, fz = math.sin(s.heading), math.cos(s.heading)  -- forward
   local rx, rz = fz, -fx                                     -- to one side
-  local ahead = 15 + rand() * 25
-  local side = (rand() < 0.5 and -1 or 1) * (14 + rand() * 12)
+  local ahead = 12 + rand() * 23
+  local side = (rand() < 0.5 and -1 or 1) * (13 + rand() * 9)
   local cx, cz = s.x + ahead * fx + side * rx, s.z + ahead * fz + side * rz
   local samples, err = game.crater{x = cx, z = cz, radius = 6 + rand() * 4, depth = 2 + rand() * 2}
   shells = shells + 1
@@ -56,12 +56,14 @@ game.on("crater", function(x, z, radius, depth)
     local py = game.terrain:height(px, pz)
     local vel
     if near and i <= 2 then
-      -- Hurled at the vehicle: aimed where it will be after a 1.2 s flight.
+      -- Thrown towards the vehicle: it comes down two thirds of the way to where the vehicle will
+      -- be in two seconds, and bounces and rolls the rest (a nudge, not a missile).
       local s = near:state()
-      local t = 1.2
-      local tx = s.x + math.sin(s.heading) * s.speed * t + (rand() - 0.5) * 4
-      local tz = s.z + math.cos(s.heading) * s.speed * t + (rand() - 0.5) * 4
-      vel = {(tx - px) / t, 5.5 + rand(), (tz - pz) / t}
+      local ahead = 2 * s.speed
+      local tx = s.x + math.sin(s.heading) * ahead + (rand() - 0.5) * 4
+      local tz = s.z + math.cos(s.heading) * ahead + (rand() - 0.5) * 4
+      local t = 1.1
+      vel = {(tx - px) * 0.65 / t, 5 + rand(), (tz - pz) * 0.65 / t}
     else
       -- Out over the rim, to roll back down the crater's wall.
       local out = 3 + rand() * 3
@@ -70,7 +72,7 @@ game.on("crater", function(x, z, radius, depth)
     local spin = {rand() * 6 - 3, rand() * 6 - 3, rand() * 6 - 3}
     if py then
       if i % 2 == 1 then
-        game.spawn_body{shape = "sphere", x = px, z = pz, y = py + 1.5, radius = 0.4 + rand() * 0.3,
+        game.spawn_body{shape = "sphere", x = px, z = pz, y = py + 1.5, radius = 0.3 + rand() * 0.3,
                         velocity = vel, spin = spin, name = "boulder"}
       else
         local w = 0.4 + rand() * 0.6
