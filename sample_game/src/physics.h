@@ -36,7 +36,11 @@ enum CollisionGroup : int {
 inline constexpr double kPhysicsSubstep = 1.0 / 120.0;
 
 /// The game's Bullet world. Positions cross it through the shape's origin (the middle of the
-/// terrain): Bullet's floats stay within about 1.5 km of it. Threading: the game's thread.
+/// terrain): Bullet's floats stay within about 1.5 km of it. Friction follows the terrain's
+/// material: the terrain's triangles carry their material id as Bullet's part id, and create()
+/// installs Bullet's process-wide contact hook (gContactAddedCallback, a stateless function
+/// every Physics shares) that scales a terrain contact's friction by it. Threading: the game's
+/// thread.
 class Physics {
  public:
   /// A world over `terrain` (kept alive). Errors: a null terrain.
