@@ -1,6 +1,8 @@
 // The sample game's simulation: fixed steps, vehicles, cameras, the budget controller, scripts.
 #include "game.h"
 
+#include <btBulletDynamicsCommon.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -9,7 +11,6 @@
 #include <lua.hpp>
 #include <sstream>
 
-#include "collision.h"
 #include "ridgeline/edit.h"
 
 namespace game {
@@ -70,6 +71,9 @@ Result<std::unique_ptr<Game>> Game::create(const GameOptions& options) {
   } else {
     g->terrain_ = ridgeline::Terrain::create(std::move(*hf)).value();
   }
+  auto physics = Physics::create(g->terrain_);
+  if (!physics) return Error{physics.error().message};
+  g->physics_ = std::move(*physics);
   auto land = ridgeline::Landscape::create(g->terrain_, {.patch_exponent = options.patch_exponent});
   if (!land) return Error{land.error().message};
   g->landscape_ = *land;
@@ -122,16 +126,14 @@ ridgeline::Result<int> Game::spawn(const std::string& model, double x, double z,
   VehicleEntry e{next_vehicle_id_++,
                  name.empty() ? model : name,
                  model,
-                 Vehicle(p, {x, start_y, z}, heading),
+                 Vehicle(*physics_, p, {x, start_y, z}, heading),
                  {},
                  0};
-  e.body.chassis_min = glm::dvec3(m->body_min) - p.com_in_model;
-  e.body.chassis_max = glm::dvec3(m->body_max) - p.com_in_model;
-  // The chassis box check uses the bottom of the frame, not the (lower) wheels.
-  e.body.chassis_min.y =
-      std::max(e.body.chassis_min.y, double(m->wheel_centres[0].y) - p.com_in_model.y);
-  e.body.place_on_surface(*terrain_, x, z, heading);
+  e.body.place_on_surface(x, z, heading);
   const int id = e.id;
+  // The chassis carries its vehicle's id: contacts name the vehicles they involve.
+  e.body.chassis()->setUserIndex(id);
+  e.body.chassis()->setUserIndex2(1);
   vehicles_.emplace(id, std::move(e));
   return id;
 }
@@ -145,6 +147,35 @@ bool Game::remove_vehicle(int id) {
   if (vehicles_.erase(id) == 0) return false;
   for (auto it = touching_.begin(); it != touching_.end();)
     it = it->first.first == id || it->first.second == id ? touching_.erase(it) : std::next(it);
+  for (auto it = body_touching_.begin(); it != body_touching_.end();)
+    it = it->first.first == id ? body_touching_.erase(it) : std::next(it);
+  return true;
+}
+
+Result<int> Game::spawn_body(const BodySpec& spec) {
+  if (!terrain_->height(spec.position.x, spec.position.z))
+    return Error{"spawn_body: (" + std::to_string(spec.position.x) + ", " +
+                 std::to_string(spec.position.z) + ") is off the terrain"};
+  while (bodies_.size() >= kMaxBodies) remove_body(bodies_.begin()->first);  // the oldest
+  const int id = next_body_id_++;
+  LooseBody b(*physics_, id, spec);
+  b.spawned_frame = frame_;
+  auto* rb = const_cast<btRigidBody*>(b.rigid_body());
+  rb->setUserIndex(id);
+  rb->setUserIndex2(2);
+  bodies_.emplace(id, std::move(b));
+  return id;
+}
+
+LooseBody* Game::body(int id) {
+  auto it = bodies_.find(id);
+  return it == bodies_.end() ? nullptr : &it->second;
+}
+
+bool Game::remove_body(int id) {
+  if (bodies_.erase(id) == 0) return false;
+  for (auto it = body_touching_.begin(); it != body_touching_.end();)
+    it = it->first.second == id ? body_touching_.erase(it) : std::next(it);
   return true;
 }
 
@@ -167,9 +198,7 @@ void Game::clamp_to_terrain(VehicleEntry& e) {
   if (p.x < x0 || p.x > x1 || p.z < z0 || p.z > z1) {
     // The edge of the world: the vehicle is stopped and put back inside.
     const double x = std::clamp(p.x, x0, x1), z = std::clamp(p.z, z0, z1);
-    const double y = terrain_->height(x, z).value_or(p.y) + e.body.params().com_in_model.y;
-    (void)y;
-    e.body.place_on_surface(*terrain_, x, z, e.body.heading());
+    e.body.place_on_surface(x, z, e.body.heading());
   }
 }
 
@@ -221,16 +250,37 @@ void Game::step() {
     }
   }
   follow_terrain_edits();
+  std::map<int, glm::dvec3> before;
   for (auto& [id, e] : vehicles_) {
-    const glm::dvec3 before = e.body.position();
-    e.body.step(*terrain_, dt);
+    before[id] = e.body.position();
+    pre_velocity_[{1, id}] = e.body.velocity();
+  }
+  for (auto& [id, b] : bodies_)
+    if (!b.sleeping()) pre_velocity_[{2, id}] = b.velocity();
+  physics_->step(dt);
+  for (auto& [id, e] : vehicles_) {
     clamp_to_terrain(e);
-    e.body.measure_contacts(*terrain_);
-    const glm::dvec3 d = e.body.position() - before;
+    e.body.measure_contacts();
+    const glm::dvec3 d = e.body.position() - before[id];
     e.distance_m += std::hypot(d.x, d.z);
   }
-  contacts_ = resolve_vehicle_contacts(vehicles_, touching_);
+  count_touches();
+  tidy_bodies();
   step_times_.physics_ms += ms_since(t_physics) - waypoint_scripts_ms;
+  // A body that started touching a vehicle: the "hit" event (after the physics, not inside it).
+  for (const Hit& h : hits_) {
+    emit(
+        "hit",
+        [](lua_State* L, void* u) -> int {
+          const auto* a = static_cast<const Hit*>(u);
+          lua_pushinteger(L, a->vehicle);
+          lua_pushinteger(L, a->body);
+          lua_pushnumber(L, a->speed);
+          return 3;
+        },
+        const_cast<Hit*>(&h));
+  }
+  hits_.clear();
   step_times_.scripts_ms += scripts_->take_script_ms() + scripts_before;
   ++frame_;
 }
@@ -260,6 +310,77 @@ Result<std::size_t> Game::crater(double x, double z, double radius, double depth
   return r->samples_changed;
 }
 
+void Game::count_touches() {
+  // The pairs touching now, from the world's contact manifolds. A pair that had not touched for
+  // kTouchGap steps counts a collision (vehicles) or a hit (a body on a vehicle): a boulder that
+  // bounces off a truck twice in a moment hits it once.
+  constexpr std::uint64_t kTouchGap = 30;
+  std::map<std::pair<int, int>, bool> vv, vb;
+  btDispatcher* d = physics_->world().getDispatcher();
+  for (int k = 0; k < d->getNumManifolds(); ++k) {
+    const btPersistentManifold* m = d->getManifoldByIndexInternal(k);
+    bool touch = false;
+    for (int c = 0; c < m->getNumContacts() && !touch; ++c)
+      touch = m->getContactPoint(c).getDistance() < 0.01f;
+    if (!touch) continue;
+    const btCollisionObject* a = m->getBody0();
+    const btCollisionObject* b = m->getBody1();
+    if (a->getUserIndex2() == 2 && b->getUserIndex2() == 1) std::swap(a, b);
+    if (a->getUserIndex2() != 1) continue;  // neither is a vehicle
+    if (b->getUserIndex2() == 1)
+      vv[{std::min(a->getUserIndex(), b->getUserIndex()),
+          std::max(a->getUserIndex(), b->getUserIndex())}] = true;
+    else if (b->getUserIndex2() == 2)
+      vb[{a->getUserIndex(), b->getUserIndex()}] = true;
+  }
+  const auto fresh = [&](std::map<std::pair<int, int>, std::uint64_t>& last,
+                         const std::pair<int, int>& key) {
+    auto it = last.find(key);
+    const bool is_new = it == last.end() || frame_ > it->second + kTouchGap;
+    last[key] = frame_;
+    return is_new;
+  };
+  for (const auto& [key, t] : vv) {
+    if (!fresh(touching_, key)) continue;
+    for (int id : {key.first, key.second})
+      if (VehicleEntry* e = vehicle(id)) ++e->body.collisions;
+  }
+  for (const auto& [key, t] : vb) {
+    if (!fresh(body_touching_, key)) continue;
+    VehicleEntry* e = vehicle(key.first);
+    LooseBody* b = body(key.second);
+    if (e == nullptr || b == nullptr) continue;
+    ++e->body.body_hits;
+    ++b->vehicle_hits;
+    // The speed at which they met: the velocities before the step (the impact changed them).
+    const auto vel = [&](int kind, int id, const glm::dvec3& now) {
+      auto it = pre_velocity_.find({kind, id});
+      return it == pre_velocity_.end() ? now : it->second;
+    };
+    hits_.push_back(
+        {key.first, key.second,
+         glm::length(vel(2, key.second, b->velocity()) - vel(1, key.first, e->body.velocity()))});
+  }
+  for (auto* last : {&touching_, &body_touching_})
+    for (auto it = last->begin(); it != last->end();)
+      it = frame_ > it->second + kTouchGap ? last->erase(it) : std::next(it);
+  contacts_ = vv.size();
+  body_contacts_ = vb.size();
+  pre_velocity_.clear();
+}
+
+void Game::tidy_bodies() {
+  // A body that rolled off the terrain's edge, or fell through it (it cannot, but a game does not
+  // keep what it could not see), is removed.
+  std::vector<int> gone;
+  for (const auto& [id, b] : bodies_) {
+    const glm::dvec3 p = b.position();
+    const auto h = terrain_->height(p.x, p.z);
+    if (!h || p.y < *h - 20 || !std::isfinite(p.y)) gone.push_back(id);
+  }
+  for (int id : gone) remove_body(id);
+}
+
 void Game::follow_terrain_edits() {
   const ridgeline::TerrainChanges c = terrain_->changes_since(seen_edit_version_);
   seen_edit_version_ = c.version;
@@ -270,7 +391,7 @@ void Game::follow_terrain_edits() {
     for (const ridgeline::TerrainChange& ch : c.changes) {
       if (p.x >= ch.box.min.x - m && p.x <= ch.box.max.x + m && p.z >= ch.box.min.z - m &&
           p.z <= ch.box.max.z + m && p.y >= ch.box.min.y - m && p.y <= ch.box.max.y + m) {
-        e.body.follow_ground(*terrain_);  // once: it compares with the ground it last saw
+        e.body.follow_ground();  // once: it compares with the ground it last saw
         break;
       }
     }
@@ -306,10 +427,13 @@ ridgeline::Camera Game::camera() const {
       const glm::dvec3 p = e->body.position();
       const double h = e->body.heading();
       glm::dvec3 eye = p - glm::dvec3(std::sin(h), 0, std::cos(h)) * rig_.follow_distance;
+      // At the vehicle's height plus the lift, but never closer than 2.5 m to the ground under
+      // the eye (going downhill the ground behind is higher: the camera rises over it).
       const double ground = terrain_->height(eye.x, eye.z).value_or(p.y);
-      eye.y = std::max(p.y, ground) + rig_.follow_height;
+      eye.y = std::max(p.y + rig_.follow_height, ground + 2.5);
       c.eye = eye;
-      c.target = p + glm::dvec3(0, 2, 0);
+      c.target =
+          p + glm::dvec3(std::sin(h), 0, std::cos(h)) * rig_.follow_ahead + glm::dvec3(0, 1.5, 0);
       break;
     }
     case CameraMode::kMap:

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "game_api.h"
+#include "physics.h"
 #include "ridgeline/budget_controller.h"
 #include "ridgeline/camera.h"
 #include "ridgeline/detail.h"
@@ -71,7 +72,9 @@ struct GameOptions {
 /// Milliseconds one frame's simulation spent, by part.
 struct StepTimes {
   double scripts_ms = 0;  ///< Lua chunks and handlers (game.burn_ms load included)
-  double physics_ms = 0;  ///< vehicles: autopilots, suspension, contacts, collisions
+  /// Bullet and around it: autopilots, the edit sync, the world's step (vehicles, loose bodies,
+  /// contacts), wheel states, collision counts.
+  double physics_ms = 0;
 };
 
 /// Threading: one thread.
@@ -93,7 +96,8 @@ class Game final : public GameApi {
   // ---- simulation ----------------------------------------------------------------------------
   /// One fixed step: scripts' tick handlers, autopilots, the vehicles' reaction to every terrain
   /// edit since the last step (from any brush, C++ or Lua, or a loaded edit state: the terrain's
-  /// change log is polled once here), vehicle physics, vehicle-vehicle contacts.
+  /// change log is polled here, and by the Bullet world's TerrainSync), the Bullet step
+  /// (vehicles, loose bodies, their contacts), then wheel states and collision counts.
   void step();
   /// Times of the steps since the last call (a frame may take several steps), and resets them.
   StepTimes take_step_times() noexcept;
@@ -104,8 +108,14 @@ class Game final : public GameApi {
   std::map<int, VehicleEntry>& vehicles() noexcept { return vehicles_; }
   const VehicleModel* model(const std::string& name) const;
   const std::vector<CraterRecord>& craters() const noexcept { return craters_; }
-  /// Vehicle-vehicle contacts in the last step.
+  /// Vehicle-vehicle pairs touching after the last step.
   std::size_t contacts() const noexcept { return contacts_; }
+  /// Loose body-vehicle pairs touching after the last step.
+  std::size_t body_contacts() const noexcept { return body_contacts_; }
+  /// The Bullet world (vehicles, loose bodies, the terrain shape).
+  Physics& physics() noexcept { return *physics_; }
+  const Physics& physics() const noexcept { return *physics_; }
+  std::map<int, LooseBody>& bodies() noexcept { return bodies_; }
 
   // ---- views, cameras, budget ----------------------------------------------------------------
   /// Feeds the last frame's time to the controller (when on) and updates the active view (with
@@ -151,6 +161,10 @@ class Game final : public GameApi {
   const std::map<int, VehicleEntry>& vehicles() const noexcept override { return vehicles_; }
   bool remove_vehicle(int id) override;
   std::vector<std::string> model_names() const override;
+  ridgeline::Result<int> spawn_body(const BodySpec& spec) override;
+  LooseBody* body(int id) override;
+  const std::map<int, LooseBody>& bodies() const noexcept override { return bodies_; }
+  bool remove_body(int id) override;
   const std::shared_ptr<ridgeline::Terrain>& terrain_ptr() const noexcept override {
     return terrain_;
   }
@@ -174,9 +188,14 @@ class Game final : public GameApi {
   }
   // Pulls the terrain's change log: vehicles near a changed box follow the new ground.
   void follow_terrain_edits();
+  // Counts the vehicle-vehicle and vehicle-body touches of the last Bullet step.
+  void count_touches();
+  // Removes loose bodies that left the terrain or fell through it.
+  void tidy_bodies();
 
   GameOptions options_;
   std::shared_ptr<ridgeline::Terrain> terrain_;
+  std::unique_ptr<Physics> physics_;  // before the vehicles and bodies: destroyed after them
   std::shared_ptr<const ridgeline::Landscape> landscape_;
   std::unique_ptr<ridgeline::RoamView> views_[3];
   std::map<std::string, VehicleModel> models_;
@@ -184,8 +203,18 @@ class Game final : public GameApi {
   int next_vehicle_id_ = 1;
   std::vector<CraterRecord> craters_;
   std::size_t craters_emitted_ = 0;
-  std::map<std::pair<int, int>, bool> touching_;
-  std::size_t contacts_ = 0;
+  std::map<int, LooseBody> bodies_;
+  int next_body_id_ = 1;
+  // The step at which each vehicle pair, and each (vehicle, body) pair, last touched.
+  std::map<std::pair<int, int>, std::uint64_t> touching_, body_touching_;
+  std::size_t contacts_ = 0, body_contacts_ = 0;
+  struct Hit {
+    int vehicle, body;
+    double speed;  // relative speed when they met (before the step), m/s
+  };
+  std::vector<Hit> hits_;  // new body-vehicle touches of this step, for the "hit" event
+  // Velocities before this step's Bullet step, by (1 vehicle | 2 body, id): the hits' speeds.
+  std::map<std::pair<int, int>, glm::dvec3> pre_velocity_;
   CameraRig rig_;
   ridgeline::BudgetController controller_ = ridgeline::BudgetController::create().value();
   bool controller_on_ = true;

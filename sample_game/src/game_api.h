@@ -26,7 +26,9 @@ struct CameraRig {
   glm::dvec3 free_eye{300, 400, 300};
   double free_yaw = 0.8, free_pitch = -0.35;  ///< radians; yaw 0 = +z
   int follow_vehicle = -1;                    ///< vehicle id; -1: the first vehicle
-  double follow_distance = 22, follow_height = 9;
+  /// Follow camera: metres behind the vehicle, above it (or above the ground under the eye),
+  /// and ahead of it where it looks (the road ahead, where the artillery's craters land).
+  double follow_distance = 22, follow_height = 7, follow_ahead = 12;
   glm::dvec2 map_centre{1024, 1024};
   double map_height = 1500;
 };
@@ -39,6 +41,9 @@ struct VehicleEntry {
   Autopilot autopilot;
   double distance_m = 0;  ///< path length driven
 };
+
+/// Loose bodies alive at once: the oldest is removed when another is spawned.
+inline constexpr std::size_t kMaxBodies = 160;
 
 /// A deformation the game applied (for stats and the renderer).
 struct CraterRecord {
@@ -91,6 +96,15 @@ class GameApi {
   virtual const std::map<int, VehicleEntry>& vehicles() const noexcept = 0;
   virtual bool remove_vehicle(int id) = 0;
   virtual std::vector<std::string> model_names() const = 0;
+
+  // ---- loose bodies (boulders, debris) ------------------------------------------------------
+  /// Spawns a loose body (the caller has checked the spec: finite, sizes 0.05 .. 5 m, mass >= 0).
+  /// Fails off the terrain. At most kMaxBodies live at once: spawning another removes the oldest.
+  virtual ridgeline::Result<int> spawn_body(const BodySpec& spec) = 0;
+  /// The body, or null when there is none with that id (removed, or despawned).
+  virtual LooseBody* body(int id) = 0;
+  virtual const std::map<int, LooseBody>& bodies() const noexcept = 0;
+  virtual bool remove_body(int id) = 0;
 
   // ---- terrain ------------------------------------------------------------------------------
   virtual const std::shared_ptr<ridgeline::Terrain>& terrain_ptr() const noexcept = 0;

@@ -1,7 +1,7 @@
-// Internals shared by the files that bind the game to Lua: lua_game.cpp (the `game` table) and
-// lua_vehicles.cpp (vehicle handles). Conventions follow the ridgeline binding and use its
-// checks (ridgeline/lua/check.h): misuse raises an argument error naming the field, an expected
-// miss returns nil, message; option tables refuse unknown fields.
+// Internals shared by the files that bind the game to Lua: lua_game.cpp (the `game` table),
+// lua_vehicles.cpp (vehicle handles) and lua_bodies.cpp (loose-body handles). Conventions follow
+// the ridgeline binding and use its checks (ridgeline/lua/check.h): misuse raises an argument error
+// naming the field, an expected miss returns nil, message; option tables refuse unknown fields.
 #pragma once
 
 #include <string>
@@ -31,6 +31,15 @@ void push_vehicle(lua_State* L, int id);
 VehicleEntry& check_vehicle(lua_State* L, int arg);
 /// The id of the vehicle handle at stack index `index`, or -1 when it is none.
 int test_vehicle(lua_State* L, int index);
+
+/// Registers the loose-body metatable `game.body` (once per state), like the vehicle's.
+void register_body_type(lua_State* L, Context* ctx);
+/// Pushes a handle to loose body `id`.
+void push_body(lua_State* L, int id);
+/// game.spawn_body{...}, game.bodies(), game.body(id) (lua_bodies.cpp).
+int g_spawn_body(lua_State* L);
+int g_bodies(lua_State* L);
+int g_body(lua_State* L);
 
 /// Sets field `k` of the table on top of the stack.
 void set_number(lua_State* L, const char* k, double v);

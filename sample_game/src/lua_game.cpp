@@ -144,7 +144,8 @@ void push_camera(lua_State* L, GameApi& g) {
   }
 }
 
-// game.camera{mode=, vehicle=, eye=, yaw=, pitch=, centre=, height=, distance=} / game.camera()
+// game.camera{mode=, vehicle=, eye=, yaw=, pitch=, centre=, height=, distance=, lift=, ahead=} /
+// game.camera()
 int g_camera(lua_State* L) {
   GameApi& g = game_of(L);
   if (lua_isnoneornil(L, 1)) {
@@ -152,8 +153,8 @@ int g_camera(lua_State* L) {
     return 1;
   }
   luaL_checktype(L, 1, LUA_TTABLE);
-  static const char* const kFields[] = {"mode",   "vehicle", "eye",      "yaw",  "pitch",
-                                        "centre", "height",  "distance", nullptr};
+  static const char* const kFields[] = {"mode",   "vehicle",  "eye",  "yaw",   "pitch", "centre",
+                                        "height", "distance", "lift", "ahead", nullptr};
   check_fields(L, 1, kFields);
   CameraRig r = g.rig();
   const char* mode = nullptr;
@@ -189,6 +190,12 @@ int g_camera(lua_State* L) {
   if (get_number_field(L, 1, "distance", &r.follow_distance) &&
       (r.follow_distance < 2 || r.follow_distance > 500))
     luaL_argerror(L, 1, "field 'distance': 2 .. 500 metres expected");
+  if (get_number_field(L, 1, "lift", &r.follow_height) &&
+      (r.follow_height < 0.5 || r.follow_height > 200))
+    luaL_argerror(L, 1, "field 'lift': 0.5 .. 200 metres expected");
+  if (get_number_field(L, 1, "ahead", &r.follow_ahead) &&
+      (r.follow_ahead < 0 || r.follow_ahead > 200))
+    luaL_argerror(L, 1, "field 'ahead': 0 .. 200 metres expected");
   g.rig() = r;
   return 0;
 }
@@ -214,14 +221,14 @@ int g_budget(lua_State* L) {
 }
 
 // game.set_budget{controller=, threshold=, render_scale=, target_ms=, deadband=, headroom=, min=,
-//                 max=, min_scale=, scale_from=, triangles=, tess_ms=}: every field checked before any
-//                 applies.
+//                 max=, min_scale=, scale_from=, triangles=, tess_ms=}: every field checked before
+//                 any applies.
 int g_set_budget(lua_State* L) {
   GameApi& g = game_of(L);
   luaL_checktype(L, 1, LUA_TTABLE);
   static const char* const kFields[] = {
-      "controller", "threshold",  "render_scale", "target_ms", "deadband", "headroom", "min",
-      "max",        "min_scale",  "scale_from",   "triangles", "tess_ms",  nullptr};
+      "controller", "threshold", "render_scale", "target_ms", "deadband", "headroom", "min",
+      "max",        "min_scale", "scale_from",   "triangles", "tess_ms",  nullptr};
   check_fields(L, 1, kFields);
   ridgeline::BudgetController& c = g.controller();
   BudgetSettings b = g.budget();
@@ -241,7 +248,8 @@ int g_set_budget(lua_State* L) {
   double deadband = c.desc().deadband;
   const bool has_deadband = get_number_field(L, 1, "deadband", &deadband);
   if (has_deadband && !(deadband >= 0 && deadband < 0.5))
-    luaL_argerror(L, 1, "field 'deadband': 0 .. 0.5 (exclusive) expected, a fraction of the target");
+    luaL_argerror(L, 1,
+                  "field 'deadband': 0 .. 0.5 (exclusive) expected, a fraction of the target");
   double headroom = c.desc().headroom_gain;
   const bool has_headroom = get_number_field(L, 1, "headroom", &headroom);
   if (has_headroom && !(headroom >= 0 && headroom <= 100))
@@ -335,6 +343,7 @@ int g_stats(lua_State* L) {
   set_number(L, "tess_ms", v.stats.update_ms);
   set_number(L, "craters", double(g.crater_count()));
   set_number(L, "script_errors", double(runner_of(L).error_count()));
+  set_number(L, "bodies", double(g.bodies().size()));
   if (const ridgeline::DetailCache* cache = g.terrain_ptr()->surface().detail_cache()) {
     const ridgeline::DetailCacheStats s = cache->stats();
     set_number(L, "tiles_resident", double(s.resident_tiles));
@@ -385,12 +394,16 @@ const luaL_Reg kGame[] = {{"spawn", g_spawn},
                           {"stats", g_stats},
                           {"models", g_models},
                           {"materials", g_materials},
+                          {"spawn_body", g_spawn_body},
+                          {"bodies", g_bodies},
+                          {"body", g_body},
                           {nullptr, nullptr}};
 
 }  // namespace
 
 void push_game_table(lua_State* L, Context* ctx) {
   register_vehicle_type(L, ctx);
+  register_body_type(L, ctx);
   lua_newtable(L);
   lua_pushlightuserdata(L, ctx);
   luaL_setfuncs(L, kGame, 1);

@@ -126,7 +126,7 @@ int v_state(lua_State* L) {
   const glm::dvec3 p = e.body.position();
   int contacts = 0;
   for (const WheelState& w : e.body.wheels()) contacts += w.contact;
-  lua_createtable(L, 0, 12);
+  lua_createtable(L, 0, 13);
   set_number(L, "id", e.id);
   set_string(L, "name", e.name);
   set_string(L, "model", e.model);
@@ -139,6 +139,7 @@ int v_state(lua_State* L) {
   set_number(L, "distance", e.distance_m);
   set_number(L, "material", e.body.ground_material());
   set_number(L, "collisions", double(e.body.collisions));
+  set_number(L, "body_hits", double(e.body.body_hits));
   return 1;
 }
 
@@ -153,7 +154,7 @@ int v_place(lua_State* L) {
     lua_pushfstring(L, "place: (%f, %f) is off the terrain", x, z);
     return 2;
   }
-  e.body.place_on_surface(t, x, z, heading);
+  e.body.place_on_surface(x, z, heading);
   lua_pushboolean(L, 1);
   return 1;
 }

@@ -44,6 +44,7 @@ double cpu_ms(clockid_t clock) {
 
 struct Args {
   bool headless = false, offscreen = false, egl = false, no_panel = false, wireframe = false;
+  bool panel_open = false;
   std::uint64_t frames = 0;
   std::vector<std::string> scripts;
   std::string screenshot, stats, out_dir = "out", camera, record_path;
@@ -194,9 +195,11 @@ int run(const Args& a) {
       return 1;
     }
     renderer = std::move(*r);
-    if (!a.no_panel)
+    if (!a.no_panel) {
       panel = std::make_unique<game::Panel>(
           ctx->mode() == game::GlMode::kWindow ? ctx->window() : nullptr, a.width, a.height);
+      panel->set_open(a.panel_open);
+    }
   }
   if (!a.out_dir.empty() && (a.screenshot_every > 0))
     std::filesystem::create_directories(a.out_dir);
@@ -208,7 +211,7 @@ int run(const Args& a) {
   game::RunStats stats;
   double last_frame_ms = 0;
   double accumulator = 0;
-  bool f5_was_down = false, tab_was_down = false, f1_was_down = false;
+  bool f5_was_down = false, tab_was_down = false, f1_was_down = false, f2_was_down = false;
   std::uint64_t frame = 0;
   const bool window = ctx && ctx->mode() == game::GlMode::kWindow;
   auto wall0 = Clock::now();
@@ -229,6 +232,9 @@ int run(const Args& a) {
       const bool f1 = glfwGetKey(w, GLFW_KEY_F1) == GLFW_PRESS;
       if (f1 && !f1_was_down) rs.wireframe = !rs.wireframe;
       f1_was_down = f1;
+      const bool f2 = glfwGetKey(w, GLFW_KEY_F2) == GLFW_PRESS;
+      if (f2 && !f2_was_down && panel) panel->toggle();
+      f2_was_down = f2;
     }
     if (frame % 30 == 0) g.reload_changed_scripts();  // hot reload: edit a script, it re-runs
     // Fixed steps: offscreen and headless take exactly one per frame (reproducible); a window
@@ -331,6 +337,9 @@ int run(const Args& a) {
     rec.bytes_uploaded = rstats.bytes_uploaded;
     rec.view_upload_bytes = vf.stats.upload_bytes;
     rec.contacts = g.contacts();
+    rec.body_contacts = g.body_contacts();
+    rec.bodies = g.bodies().size();
+    for (const auto& [id, b] : g.bodies()) rec.bodies_awake += !b.sleeping();
     if (auto ds = g.detail_stats()) {
       rec.tiles_resident = ds->resident_tiles;
       rec.tiles_pending = ds->pending;
@@ -347,6 +356,7 @@ int run(const Args& a) {
       vr.reached = e.autopilot.reached;
       vr.material = e.body.ground_material();
       vr.collisions = e.body.collisions;
+      vr.body_hits = e.body.body_hits;
       vr.min_gap = 1e9;
       for (const auto& w : e.body.wheels()) {
         vr.min_gap = std::min(vr.min_gap, w.surface_gap);
@@ -445,6 +455,8 @@ int main(int argc, char** argv) {
                "fragment path)");
   app.add_flag("--unsorted", a.unsorted, "draw terrain patches in index order, not nearest first");
   app.add_flag("--no-panel", a.no_panel, "no debug panel (reproducible pictures)");
+  app.add_flag("--panel-open", a.panel_open,
+               "start with the debug panel unfolded (it starts folded; F2 toggles it)");
   app.add_flag("--wireframe", a.wireframe, "start in wireframe");
   CLI11_PARSE(app, argc, argv);
   if (a.headless && a.offscreen) {

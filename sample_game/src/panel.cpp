@@ -48,7 +48,15 @@ void Panel::draw(Game& game, RenderSettings& settings, const PanelInput& in, dou
   ImGui::NewFrame();
   ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSize(ImVec2(360, 0), ImGuiCond_FirstUseEver);
-  ImGui::Begin("Ridgeline");
+  if (toggle_) open_ = !open_, toggle_ = false, apply_ = true;
+  if (apply_) ImGui::SetNextWindowCollapsed(!open_, ImGuiCond_Always), apply_ = false;
+  open_ = ImGui::Begin("Ridgeline - F2: debug panel");
+  if (!open_) {  // folded: the title bar alone
+    ImGui::End();
+    ImGui::Render();
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    return;
+  }
   const ViewFrame& vf = game.last_view_frame();
   const ridgeline::BudgetController& c = game.controller();
   ImGui::Text("frame %.1f ms  (target %.0f ms, smoothed %.1f)", in.frame_ms, c.desc().target_ms,
@@ -114,14 +122,22 @@ void Panel::draw(Game& game, RenderSettings& settings, const PanelInput& in, dou
   ImGui::Checkbox("front to back", &settings.front_to_back);
   ImGui::Text("vehicles %zu  craters %zu  contacts %zu  t = %.1f s", game.vehicles().size(),
               game.craters().size(), game.contacts(), game.time());
+  std::size_t asleep = 0;
+  for (const auto& [id, b] : game.bodies()) asleep += b.sleeping();
+  const ridgeline::bullet::TerrainSyncStats& sync = game.physics().last_sync();
+  ImGui::Text("loose bodies %zu (%zu asleep), %zu touching vehicles", game.bodies().size(), asleep,
+              game.body_contacts());
+  ImGui::Text("Bullet on the Ridgeline shape; last edit sync: %zu woken, %zu lifted",
+              sync.bodies_woken, sync.bodies_lifted);
   if (const VehicleEntry* e =
           game.vehicle(game.rig().follow_vehicle >= 0
                            ? game.rig().follow_vehicle
                            : (game.vehicles().empty() ? -1 : game.vehicles().begin()->first))) {
     const Material& m = material(e->body.ground_material());
-    ImGui::Text("%s: %.1f m/s on %s (grip x%.2f), %llu collisions", e->name.c_str(),
+    ImGui::Text("%s: %.1f m/s on %s (grip x%.2f), %llu collisions, %llu hits", e->name.c_str(),
                 e->body.speed(), m.name, m.friction,
-                static_cast<unsigned long long>(e->body.collisions));
+                static_cast<unsigned long long>(e->body.collisions),
+                static_cast<unsigned long long>(e->body.body_hits));
   }
   ImGui::Separator();
   if (ImGui::Button("reload scripts (F5)")) game.reload_all_scripts();

@@ -7,12 +7,14 @@
 #include <GL/glext.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 #include <glm/mat4x4.hpp>
+#include <map>
 #include <string>
 
 #include "geomorph_glsl.h"
@@ -244,6 +246,78 @@ float cell_grain(std::uint32_t i, std::uint32_t j) {
   return 0.94f + 0.12f * float(h & 0xffff) / 65535.0f;
 }
 
+// A boulder of unit radius: an icosahedron subdivided twice, each vertex pushed in or out by up to
+// 5 % (a deterministic hash), flat-shaded facets in pale weathered stone (bright enough to read
+// against the grass in the shadowed side). The physics body is
+// the sphere; the facets stay within 5 % of it.
+ModelMesh boulder_mesh() {
+  const double t = (1 + std::sqrt(5.0)) / 2;
+  std::vector<glm::dvec3> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},
+                               {0, -1, t}, {0, 1, t}, {0, -1, -t}, {0, 1, -t},
+                               {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  std::vector<std::array<int, 3>> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                                       {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                                       {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                                       {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+  for (glm::dvec3& p : v) p = glm::normalize(p);
+  for (int level = 0; level < 2; ++level) {
+    std::map<std::pair<int, int>, int> mid;
+    auto middle = [&](int a, int b) {
+      const auto key = std::minmax(a, b);
+      auto it = mid.find(key);
+      if (it != mid.end()) return it->second;
+      v.push_back(glm::normalize(v[std::size_t(a)] + v[std::size_t(b)]));
+      return mid[key] = int(v.size()) - 1;
+    };
+    std::vector<std::array<int, 3>> g;
+    for (const auto& [a, b, c] : f) {
+      const int ab = middle(a, b), bc = middle(b, c), ca = middle(c, a);
+      g.push_back({a, ab, ca});
+      g.push_back({b, bc, ab});
+      g.push_back({c, ca, bc});
+      g.push_back({ab, bc, ca});
+    }
+    f = std::move(g);
+  }
+  for (std::size_t k = 0; k < v.size(); ++k)
+    v[k] *= 0.95 + 0.05 * cell_grain(std::uint32_t(k), 7u) / 1.06;
+  ModelMesh m;
+  for (const auto& tri : f) {
+    const glm::dvec3 a = v[std::size_t(tri[0])], b = v[std::size_t(tri[1])],
+                     c = v[std::size_t(tri[2])];
+    const glm::vec3 n(glm::normalize(glm::cross(b - a, c - a)));
+    const float shade =
+        0.85f + 0.3f * (cell_grain(std::uint32_t(tri[0]), std::uint32_t(tri[1])) - 0.94f);
+    for (const glm::dvec3& p : {a, b, c})
+      m.vertices.push_back({float(p.x), float(p.y), float(p.z), n.x, n.y, n.z, 0.72f * shade,
+                            0.66f * shade, 0.58f * shade});
+  }
+  for (std::uint32_t k = 0; k < m.vertices.size(); ++k) m.indices.push_back(k);
+  return m;
+}
+
+// Debris: a unit cube (half extents 1), timber brown, scaled to a body's half extents.
+ModelMesh debris_mesh() {
+  ModelMesh m;
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side = -1; side <= 1; side += 2) {
+      glm::vec3 n(0);
+      n[axis] = float(side);
+      const int u = (axis + 1) % 3, w = (axis + 2) % 3;
+      const std::uint32_t base = std::uint32_t(m.vertices.size());
+      const float shade = 0.8f + 0.1f * float(axis) + (side > 0 ? 0.05f : 0.0f);
+      for (int k = 0; k < 4; ++k) {
+        glm::vec3 p = n;
+        p[u] = (k & 1) ? 1.0f : -1.0f;
+        p[w] = (k & 2) ? 1.0f : -1.0f;
+        m.vertices.push_back(
+            {p.x, p.y, p.z, n.x, n.y, n.z, 0.55f * shade, 0.40f * shade, 0.26f * shade});
+      }
+      for (std::uint32_t k : {0u, 1u, 3u, 0u, 3u, 2u}) m.indices.push_back(base + k);
+    }
+  return m;
+}
+
 }  // namespace
 
 ridgeline::Status Renderer::make_target(Target& t, int w, int h) {
@@ -336,6 +410,8 @@ ridgeline::Result<std::unique_ptr<Renderer>> Renderer::create(Game& game, int wi
     const VehicleModel* m = game.model(name);
     r->models_[name] = {r->upload_model(m->body), r->upload_model(m->wheel)};
   }
+  r->boulder_ = r->upload_model(boulder_mesh());
+  r->debris_ = r->upload_model(debris_mesh());
   if (glGetError() != GL_NO_ERROR) return Error{"renderer: OpenGL error during setup"};
   return r;
 }
@@ -347,12 +423,13 @@ Renderer::~Renderer() {
       glDeleteBuffers(1, &p.vbo);
       glDeleteBuffers(1, &p.ibo);
     }
-  for (auto& [k, m] : models_)
-    for (MeshGpu* g : {&m.first, &m.second}) {
-      glDeleteVertexArrays(1, &g->vao);
-      glDeleteBuffers(1, &g->vbo);
-      glDeleteBuffers(1, &g->ibo);
-    }
+  std::vector<MeshGpu*> meshes = {&boulder_, &debris_};
+  for (auto& [k, m] : models_) meshes.insert(meshes.end(), {&m.first, &m.second});
+  for (MeshGpu* g : meshes) {
+    glDeleteVertexArrays(1, &g->vao);
+    glDeleteBuffers(1, &g->vbo);
+    glDeleteBuffers(1, &g->ibo);
+  }
   glDeleteProgram(terrain_prog_);
   glDeleteProgram(sky_prog_);
   glDeleteProgram(model_prog_);
@@ -572,6 +649,20 @@ RenderStats Renderer::draw(Game& game, const RenderSettings& settings) {
       glBindVertexArray(it->second.second.vao);
       glDrawElements(GL_TRIANGLES, it->second.second.count, GL_UNSIGNED_INT, nullptr);
     }
+  }
+
+  // Loose bodies: boulders (the faceted sphere) and debris (the cube), at the body's size.
+  for (const auto& [id, b] : game.bodies()) {
+    const glm::dvec3 p = b.position();
+    if (glm::length(p - eye) > 1500) continue;
+    const MeshGpu& mesh = b.spec().shape == BodyShape::kSphere ? boulder_ : debris_;
+    const glm::dmat4 m = glm::translate(glm::dmat4(1.0), p - eye) *
+                         glm::dmat4(glm::mat4_cast(b.orientation())) *
+                         glm::scale(glm::dmat4(1.0), b.spec().size);
+    const glm::mat4 mf(m);
+    glUniformMatrix4fv(u_model, 1, GL_FALSE, glm::value_ptr(mf));
+    glBindVertexArray(mesh.vao);
+    glDrawElements(GL_TRIANGLES, mesh.count, GL_UNSIGNED_INT, nullptr);
   }
 
   // Terrain, nearest patches first.

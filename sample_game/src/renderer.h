@@ -1,9 +1,9 @@
 // Renderer: draws the game with OpenGL 3.3 core: the active camera's ROAM mesh (per-patch
 // buffers, re-uploaded only for dirty patches, geomorphs on the GPU, shaded by the terrain's
-// material map), vehicles from their glTF meshes, the sky. The scene renders into a framebuffer
-// object at the game's render scale (dynamic resolution) and is upscaled into the output
-// framebuffer object at full resolution, where the panel draws and screenshots read. Needs a
-// current context (gl_context.h).
+// material map), vehicles from their glTF meshes, the loose bodies (boulders, debris), the sky. The
+// scene renders into a framebuffer object at the game's render scale (dynamic resolution) and is
+// upscaled into the output framebuffer object at full resolution, where the panel draws and
+// screenshots read. Needs a current context (gl_context.h).
 //
 // For the ROAM core's output (docs/game.md, "Rendering"): every patch upload goes through
 // upload_patch() (the dirty ranges of RoamView::take_dirty_patches() with glBufferSubData), the
@@ -97,6 +97,7 @@ class Renderer {
   bool patches_initialised_[3] = {false, false, false};
   std::vector<std::pair<float, std::uint32_t>> order_;
   std::map<std::string, std::pair<MeshGpu, MeshGpu>> models_;  ///< body, wheel
+  MeshGpu boulder_, debris_;  ///< loose bodies: unit sphere (faceted), unit cube
 };
 
 }  // namespace game

@@ -43,7 +43,8 @@ ridgeline::Status RunStats::write(const std::string& path, const std::string& mo
       {"render", &FrameRecord::render_ms, {}},     {"panel", &FrameRecord::panel_ms, {}}};
   std::vector<double> other;
   std::size_t resident_max = 0, pending_max = 0, steady = 0, converged = 0, capped = 0, timed = 0;
-  std::uint64_t generated_first = 0, generated_last = 0, contact_frames = 0;
+  std::uint64_t generated_first = 0, generated_last = 0, contact_frames = 0, body_frames = 0;
+  std::size_t bodies_max = 0;
   bool first_steady = true;
   for (const FrameRecord& f : frames_) {
     json vs = json::array();
@@ -56,7 +57,8 @@ ridgeline::Status RunStats::write(const std::string& path, const std::string& mo
                     {"max_contact_gap_m", v.max_contact_gap},
                     {"wheels_in_contact", v.contacts},
                     {"material", v.material},
-                    {"collisions", v.collisions}});
+                    {"collisions", v.collisions},
+                    {"body_hits", v.body_hits}});
     frames.push_back({{"frame", f.frame},
                       {"time_s", f.time_s},
                       {"wall_s", f.wall_s},
@@ -89,6 +91,9 @@ ridgeline::Status RunStats::write(const std::string& path, const std::string& mo
                       {"bytes_uploaded", f.bytes_uploaded},
                       {"view_upload_bytes", f.view_upload_bytes},
                       {"vehicle_contacts", f.contacts},
+                      {"body_vehicle_contacts", f.body_contacts},
+                      {"bodies", f.bodies},
+                      {"bodies_awake", f.bodies_awake},
                       {"detail_tiles_resident", f.tiles_resident},
                       {"detail_tiles_pending", f.tiles_pending},
                       {"detail_tiles_generated", f.tiles_generated},
@@ -116,6 +121,8 @@ ridgeline::Status RunStats::write(const std::string& path, const std::string& mo
       capped += f.stop == 1;
       timed += f.stop == 2;
       contact_frames += f.contacts > 0;
+      body_frames += f.body_contacts > 0;
+      bodies_max = std::max(bodies_max, f.bodies);
     }
   }
   json errors = json::array();
@@ -181,6 +188,8 @@ ridgeline::Status RunStats::write(const std::string& path, const std::string& mo
       {"detail_tiles_pending_max", pending_max},
       {"detail_tiles_generated", generated_last - generated_first},
       {"frames_with_vehicle_contacts", contact_frames},
+      {"frames_with_bodies_touching_vehicles", body_frames},
+      {"loose_bodies_max", bodies_max},
       {"target_ms", game.controller().desc().target_ms},
       {"controller_range_px",
        {game.controller().desc().min_threshold, game.controller().desc().max_threshold}},

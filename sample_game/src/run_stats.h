@@ -28,8 +28,10 @@ struct FrameRecord {
   double smoothed_ms = 0;       ///< the controller's moving average after this frame
   std::uint64_t reversals = 0;  ///< the controller's direction reversals so far
   std::uint32_t triangles = 0, splits = 0, merges = 0, patches_uploaded = 0, pending_splits = 0;
-  int stop = -1;             ///< ridgeline::StopReason of the view update, -1 when none ran
-  std::size_t contacts = 0;  ///< vehicle-vehicle contacts in the last step
+  int stop = -1;                  ///< ridgeline::StopReason of the view update, -1 when none ran
+  std::size_t contacts = 0;       ///< vehicle-vehicle pairs touching after the last step
+  std::size_t body_contacts = 0;  ///< loose body-vehicle pairs touching after the last step
+  std::size_t bodies = 0, bodies_awake = 0;  ///< loose bodies alive, and not asleep
   /// Vertex and index bytes the renderer sent to GL (dirty ranges, whole buffers when they grew),
   /// and the bytes the view's update changed (RoamStats::upload_bytes).
   std::uint64_t bytes_uploaded = 0, view_upload_bytes = 0;
@@ -43,6 +45,7 @@ struct FrameRecord {
     int contacts;
     int material;
     std::uint64_t collisions;
+    std::uint64_t body_hits;
   };
   std::vector<VehicleRecord> vehicles;
 };

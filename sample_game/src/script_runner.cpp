@@ -15,7 +15,7 @@ namespace game {
 using ridgeline::Error;
 using ridgeline::Status;
 
-const char* const kScriptEvents[] = {"tick", "waypoint", "crater", nullptr};
+const char* const kScriptEvents[] = {"tick", "waypoint", "crater", "hit", nullptr};
 
 namespace {
 

@@ -1,7 +1,12 @@
-// Raycast-suspension vehicle (the classic "raycast vehicle": one ray per wheel along the body's
-// down axis, a spring-damper on the hit distance, a friction circle per tyre) on Ridgeline's
-// surface queries. Semi-implicit Euler with fixed substeps.
+// Raycast-suspension vehicle on Bullet: a btRaycastVehicle (one ray per wheel along the body's
+// down axis, a spring-damper on the hit distance, a friction impulse per tyre limited by the
+// suspension load) whose rays go through btCollisionWorld::rayTest, i.e. through Ridgeline's
+// raycast on the terrain (ridgeline/bullet/terrain_shape.h), and a box chassis that collides
+// with the terrain's finest triangles, the other vehicles and the loose bodies. The tyres' grip
+// follows the material under them (materials.cpp).
 #include "vehicle.h"
+
+#include <btBulletDynamicsCommon.h>
 
 #include <algorithm>
 #include <cmath>
@@ -12,9 +17,126 @@
 
 namespace game {
 namespace {
+
 constexpr double kGravity = 9.81;
-constexpr int kSubsteps = 4;
+
+btVector3 bt(const glm::dvec3& v) {
+  return btVector3(btScalar(v.x), btScalar(v.y), btScalar(v.z));
+}
+glm::dvec3 dv(const btVector3& v) {
+  return {v.x(), v.y(), v.z()};
+}
+
+// Wheel rays see the terrain alone: the chassis hulls meet other vehicles and push the loose
+// bodies (a wheel ray that found another vehicle's hull after a crash would drive the vehicle up
+// onto it, and a boulder under a wheel would carry the truck without being pushed down).
+struct Raycaster final : btVehicleRaycaster {
+  btDynamicsWorld* world = nullptr;
+  const btCollisionObject* self = nullptr;
+  void* castRay(const btVector3& from, const btVector3& to,
+                btVehicleRaycasterResult& result) override {
+    struct Closest final : btCollisionWorld::ClosestRayResultCallback {
+      using ClosestRayResultCallback::ClosestRayResultCallback;
+      const btCollisionObject* self = nullptr;
+      bool needsCollision(btBroadphaseProxy* proxy) const override {
+        return proxy->m_clientObject != self && ClosestRayResultCallback::needsCollision(proxy);
+      }
+    } cb(from, to);
+    cb.self = self;
+    cb.m_collisionFilterGroup = kGroupVehicle;
+    cb.m_collisionFilterMask = kGroupTerrain;
+    world->rayTest(from, to, cb);
+    if (!cb.hasHit()) return nullptr;
+    result.m_hitPointInWorld = cb.m_hitPointWorld;
+    result.m_hitNormalInWorld = cb.m_hitNormalWorld.normalized();
+    result.m_distFraction = cb.m_closestHitFraction;
+    return const_cast<btCollisionObject*>(cb.m_collisionObject);
+  }
+};
+
 }  // namespace
+
+// The Bullet side of a vehicle. It is also the world's action for the vehicle: at each internal
+// step it turns the controls into engine force, brakes, steering and grip, then runs the raycast
+// vehicle.
+struct Vehicle::Parts final : btActionInterface {
+  Vehicle* owner = nullptr;
+  btDynamicsWorld* world = nullptr;
+  std::unique_ptr<btConvexHullShape> hull;
+  std::unique_ptr<btRigidBody> body;
+  Raycaster raycaster;
+  std::unique_ptr<btRaycastVehicle> vehicle;
+
+  void updateAction(btCollisionWorld* w, btScalar dt) override {
+    const double steer = std::clamp(owner->controls.steer, -1.0, 1.0) * owner->params_.max_steer;
+    vehicle->setSteeringValue(btScalar(steer), 0);
+    vehicle->setSteeringValue(btScalar(steer), 1);
+    // Bullet's raycast vehicle: the suspension rays (Ridgeline's raycast on the terrain), the
+    // springs, the wheel transforms. Its own tyre impulses are switched off (zero friction slip):
+    // they only cancel a fifth of the side slip per step (resolveSingleBilateral's damping), so a
+    // braked truck creeps down any slope; the tyres below cancel all of it within the friction
+    // circle.
+    vehicle->updateAction(w, dt);
+    tyres(double(dt));
+  }
+
+  // Engine, brakes, rolling resistance and side grip at each wheel in contact, as impulses on the
+  // chassis at the contact point, each limited by the friction circle: the suspension load times
+  // the tyre's friction times the ground's material factor (materials.cpp). Applied wheel by
+  // wheel, each seeing the velocity the previous ones left (sequential impulses).
+  void tyres(double dt) {
+    const VehicleParams& p = owner->params_;
+    const Controls& c = owner->controls;
+    const double throttle = std::clamp(c.throttle, -1.0, 1.0);
+    const double brake = std::clamp(c.brake, 0.0, 1.0);
+    const double fwd_speed = owner->speed();
+    btRigidBody& chassis = *body;
+    const btVector3 com = chassis.getCenterOfMassPosition();
+    const btMatrix3x3& basis = chassis.getWorldTransform().getBasis();
+    const btVector3 fwd = basis.getColumn(2), up = basis.getColumn(1);
+    for (int i = 0; i < 4; ++i) {
+      const btWheelInfo& wi = vehicle->getWheelInfo(i);
+      if (!wi.m_raycastInfo.m_isInContact) continue;
+      const btVector3 n = wi.m_raycastInfo.m_contactNormalWS;
+      const btVector3 r = wi.m_raycastInfo.m_contactPointWS - com;
+      const btVector3 wheel_fwd = fwd.rotate(up, wi.m_steering);
+      btVector3 tf = wheel_fwd - n * n.dot(wheel_fwd);
+      if (tf.length2() < 1e-8f) continue;
+      tf.normalize();
+      const btVector3 ts = n.cross(tf);
+      // Effective mass of the chassis at the contact along a direction.
+      const auto mass_along = [&](const btVector3& d) {
+        const btVector3 rd = r.cross(d);
+        const double k =
+            double(chassis.getInvMass()) + double(rd.dot(chassis.getInvInertiaTensorWorld() * rd));
+        return k > 0 ? 1.0 / k : 0.0;
+      };
+      const btVector3 vp = chassis.getVelocityInLocalPoint(r);
+      const double vf = vp.dot(tf), vs = vp.dot(ts);
+      // Side: cancel the slip. Along: the engine (none above the top speed), else brakes and
+      // rolling resistance, which stop the wheel's rolling at most.
+      double js = -vs * mass_along(ts);
+      double jf = 0;
+      if (throttle != 0 && !(throttle > 0 && fwd_speed > p.max_speed) &&
+          !(throttle < 0 && fwd_speed < -p.max_speed / 3)) {
+        jf = throttle * p.engine_force / 4 * dt;
+      } else {
+        const double stop = (brake * p.brake_force + 0.015 * p.mass * kGravity) / 4 * dt;
+        jf = std::clamp(-vf * mass_along(tf), -stop, stop);
+      }
+      const double limit = p.friction * material(owner->wheels_[std::size_t(i)].material).friction *
+                           double(std::min(wi.m_wheelsSuspensionForce, wi.m_maxSuspensionForce)) *
+                           dt;
+      const double mag = std::hypot(jf, js);
+      if (mag > limit && mag > 0) {
+        jf *= limit / mag;
+        js *= limit / mag;
+      }
+      chassis.applyImpulse(tf * btScalar(jf) + ts * btScalar(js), r);
+    }
+  }
+  void debugDraw(btIDebugDraw*) override {}
+};
 
 VehicleParams params_from_model(const VehicleModel& model, double mass_kg) {
   VehicleParams p;
@@ -32,6 +154,11 @@ VehicleParams params_from_model(const VehicleModel& model, double mass_kg) {
   }
   const glm::vec3 e = model.body_max - model.body_min;
   p.inertia_extent = {e.x, e.y, e.z};
+  // The chassis box: the body's box, its bottom at the wheel centres (the frame; the wheels
+  // below it are rays).
+  p.chassis_min = glm::dvec3(model.body_min) - p.com_in_model;
+  p.chassis_max = glm::dvec3(model.body_max) - p.com_in_model;
+  p.chassis_min.y = std::max(p.chassis_min.y, double(wheel_y) - p.com_in_model.y);
   // Static sag of about rest_length / 3, damping ratio about 0.5.
   const double per_wheel = mass_kg * kGravity / 4;
   p.spring_k = per_wheel / (p.rest_length / 3);
@@ -42,28 +169,154 @@ VehicleParams params_from_model(const VehicleModel& model, double mass_kg) {
   return p;
 }
 
-Vehicle::Vehicle(const VehicleParams& params, glm::dvec3 position, double heading_rad)
-    : params_(params) {
+Vehicle::Vehicle(Physics& physics, const VehicleParams& params, glm::dvec3 position,
+                 double heading_rad)
+    : physics_(&physics), params_(params), parts_(std::make_unique<Parts>()) {
+  Parts& b = *parts_;
+  b.owner = this;
+  b.world = &physics.world();
+  // The chassis: a hull of the body's box above a third of its height, narrowing below to the
+  // four points where the wheels' bottoms are at full compression. A wheel that bottoms out (a
+  // hard landing in a crater) then rests on the hull instead of sinking into the ground, and a
+  // crest or a crater's rim lifts the bevelled nose instead of stopping the vehicle dead.
+  const glm::dvec3 lo = params.chassis_min, hi = params.chassis_max;
+  b.hull = std::make_unique<btConvexHullShape>();
+  const double mid = lo.y + (hi.y - lo.y) / 3;
+  for (int i = 0; i < 8; ++i)
+    b.hull->addPoint(bt({i & 1 ? hi.x : lo.x, i & 4 ? hi.y : mid, i & 2 ? hi.z : lo.z}), false);
+  for (const glm::dvec3& a : params.attach)
+    b.hull->addPoint(bt(a - glm::dvec3(0, params.wheel_radius, 0)), false);
+  b.hull->recalcLocalAabb();
+  b.hull->setMargin(0.02f);
   const glm::dvec3 e = params.inertia_extent;
   const double m = params.mass;
-  inertia_ = {m / 12 * (e.y * e.y + e.z * e.z), m / 12 * (e.x * e.x + e.z * e.z),
-              m / 12 * (e.x * e.x + e.y * e.y)};
+  const btVector3 inertia(btScalar(m / 12 * (e.y * e.y + e.z * e.z)),
+                          btScalar(m / 12 * (e.x * e.x + e.z * e.z)),
+                          btScalar(m / 12 * (e.x * e.x + e.y * e.y)));
+  btRigidBody::btRigidBodyConstructionInfo info(btScalar(m), nullptr, b.hull.get(), inertia);
+  info.m_friction = 0.3f;
+  info.m_restitution = 0.2f;
+  info.m_linearDamping = 0.02f;
+  info.m_angularDamping = 0.4f;
+  b.body = std::make_unique<btRigidBody>(info);
+  b.body->setActivationState(DISABLE_DEACTIVATION);
+  physics.world().addRigidBody(b.body.get(), kGroupVehicle,
+                               kGroupTerrain | kGroupVehicle | kGroupBody);
+  b.raycaster.world = &physics.world();
+  b.raycaster.self = b.body.get();
+  // Bullet's suspension force is stiffness x chassis mass x compression: per-kilogram figures.
+  btRaycastVehicle::btVehicleTuning tuning;
+  tuning.m_suspensionStiffness = btScalar(params.spring_k / m);
+  tuning.m_suspensionCompression = btScalar(params.damper_c / m);
+  tuning.m_suspensionDamping = btScalar(params.damper_c / m);
+  tuning.m_maxSuspensionTravelCm = btScalar(params.rest_length * 100);
+  tuning.m_frictionSlip = 0;  // the tyres are ours (Parts::tyres)
+  tuning.m_maxSuspensionForce = btScalar(m * kGravity * 8);
+  b.vehicle = std::make_unique<btRaycastVehicle>(tuning, b.body.get(), &b.raycaster);
+  b.vehicle->setCoordinateSystem(0, 1, 2);  // right (the body's +x is left: axles point -x), up,
+                                            // forward
+  for (int i = 0; i < 4; ++i) {
+    btWheelInfo& w = b.vehicle->addWheel(bt(params.attach[i]), btVector3(0, -1, 0),
+                                         btVector3(-1, 0, 0), btScalar(params.rest_length),
+                                         btScalar(params.wheel_radius), tuning, i < 2);
+    w.m_rollInfluence = 0.2f;
+  }
+  physics.world().addAction(&b);
   place(position, heading_rad);
 }
 
-void Vehicle::place(glm::dvec3 position, double heading_rad) {
-  pos_ = position;
-  q_ = glm::angleAxis(heading_rad, glm::dvec3(0, 1, 0));
-  v_ = w_ = glm::dvec3(0);
-  for (int i = 0; i < 4; ++i) {
-    wheels_[i] = {};
-    wheels_[i].suspension_length = params_.rest_length;
-    wheels_[i].centre = pos_ + q_ * params_.attach[i] - up() * params_.rest_length;
+Vehicle::~Vehicle() {
+  if (parts_ && physics_ != nullptr) {
+    physics_->world().removeAction(parts_.get());
+    physics_->world().removeRigidBody(parts_->body.get());
   }
 }
 
-bool Vehicle::place_on_surface(const ridgeline::Terrain& terrain, double x, double z,
-                               double heading_rad) {
+Vehicle::Vehicle(Vehicle&& o) noexcept
+    : controls(o.controls),
+      collisions(o.collisions),
+      body_hits(o.body_hits),
+      physics_(o.physics_),
+      params_(o.params_),
+      parts_(std::move(o.parts_)),
+      wheels_(o.wheels_),
+      ground_material_(o.ground_material_),
+      ground_(o.ground_) {
+  if (parts_) parts_->owner = this;
+  o.physics_ = nullptr;
+}
+
+Vehicle& Vehicle::operator=(Vehicle&& o) noexcept {
+  if (this != &o) {
+    if (parts_ && physics_ != nullptr) {
+      physics_->world().removeAction(parts_.get());
+      physics_->world().removeRigidBody(parts_->body.get());
+    }
+    controls = o.controls;
+    collisions = o.collisions;
+    body_hits = o.body_hits;
+    physics_ = o.physics_;
+    params_ = o.params_;
+    parts_ = std::move(o.parts_);
+    wheels_ = o.wheels_;
+    ground_material_ = o.ground_material_;
+    ground_ = o.ground_;
+    if (parts_) parts_->owner = this;
+    o.physics_ = nullptr;
+  }
+  return *this;
+}
+
+const btRigidBody* Vehicle::chassis() const noexcept {
+  return parts_->body.get();
+}
+
+btRigidBody* Vehicle::chassis() noexcept {
+  return parts_->body.get();
+}
+
+glm::dvec3 Vehicle::position() const noexcept {
+  return physics_->to_world(parts_->body->getCenterOfMassPosition());
+}
+
+glm::dquat Vehicle::orientation() const noexcept {
+  const btQuaternion q = parts_->body->getOrientation();
+  return glm::dquat(q.w(), q.x(), q.y(), q.z());
+}
+
+glm::dvec3 Vehicle::velocity() const noexcept {
+  return dv(parts_->body->getLinearVelocity());
+}
+
+double Vehicle::heading() const noexcept {
+  const glm::dvec3 f = forward();
+  return std::atan2(f.x, f.z);
+}
+
+double Vehicle::speed() const noexcept {
+  return glm::dot(velocity(), forward());
+}
+
+void Vehicle::place(glm::dvec3 position, double heading_rad) {
+  const glm::dquat q = glm::angleAxis(heading_rad, glm::dvec3(0, 1, 0));
+  btRigidBody& body = *parts_->body;
+  body.setCenterOfMassTransform(
+      btTransform(btQuaternion(btScalar(q.x), btScalar(q.y), btScalar(q.z), btScalar(q.w)),
+                  physics_->to_local(position)));
+  body.setLinearVelocity(btVector3(0, 0, 0));
+  body.setAngularVelocity(btVector3(0, 0, 0));
+  body.clearForces();
+  parts_->vehicle->resetSuspension();
+  // Contacts made at the old place are meaningless at the new one.
+  btDiscreteDynamicsWorld& w = physics_->world();
+  w.getBroadphase()->getOverlappingPairCache()->cleanProxyFromPairs(body.getBroadphaseHandle(),
+                                                                    w.getDispatcher());
+  w.updateSingleAabb(&body);
+  measure_contacts();
+}
+
+bool Vehicle::place_on_surface(double x, double z, double heading_rad) {
+  const ridgeline::Terrain& terrain = physics_->terrain();
   const auto hn = terrain.height_normal(x, z);
   if (!hn) return false;
   // The mean face normal under the wheels' footprint gives the tilt.
@@ -75,189 +328,65 @@ bool Vehicle::place_on_surface(const ridgeline::Terrain& terrain, double x, doub
   }
   if (glm::length(n) < 1e-6) n = glm::dvec3(hn->face_normal);
   n = glm::normalize(n);
-  place({x, hn->height + params_.com_in_model.y, z}, heading_rad);
-  // Tilt: the rotation taking +y to n, applied after the heading.
+  glm::dquat q = yaw;
   const glm::dvec3 axis = glm::cross(glm::dvec3(0, 1, 0), n);
   const double s = glm::length(axis);
-  if (s > 1e-9) q_ = glm::angleAxis(std::asin(std::min(1.0, s)), axis / s) * q_;
-  pos_.y -= 5;  // start low, then lift until every wheel clears the surface
-  resolve_penetration(terrain);
-  pos_ += up() * (params_.rest_length * 0.6);
-  measure_contacts(terrain);
+  if (s > 1e-9) q = glm::angleAxis(std::asin(std::min(1.0, s)), axis / s) * yaw;
+  // Lowest height at which every wheel at full compression clears the ground by its radius and
+  // no corner of the chassis' bottom is under it; then the suspension a little extended.
+  glm::dvec3 pos(x, hn->height, z);
+  double lift = -1e300;
+  for (const glm::dvec3& at : params_.attach) {
+    const glm::dvec3 a = pos + q * at;
+    if (auto h = terrain.height_normal(a.x, a.z))
+      lift = std::max(
+          lift, h->height + params_.wheel_radius / std::max(0.2, double(h->face_normal.y)) - a.y);
+  }
+  const glm::dvec3 lo = params_.chassis_min, hi = params_.chassis_max;
+  for (int i = 0; i < 4; ++i) {
+    const glm::dvec3 c = pos + q * glm::dvec3(i & 1 ? hi.x : lo.x, lo.y, i & 2 ? hi.z : lo.z);
+    if (auto h = terrain.height(c.x, c.z)) lift = std::max(lift, *h - c.y);
+  }
+  if (lift > -1e300) pos.y += lift;
+  pos += q * glm::dvec3(0, params_.rest_length * 0.6, 0);
+  place(pos, heading_rad);
+  // place() took the heading alone: set the tilt too.
+  btRigidBody& body = *parts_->body;
+  btTransform t = body.getCenterOfMassTransform();
+  t.setRotation(btQuaternion(btScalar(q.x), btScalar(q.y), btScalar(q.z), btScalar(q.w)));
+  body.setCenterOfMassTransform(t);
+  physics_->world().updateSingleAabb(&body);
+  measure_contacts();
   return true;
 }
 
-double Vehicle::heading() const noexcept {
-  const glm::dvec3 f = forward();
-  return std::atan2(f.x, f.z);
-}
-
-double Vehicle::speed() const noexcept {
-  return glm::dot(v_, forward());
-}
-
-std::array<glm::dvec3, 4> Vehicle::chassis_corners() const {
-  const glm::dvec3 a = chassis_min, b = chassis_max;
-  return {pos_ + q_ * glm::dvec3(a.x, a.y, a.z), pos_ + q_ * glm::dvec3(b.x, a.y, a.z),
-          pos_ + q_ * glm::dvec3(a.x, a.y, b.z), pos_ + q_ * glm::dvec3(b.x, a.y, b.z)};
-}
-
-void Vehicle::step(const ridgeline::Terrain& terrain, double dt) {
-  if (!(dt > 0)) return;
-  for (int s = 0; s < kSubsteps; ++s) substep(terrain, dt / kSubsteps);
-  resolve_penetration(terrain);
-}
-
-void Vehicle::substep(const ridgeline::Terrain& terrain, double dt) {
-  const glm::dmat3 R = glm::mat3_cast(q_);
-  const glm::dvec3 up = R[1], fwd = R[2];
-  const double m = params_.mass;
-  glm::dvec3 force(0, -kGravity * m, 0), torque(0);
-  const double reach = params_.rest_length + params_.wheel_radius;
-  const double throttle = std::clamp(controls.throttle, -1.0, 1.0);
-  const double brake = std::clamp(controls.brake, 0.0, 1.0);
-  const double steer = std::clamp(controls.steer, -1.0, 1.0) * params_.max_steer;
-  const double fwd_speed = glm::dot(v_, fwd);
-  for (int i = 0; i < 4; ++i) {
-    WheelState& w = wheels_[i];
-    const glm::dvec3 r_attach = R * params_.attach[i];
-    const glm::dvec3 a = pos_ + r_attach;
-    w.steer = i < 2 ? steer : 0.0;
-    const auto hit = terrain.raycast(a, -up, reach);
-    if (!hit) {
-      w.contact = false;
-      w.load_n = 0;
-      w.suspension_length = params_.rest_length;
-      w.centre = a - up * w.suspension_length;
-      continue;
-    }
-    const double dist = hit->started_below ? 0.0 : hit->distance;
-    const double compression = reach - dist;  // 0 .. reach
-    const glm::dvec3 va = v_ + glm::cross(w_, r_attach);
-    const double rate = -glm::dot(va, up);  // compression speed
-    const double fn = std::max(0.0, params_.spring_k * compression + params_.damper_c * rate);
-    w.contact = true;
-    w.contact_point = hit->point;
-    const glm::dvec3 n(hit->normal);
-    w.contact_normal = n;
-    w.load_n = fn;
-    w.suspension_length = std::clamp(dist - params_.wheel_radius, 0.0, params_.rest_length);
-    w.centre = a - up * w.suspension_length;
-    glm::dvec3 f = up * fn;
-    // Tyre: directions in the contact plane.
-    const glm::dvec3 wheel_fwd = glm::angleAxis(w.steer, up) * fwd;
-    glm::dvec3 tf = wheel_fwd - n * glm::dot(n, wheel_fwd);
-    const double tl = glm::length(tf);
-    if (tl > 1e-6) {
-      tf /= tl;
-      const glm::dvec3 ts = glm::cross(n, tf);
-      const glm::dvec3 r_contact = hit->point - pos_;
-      const glm::dvec3 vp = v_ + glm::cross(w_, r_contact);
-      const double vf = glm::dot(vp, tf), vs = glm::dot(vp, ts);
-      const double quarter = m / 4;
-      // Lateral: cancel (most of) the side slip this substep.
-      double fs = -vs * quarter / dt * 0.5;
-      // Longitudinal: engine (none above max speed), brakes, rolling resistance.
-      double ff = 0;
-      if (!(throttle > 0 && fwd_speed > params_.max_speed) &&
-          !(throttle < 0 && fwd_speed < -params_.max_speed / 3))
-        ff += throttle * params_.engine_force / 4;
-      const double stop = std::abs(vf) * quarter / dt * 0.5;
-      ff -= (vf > 0 ? 1 : -1) * std::min(brake * params_.brake_force / 4, stop);
-      ff -= vf * 0.02 * quarter;  // rolling resistance
-      // Friction circle, scaled by the ground's material (sand, mud and snow slip earlier).
-      const double limit = params_.friction * material(hit->material).friction * fn;
-      const double mag = std::hypot(ff, fs);
-      if (mag > limit && mag > 0) {
-        ff *= limit / mag;
-        fs *= limit / mag;
-      }
-      const glm::dvec3 ft = tf * ff + ts * fs;
-      f += ft;
-      torque += glm::cross(r_contact, ft);
-      w.spin += vf * dt / params_.wheel_radius;
-    }
-    force += up * 0.0;
-    torque += glm::cross(r_attach, up * fn);
-    force += f;
-  }
-  // Chassis corners below the surface push back like stiff bump stops (with friction), so a
-  // body that lands on its frame slides off instead of hanging.
-  for (const glm::dvec3& c : chassis_corners()) {
-    const auto hn = terrain.height_normal(c.x, c.z);
-    if (!hn || c.y >= hn->height) continue;
-    const glm::dvec3 n(hn->face_normal);
-    const double depth = (hn->height - c.y) * n.y;
-    const glm::dvec3 r = c - pos_;
-    const glm::dvec3 vc = v_ + glm::cross(w_, r);
-    const double vn = glm::dot(vc, n);
-    const double fn = std::max(0.0, 4 * params_.spring_k * depth - 2 * params_.damper_c * vn);
-    glm::dvec3 vt = vc - n * vn;
-    glm::dvec3 f = n * fn;
-    const double vtl = glm::length(vt);
-    if (vtl > 1e-6) f -= vt / vtl * std::min(0.6 * fn, vtl * m / 4 / dt * 0.5);
-    force += f;
-    torque += glm::cross(r, f);
-  }
-  // Light air drag and angular damping keep the integration calm.
-  force -= v_ * (0.05 * m) * glm::length(v_) * 0.01;
-  // Integrate (semi-implicit Euler).
-  v_ += force / m * dt;
-  const glm::dvec3 tb = glm::transpose(R) * torque;  // body frame
-  glm::dvec3 wb = glm::transpose(R) * w_;
-  wb += tb / inertia_ * dt;
-  wb *= std::max(0.0, 1.0 - 1.5 * dt);
-  w_ = R * wb;
-  pos_ += v_ * dt;
-  const glm::dquat spin(0, w_.x, w_.y, w_.z);
-  q_ = glm::normalize(q_ + 0.5 * dt * (spin * q_));
-}
-
-double Vehicle::resolve_penetration(const ridgeline::Terrain& terrain) {
-  const glm::dmat3 R = glm::mat3_cast(q_);
-  const glm::dvec3 up = R[1];
-  double lift = 0;
-  // A wheel at full compression (its centre at the attach point) must clear the surface by its
-  // radius; a chassis corner must not be below the surface.
-  for (int i = 0; i < 4; ++i) {
-    const glm::dvec3 a = pos_ + R * params_.attach[i];
-    if (auto hn = terrain.height_normal(a.x, a.z)) {
-      const double need =
-          hn->height + params_.wheel_radius / std::max(0.2, double(hn->face_normal.y));
-      lift = std::max(lift, need - a.y);
-    }
-  }
-  // Corners are held by contact forces in substep(); only a deep one (an edit opened the ground,
-  // a teleport) is lifted out at once.
-  for (const glm::dvec3& c : chassis_corners())
-    if (auto h = terrain.height(c.x, c.z)) lift = std::max(lift, *h - c.y - 0.25);
-  if (lift > 0) {
-    pos_.y += lift;
-    if (v_.y < 0) v_.y = 0;
-    for (WheelState& w : wheels_) w.centre.y += lift;
-  }
-  (void)up;
-  return std::max(lift, 0.0);
-}
-
-void Vehicle::measure_contacts(const ridgeline::Terrain& terrain) {
-  // The wheel state for the final pose of the step (what is drawn and what the tests check).
-  const glm::dmat3 R = glm::mat3_cast(q_);
-  const glm::dvec3 up = R[1];
+void Vehicle::measure_contacts() {
+  // The wheel state for the final pose of the step (what is drawn and what the tests check),
+  // from the terrain's own queries: each wheel's suspension ray again, the gap under its lowest
+  // point, the material under it. Bullet's wheel info gives the load, the steering and the spin.
+  const ridgeline::Terrain& terrain = physics_->terrain();
+  const glm::dquat q = orientation();
+  const glm::dvec3 up = q * glm::dvec3(0, 1, 0), pos = position();
   const double reach = params_.rest_length + params_.wheel_radius;
   for (int i = 0; i < 4; ++i) {
-    WheelState& w = wheels_[i];
-    const glm::dvec3 a = pos_ + R * params_.attach[i];
+    WheelState& w = wheels_[std::size_t(i)];
+    const btWheelInfo& wi = parts_->vehicle->getWheelInfo(i);
+    const glm::dvec3 a = pos + q * params_.attach[std::size_t(i)];
     const auto hit = terrain.raycast(a, -up, reach);
     const double dist = hit ? (hit->started_below ? 0.0 : hit->distance) : reach;
     w.contact = hit.has_value();
     w.suspension_length = std::clamp(dist - params_.wheel_radius, 0.0, params_.rest_length);
     w.centre = a - up * w.suspension_length;
+    w.contact_point = hit ? hit->point : w.centre - up * params_.wheel_radius;
+    w.contact_normal = hit ? glm::dvec3(hit->normal) : glm::dvec3(0, 1, 0);
     const glm::dvec3 bottom = w.centre - up * params_.wheel_radius;
     const auto h = terrain.height(bottom.x, bottom.z);
     w.surface_gap = h ? bottom.y - *h : 0.0;
     w.material = hit ? hit->material : 0;
-    ground_[i] = {a.x, a.z, terrain.height(a.x, a.z).value_or(std::nan(""))};
+    w.load_n = wi.m_raycastInfo.m_isInContact ? double(wi.m_wheelsSuspensionForce) : 0.0;
+    w.steer = wi.m_steering;
+    w.spin = wi.m_rotation;
+    ground_[std::size_t(i)] = {a.x, a.z, terrain.height(a.x, a.z).value_or(std::nan(""))};
   }
   // The ground's material: the one under most wheels in contact (ties: the lowest id).
   int votes[256] = {};
@@ -269,42 +398,23 @@ void Vehicle::measure_contacts(const ridgeline::Terrain& terrain) {
   ground_material_ = static_cast<std::uint8_t>(best);
 }
 
-glm::dmat3 Vehicle::inverse_inertia_world() const noexcept {
-  const glm::dmat3 R = glm::mat3_cast(q_);
-  const glm::dmat3 inv_body(glm::dvec3(1.0 / inertia_.x, 0, 0), glm::dvec3(0, 1.0 / inertia_.y, 0),
-                            glm::dvec3(0, 0, 1.0 / inertia_.z));
-  return R * inv_body * glm::transpose(R);
-}
-
-glm::dvec3 Vehicle::velocity_at(const glm::dvec3& p) const noexcept {
-  return v_ + glm::cross(w_, p - pos_);
-}
-
-void Vehicle::apply_impulse(const glm::dvec3& p, const glm::dvec3& impulse) noexcept {
-  v_ += impulse / params_.mass;
-  w_ += inverse_inertia_world() * glm::cross(p - pos_, impulse);
-}
-
-void Vehicle::nudge(const glm::dvec3& d) noexcept {
-  pos_ += d;
-  for (WheelState& w : wheels_) w.centre += d;
-}
-
-double Vehicle::follow_ground(const ridgeline::Terrain& terrain) {
-  // The wheels carry the body: it rises with the ground under them (the chassis is kept out of
-  // the ground by resolve_penetration below).
+double Vehicle::follow_ground() {
+  // The wheels carry the body: it rises with the ground under them.
+  const ridgeline::Terrain& terrain = physics_->terrain();
   double rise = 0;
   for (const GroundPoint& g : ground_) {
     const auto h = terrain.height(g.x, g.z);
     if (h && std::isfinite(g.height)) rise = std::max(rise, *h - g.height);
   }
   if (rise > 0) {
-    pos_.y += rise;
-    for (WheelState& w : wheels_) w.centre.y += rise;
+    btRigidBody& body = *parts_->body;
+    btTransform t = body.getCenterOfMassTransform();
+    t.setOrigin(t.getOrigin() + btVector3(0, btScalar(rise), 0));
+    body.setCenterOfMassTransform(t);
+    physics_->world().updateSingleAabb(&body);
   }
-  const double lift = rise + resolve_penetration(terrain);
-  measure_contacts(terrain);
-  return lift;
+  measure_contacts();
+  return rise;
 }
 
 bool Autopilot::drive(Vehicle& v) {

@@ -1,25 +1,30 @@
-// Vehicle: a rigid body on four raycast-suspension wheels driven over Ridgeline terrain queries.
+// Vehicle: a Bullet rigid body (the chassis box) on four raycast-suspension wheels
+// (btRaycastVehicle), in the game's Physics world on the Ridgeline shape: the wheels' rays are
+// Ridgeline's raycast, the chassis collides with the terrain's finest triangles, with the other
+// vehicles and with the loose bodies.
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <glm/gtc/quaternion.hpp>
-#include <glm/mat3x3.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
+#include <memory>
 #include <vector>
 
+#include "physics.h"
 #include "ridgeline/terrain.h"
 #include "vehicle_model.h"
+
+class btRigidBody;
 
 namespace game {
 
 /// Physical constants of a vehicle kind. Units: kg, metres, newtons, seconds, radians.
 struct VehicleParams {
   double mass = 1500;
-  glm::dvec3 inertia_extent{2, 1.5,
-                            4};        ///< box whose inertia the body takes (width, height, length)
-  std::array<glm::dvec3, 4> attach{};  ///< suspension tops in the body frame (from the COM)
+  glm::dvec3 inertia_extent{2, 1.5, 4};  ///< box whose inertia the body takes (w, h, length)
+  std::array<glm::dvec3, 4> attach{};    ///< suspension tops in the body frame (from the COM)
   double wheel_radius = 0.5;
   double rest_length = 0.35;         ///< suspension length (attach -> wheel centre) with no load
   double spring_k = 40000;           ///< N/m per wheel
@@ -30,10 +35,14 @@ struct VehicleParams {
   double max_steer = 0.55;           ///< radians at steer = +-1
   double max_speed = 25;             ///< m/s; the engine gives no force above it
   glm::dvec3 com_in_model{0, 1, 0};  ///< centre of mass in the model frame (the body origin)
+  /// The chassis' collision box in the body frame (from the COM): the frame down to the wheel
+  /// centres (the wheels below it are rays).
+  glm::dvec3 chassis_min{-1, -0.5, -2}, chassis_max{1, 0.5, 2};
 };
 
-/// Derives parameters from a model: wheels from its wheel nodes, inertia from its body box,
-/// mass from `mass_kg`; suspension sized so the static sag is about a third of the travel.
+/// Derives parameters from a model: wheels from its wheel nodes, inertia and chassis box from its
+/// body box, mass from `mass_kg`; suspension sized so the static sag is about a third of the
+/// travel.
 VehicleParams params_from_model(const VehicleModel& model, double mass_kg);
 
 /// Driver input. throttle -1..1 (negative: reverse), steer -1..1 (positive: left), brake 0..1.
@@ -44,84 +53,73 @@ struct Controls {
 /// State of one wheel after a step.
 struct WheelState {
   glm::dvec3 centre{0};         ///< world position of the wheel centre
-  glm::dvec3 contact_point{0};  ///< where the suspension ray met the surface (valid with contact)
+  glm::dvec3 contact_point{0};  ///< where the suspension ray met the ground (valid with contact)
   glm::dvec3 contact_normal{0, 1, 0};
   bool contact = false;
   double suspension_length = 0;  ///< metres, 0 .. rest_length
   double load_n = 0;             ///< suspension force, newtons
   double steer = 0;              ///< radians
   double spin = 0;               ///< accumulated rotation, radians (for drawing)
-  /// Height of the wheel's lowest point (centre - up * radius, where the suspension ray meets
-  /// the ground when in contact) above the surface at that point's xz, measured with
-  /// Terrain::height after the step: about 0 in contact, positive in the air, negative when the
-  /// wheel sinks in. Set by Vehicle::measure_contacts().
+  /// Height of the wheel's lowest point (centre - up * radius) above the surface at that point's
+  /// xz, measured with Terrain::height after the step: about 0 in contact, positive in the air,
+  /// negative when the wheel sinks in. Set by Vehicle::measure_contacts().
   double surface_gap = 0;
   std::uint8_t material = 0;  ///< material id under the wheel (valid with contact)
 };
 
-/// A vehicle body. Positions in world metres (double precision); the body frame is +y up,
-/// +z forward, +x to the left. Not thread-safe; the Terrain it reads is.
+/// A vehicle in a Physics world. Positions in world metres (double precision); the body frame is
+/// +y up, +z forward, +x to the left. Removed from the world when destroyed; move-only. Not
+/// thread-safe (the game's thread).
 class Vehicle {
  public:
-  Vehicle(const VehicleParams& params, glm::dvec3 position, double heading_rad);
+  /// Adds the chassis and its raycast vehicle to `physics` at `position` (the centre of mass),
+  /// facing `heading_rad`. `physics` must outlive the vehicle.
+  Vehicle(Physics& physics, const VehicleParams& params, glm::dvec3 position, double heading_rad);
+  ~Vehicle();
+  Vehicle(Vehicle&&) noexcept;
+  Vehicle& operator=(Vehicle&&) noexcept;
 
-  /// Advances by dt seconds (the game calls it with the fixed step, split into substeps).
-  void step(const ridgeline::Terrain& terrain, double dt);
-  /// Pushes the body up until no wheel and no chassis corner is below the surface, and removes
-  /// velocity into the surface: what keeps a body out of the ground, also when an edit removes
-  /// the ground under it. Returns the lift applied, metres.
-  double resolve_penetration(const ridgeline::Terrain& terrain);
-  /// Updates every wheel's surface_gap (see WheelState) and records the ground height under the
-  /// suspension tops, for follow_ground().
-  void measure_contacts(const ridgeline::Terrain& terrain);
-  /// The terrain was edited under the body since the last measure_contacts(): where the ground
-  /// under its wheels rose, the body rises by the largest rise (suspension, velocity and tilt
-  /// kept, so it keeps resting instead of being launched by fully compressed springs); where it
-  /// fell, the body is left to fall. Then resolves any remaining penetration and measures again.
-  /// Returns the lift applied, metres.
-  double follow_ground(const ridgeline::Terrain& terrain);
-
+  /// Read by the vehicle at each Bullet step (engine, brakes, steering).
   Controls controls;
   const VehicleParams& params() const noexcept { return params_; }
-  glm::dvec3 position() const noexcept { return pos_; }  ///< centre of mass
-  glm::dquat orientation() const noexcept { return q_; }
-  glm::dvec3 velocity() const noexcept { return v_; }
-  glm::dvec3 forward() const noexcept { return q_ * glm::dvec3(0, 0, 1); }
-  glm::dvec3 up() const noexcept { return q_ * glm::dvec3(0, 1, 0); }
+  glm::dvec3 position() const noexcept;  ///< centre of mass
+  glm::dquat orientation() const noexcept;
+  glm::dvec3 velocity() const noexcept;
+  glm::dvec3 forward() const noexcept { return orientation() * glm::dvec3(0, 0, 1); }
+  glm::dvec3 up() const noexcept { return orientation() * glm::dvec3(0, 1, 0); }
   double heading() const noexcept;  ///< radians, 0 = +z, positive towards +x
   double speed() const noexcept;    ///< signed forward speed, m/s
   const std::array<WheelState, 4>& wheels() const noexcept { return wheels_; }
-  /// Moves the body (teleport): velocities cleared.
+  /// Moves the body (teleport): velocities cleared, suspension reset, contacts dropped.
   void place(glm::dvec3 position, double heading_rad);
   /// Teleports to (x, z) with the given heading, tilted to the surface normal there and lifted
   /// so that the wheels just touch: how vehicles are spawned on slopes. False off-terrain.
-  bool place_on_surface(const ridgeline::Terrain& terrain, double x, double z, double heading_rad);
-  /// Bottom corners of the chassis box in world coordinates.
-  std::array<glm::dvec3, 4> chassis_corners() const;
-  glm::dvec3 chassis_min{-1, -0.5, -2}, chassis_max{1, 0.5, 2};  ///< body-frame box (from COM)
+  bool place_on_surface(double x, double z, double heading_rad);
+  /// Updates every wheel's state (WheelState, surface_gap and material from the terrain's
+  /// queries) and the ground under the suspension tops for follow_ground(): after each step.
+  void measure_contacts();
+  /// The terrain was edited under the body since the last measure_contacts(): where the ground
+  /// under its suspension tops rose, the chassis rises by the largest rise (velocity and tilt
+  /// kept, so it keeps resting instead of being launched by fully compressed springs); where it
+  /// fell, the body is left to fall. Returns the lift, metres.
+  double follow_ground();
 
-  // ---- contacts with other bodies (collision.cpp) ------------------------------------------
   /// Material id under most of the wheels in contact at the last measure_contacts() (0 when no
   /// wheel touches).
   std::uint8_t ground_material() const noexcept { return ground_material_; }
-  double inverse_mass() const noexcept { return 1.0 / params_.mass; }
-  /// Inverse inertia tensor in world coordinates.
-  glm::dmat3 inverse_inertia_world() const noexcept;
-  /// Velocity of the body at world point `p`, m/s.
-  glm::dvec3 velocity_at(const glm::dvec3& p) const noexcept;
-  /// Applies `impulse` (N s, world) at world point `p`: changes linear and angular velocity.
-  void apply_impulse(const glm::dvec3& p, const glm::dvec3& impulse) noexcept;
-  /// Moves the body (and its wheels) by `d` metres without touching its velocity.
-  void nudge(const glm::dvec3& d) noexcept;
-  /// Contacts with other vehicles so far (counted by collision.cpp).
+  /// The chassis rigid body (for contact queries; the game tags it with the vehicle's id).
+  const btRigidBody* chassis() const noexcept;
+  btRigidBody* chassis() noexcept;
+  /// Contacts with other vehicles so far (counted by the game at the start of each touch).
   std::uint64_t collisions = 0;
+  /// Loose bodies (boulders, debris) that hit it so far (likewise).
+  std::uint64_t body_hits = 0;
 
  private:
-  void substep(const ridgeline::Terrain& terrain, double dt);
+  struct Parts;
+  Physics* physics_ = nullptr;
   VehicleParams params_;
-  glm::dvec3 pos_{0}, v_{0}, w_{0};
-  glm::dquat q_{1, 0, 0, 0};
-  glm::dvec3 inertia_{1};  // body-frame diagonal
+  std::unique_ptr<Parts> parts_;
   std::array<WheelState, 4> wheels_{};
   std::uint8_t ground_material_ = 0;
   // Ground under the four suspension tops at the last measure_contacts() (height NaN

@@ -21,7 +21,9 @@ for i, model in ipairs(models) do
   convoy[i] = v
 end
 
-game.camera{mode = "follow", vehicle = convoy[1], distance = 26}
+-- The chase camera: behind and above the lead truck, looking at the road ahead of it, where the
+-- artillery's craters open and their boulders come down.
+game.camera{mode = "follow", vehicle = convoy[1], distance = 16, lift = 6, ahead = 18}
 game.log("convoy of " .. #convoy .. " vehicles on a " .. #waypoints .. "-point loop")
 
 -- Expose the convoy to the other scripts (artillery, budget) through a shared global.

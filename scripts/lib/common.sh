@@ -4,12 +4,13 @@
 
 RIDGELINE_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 
-# Debian packages the build, the tests and the game need (--no-install-recommends). The game:
+# Debian packages the build, the tests and the game need (--no-install-recommends). Bullet
+# Physics: Ridgeline::bullet, its tests and benchmark, and the game's bodies and vehicles. The game:
 # GLFW, Dear ImGui, EGL and Mesa's software renderer; xvfb + xauth give it a display in CI.
 RIDGELINE_PACKAGES=(
   g++ cmake ninja-build pkg-config git ca-certificates
   libglm-dev libopenimageio-dev libtinygltf-dev nlohmann-json3-dev libcli11-dev libdeflate-dev
-  libgtest-dev libbenchmark-dev liblua5.4-dev lua5.4
+  libgtest-dev libbenchmark-dev liblua5.4-dev lua5.4 libbullet-dev
   libglfw3-dev libimgui-dev libegl-dev libgl1-mesa-dri libegl-mesa0 libglx-mesa0
   xvfb xauth
 )
@@ -69,7 +70,7 @@ configure_and_build() {
 RIDGELINE_RELEASE_DIR=build/release
 RIDGELINE_RELEASE_ARGS=(-DCMAKE_BUILD_TYPE=Release -DRIDGELINE_BUILD_TESTS=ON
   -DRIDGELINE_BUILD_BENCHMARKS=ON -DRIDGELINE_BUILD_TOOLS=ON -DRIDGELINE_BUILD_LUA=ON
-  -DRIDGELINE_BUILD_GAME=ON)
+  -DRIDGELINE_BUILD_BULLET=ON -DRIDGELINE_BUILD_GAME=ON)
 
 # build_release [TARGET...]: configures build/release and builds the given targets (all when
 # none is given).

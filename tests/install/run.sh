@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs the build tree into a scratch prefix, then configures, builds and runs an outside
-# project that uses find_package(Ridgeline CONFIG REQUIRED) (all three targets) and, separately,
+# project that uses find_package(Ridgeline CONFIG REQUIRED) (all four targets) and, separately,
 # pkg-config (the core), and loads the installed ridgeline.so into the stock lua5.4.
 set -euo pipefail
 build=$1 work=$2 cxx=$3
@@ -18,6 +18,14 @@ if [ -f "$work/prefix/lib/lua/5.4/ridgeline.so" ]; then
     'local r = require "ridgeline"; local t = r.default_terrain(); assert(type(t:height(10, 10)) == "number"); print("lua5.4: require ridgeline ok")'
 else
   echo "install consumer: the package was built without Ridgeline::lua" >&2; exit 1
+fi
+# Ridgeline::bullet (optional: built when Bullet was found): a Bullet world on the installed shape.
+if grep -q '^RIDGELINE_BUILD_BULLET:BOOL=ON' "$build/CMakeCache.txt"; then
+  [ -x "$work/build/consumer_bullet" ] ||
+    { echo "install consumer: Ridgeline::bullet was built but the package lacks it" >&2; exit 1; }
+  "$work/build/consumer_bullet"
+else
+  echo "install consumer: built without Ridgeline::bullet (RIDGELINE_BUILD_BULLET=OFF): not tried"
 fi
 # pkg-config route
 PKG_CONFIG_PATH="$work/prefix/lib/pkgconfig:$work/prefix/lib/x86_64-linux-gnu/pkgconfig" \
