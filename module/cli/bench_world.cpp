@@ -80,10 +80,11 @@ struct Options {
   double clearance = 120;
 };
 
-// Bakes the generated world of `n` samples a side into `path` unless it is there.
+// Bakes the generated world of `n` samples a side into `path` unless a world this build reads is
+// there (one of an older format version is baked again).
 nlohmann::json bake_if_missing(const Options& o, std::uint32_t n, const std::string& path) {
   nlohmann::json j;
-  if (std::filesystem::exists(path)) {
+  if (std::filesystem::exists(path) && io::open_world(path)) {
     j["cached"] = true;
     j["bytes"] = std::filesystem::file_size(path);
     j["bytes_per_sample"] = double(std::filesystem::file_size(path)) / (double(n) * n);

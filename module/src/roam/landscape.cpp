@@ -61,7 +61,7 @@ class Maker final : public world::RecordMaker {
   std::shared_ptr<const RecordBlock> make(const world::Page& page) const override {
     if (page.key.level > 0) {
       if (!page.baked) return nullptr;
-      auto b = RecordBlock::decode(page.key.level, *page.baked);
+      auto b = RecordBlock::decode(page.key.level, page.baked);
       if (!b)
         log_message(LogLevel::kError,
             fmt("%s: page (%u, %d, %d): its tessellator bounds are damaged",
