@@ -12,6 +12,8 @@
 #include <sstream>
 
 #include "ridgeline/edit.h"
+#include "ridgeline/io.h"
+#include "ridgeline/world_file.h"
 
 namespace game {
 
@@ -54,8 +56,29 @@ Result<std::unique_ptr<Game>> Game::create(const GameOptions& options) {
   g->options_ = options;
   if (!(options.dt > 0 && options.dt <= 0.1))
     return Error{"game: time step " + std::to_string(options.dt) + " s; need 0 < dt <= 0.1"};
-  auto hf = ridgeline::make_default_heightfield();
-  if (!hf) return Error{hf.error().message};
+  if (!options.world_path.empty()) {
+    // A baked world: paged in on two workers; its own placement and heights, no detail.
+    if (options.detail.levels > 0)
+      return Error{"game: procedural detail over a baked world is not supported (--detail-levels 0)"};
+    auto source = ridgeline::io::open_world(options.world_path);
+    if (!source) return Error{"game: " + source.error().message};
+    ridgeline::WorldCacheDesc wc;
+    wc.budget_bytes = options.world_cache_bytes;
+    auto t = ridgeline::Terrain::open(std::move(*source), wc);
+    if (!t) return Error{"game: " + t.error().message};
+    g->terrain_ = std::move(*t);
+    return finish_create(std::move(g), options);
+  }
+  Result<ridgeline::Heightfield> hf = Error{""};
+  if (!options.heightmap_path.empty()) {
+    ridgeline::io::LoadOptions lo;
+    lo.placement = options.heightmap_placement;
+    hf = ridgeline::io::load_heightmap(options.heightmap_path, lo);
+    if (!hf) return Error{"game: " + hf.error().message};
+  } else {
+    hf = ridgeline::make_default_heightfield();
+    if (!hf) return Error{hf.error().message};
+  }
   if (options.detail.levels > 0) {
     ridgeline::DetailCacheDesc cd;
     cd.worker_threads = options.detail_workers;
@@ -69,12 +92,24 @@ Result<std::unique_ptr<Game>> Game::create(const GameOptions& options) {
     if (!stream) return Error{"game: " + stream.error().message};
     g->stream_.emplace(std::move(*stream));
   } else {
-    g->terrain_ = ridgeline::Terrain::create(std::move(*hf)).value();
+    auto t = ridgeline::Terrain::create(std::move(*hf), ridgeline::DetailParams{},
+                                        ridgeline::DetailCacheDesc{});
+    if (!t) return Error{"game: " + t.error().message};
+    g->terrain_ = std::move(*t);
   }
+  return finish_create(std::move(g), options);
+}
+
+// The parts after the terrain: physics, the landscape and views, the controller, the vehicle
+// models and the scripts.
+Result<std::unique_ptr<Game>> Game::finish_create(std::unique_ptr<Game> g,
+                                                  const GameOptions& options) {
   auto physics = Physics::create(g->terrain_);
   if (!physics) return Error{physics.error().message};
   g->physics_ = std::move(*physics);
-  auto land = ridgeline::Landscape::create(g->terrain_, {.patch_exponent = options.patch_exponent});
+  // A baked world's coarse bounds were made for one patch exponent: its own (0) is used.
+  auto land = ridgeline::Landscape::create(
+      g->terrain_, {.patch_exponent = g->terrain_->paged() ? 0u : options.patch_exponent});
   if (!land) return Error{land.error().message};
   g->landscape_ = *land;
   g->max_triangles_ = options.max_triangles;

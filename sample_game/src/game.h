@@ -65,6 +65,13 @@ struct GameOptions {
   /// Each view update waits until every tile its splits asked for has arrived (and updates
   /// again): the mesh does not depend on when tiles arrive (render tests, reference pictures).
   bool prefill_detail = false;
+  /// The world: empty for the built-in terrain; `world_path`, a baked world (ridge bake) paged in
+  /// under `world_cache_bytes`; or `heightmap_path`, a heightmap file (any io::load_heightmap
+  /// format) at `heightmap_placement` (spacing, height scale and offset, origin).
+  std::string world_path;
+  std::size_t world_cache_bytes = std::size_t{192} << 20;
+  std::string heightmap_path;
+  ridgeline::HeightfieldDesc heightmap_placement;
   /// Where script lines and errors go in every mode (null: stderr).
   std::function<void(const std::string&)> console;
 };
@@ -181,6 +188,8 @@ class Game final : public GameApi {
   std::uint32_t root_triangles() const noexcept override { return 2 * landscape_->patch_count(); }
 
  private:
+  static ridgeline::Result<std::unique_ptr<Game>> finish_create(std::unique_ptr<Game> g,
+                                                                const GameOptions& options);
   Game() = default;
   void clamp_to_terrain(VehicleEntry& e);
   void emit(const char* event, int (*push)(lua_State*, void*), void* user) {

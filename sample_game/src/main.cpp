@@ -58,6 +58,9 @@ struct Args {
   bool prefill_detail = false;
   bool full_fragments = false, unsorted = false;
   std::uint32_t patch_exponent = game::GameOptions{}.patch_exponent;
+  std::string world, heightmap;
+  double spacing = 1, height_scale = 1, height_offset = 0;
+  std::size_t cache_mb = 192;
 };
 
 // Writes the frames as a PATH.json camera path (docs/cli.md, "Camera paths").
@@ -123,6 +126,14 @@ int run(const Args& a) {
   o.max_triangles = a.triangles;
   o.tessellation_budget_ms = a.tess_ms;
   o.fixed_render_scale = a.render_scale;
+  o.world_path = a.world;
+  o.world_cache_bytes = a.cache_mb << 20;
+  o.heightmap_path = a.heightmap;
+  o.heightmap_placement.spacing_x = o.heightmap_placement.spacing_z = a.spacing;
+  o.heightmap_placement.height_scale = a.height_scale;
+  o.heightmap_placement.height_offset = a.height_offset;
+  // The built-in terrain's detail is tuned for it: a user's world has none unless asked for.
+  if (!a.world.empty() || !a.heightmap.empty()) o.detail.levels = 0;
   if (a.detail_levels >= 0) o.detail.levels = std::uint32_t(a.detail_levels);
   if (a.detail_amplitude >= 0) o.detail.amplitude = a.detail_amplitude;
   o.prefill_detail = a.prefill_detail;
@@ -447,6 +458,27 @@ int main(int argc, char** argv) {
   app.add_option("--patch-exponent", a.patch_exponent, "ROAM patches of 2^k stored cells per side")
       ->check(CLI::Range(3, 8))
       ->capture_default_str();
+  auto* world = app.add_option("--world", a.world,
+                                "play on a baked world (ridge bake --out WORLD), paged in under "
+                                "--cache-mb; the scripts lay their course around its centre")
+                    ->check(CLI::ExistingFile);
+  auto* heightmap = app.add_option("--heightmap", a.heightmap,
+                                   "play on a heightmap file (PNG, TIFF, EXR; --spacing, "
+                                   "--height-scale, --height-offset place it)")
+                        ->check(CLI::ExistingFile)
+                        ->excludes(world);
+  app.add_option("--spacing", a.spacing, "metres between --heightmap samples")
+                      ->check(CLI::Range(1e-3, 1e4))
+                      ->needs(heightmap);
+  app.add_option("--height-scale", a.height_scale, "metres per --heightmap unit")
+      ->check(CLI::Range(1e-9, 1e6))
+      ->needs(heightmap);
+  app.add_option("--height-offset", a.height_offset, "metres added to --heightmap heights")
+      ->check(CLI::Range(-1e7, 1e7))
+      ->needs(heightmap);
+  app.add_option("--cache-mb", a.cache_mb, "page cache of a --world, MiB (default 192)")
+      ->check(CLI::Range(4, 1 << 20))
+      ->needs(world);
   app.add_flag("--prefill-detail", a.prefill_detail,
                "each view update waits for the detail tiles it asked for (pictures that do not "
                "depend on tile arrival)");

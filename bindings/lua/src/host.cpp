@@ -244,6 +244,7 @@ int setup_state(lua_State* L) {
     luaL_openlibs(L);
     ModuleConfig config;
     config.max_samples = o.max_samples;
+    config.max_samples_limit = o.max_samples_limit;
     config.object_memory_limit = o.object_memory_limit;
     open_module(L, config);
     lua_setglobal(L, "ridgeline");
@@ -314,6 +315,7 @@ int setup_state(lua_State* L) {
   config.confine_paths = true;
   config.root = o.data_root.c_str();
   config.max_samples = o.max_samples;
+  config.max_samples_limit = o.max_samples_limit;
   config.object_memory_limit = o.object_memory_limit;
   open_module(L, config);
   lua_setfield(L, env, "ridgeline");

@@ -314,4 +314,9 @@ std::size_t terrain_charge_bytes(const Terrain& terrain, std::size_t cache_bytes
   return (shared ? 0 : terrain.memory_bytes()) + edit_layer + change_log + cache_bytes;
 }
 
+std::size_t paged_terrain_charge_bytes(const Terrain& terrain, std::size_t cache_bytes) {
+  const std::size_t change_log = kChangeLogCapacity * (sizeof(TerrainChange) + 16);
+  return std::max(cache_bytes, terrain.memory_bytes()) + change_log;
+}
+
 }  // namespace ridgeline::lua::detail

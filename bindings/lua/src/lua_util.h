@@ -64,6 +64,7 @@ class Charge {
 struct ConfigBox {
   bool confine_paths = false;
   std::uint64_t max_samples = 0;
+  std::uint64_t max_samples_limit = 0;  // >= max_samples
   char root[4096] = {};
   std::shared_ptr<ObjectBudget> budget;
   // Built on the first default_terrain() call and never handed out: every call returns a clone,
@@ -71,6 +72,10 @@ struct ConfigBox {
   std::shared_ptr<const Terrain> default_terrain;
   std::shared_ptr<Charge> default_charge;
 };
+
+/// Charge of a paged terrain: its cache budget (or more when pinned, coarse and edited pages pass
+/// it) and its change log.
+std::size_t paged_terrain_charge_bytes(const Terrain& terrain, std::size_t cache_bytes);
 
 /// A terrain userdata. Released: `terrain` is empty.
 struct TerrainBox {
@@ -84,6 +89,9 @@ struct TerrainBox {
   // none) and of its landscape.
   std::shared_ptr<ObjectBudget> budget;
   std::shared_ptr<Charge> terrain_charge, landscape_charge;
+  // A paged terrain (ridgeline.open_world): its cache budget, the floor of its charge (edits
+  // raise the charge as their pages stay resident).
+  std::size_t cache_bytes = 0;
 };
 
 /// A view userdata. Released: `view` is empty.

@@ -1,5 +1,7 @@
 // Deformation from Lua: terrain:deform{...} (a terrain method) and the module functions
 // ridgeline.save_edits / ridgeline.load_edits (they need the module's path rules).
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <exception>
 
@@ -13,6 +15,17 @@ Terrain& editable_terrain(lua_State* L, int arg) {
   auto* box = static_cast<TerrainBox*>(luaL_checkudata(L, arg, kTerrainMeta));
   if (!box->terrain) luaL_error(L, "attempt to use a released ridgeline.terrain");
   return *box->terrain;
+}
+
+// Most bytes the pages under edit `e`'s reach can add once copied for it (their heights as
+// floats, ray pyramid and bounds, a third more for their coarser levels).
+std::size_t edit_page_bytes(const Terrain& t, const Edit& e) {
+  const WorldInfo& i = t.info();
+  const double reach = 1.5 * std::abs(e.radius) + 2.0 * std::max(i.spacing_x, i.spacing_z);
+  const double cells_x = std::min(2.0 * reach / i.spacing_x, double(i.width));
+  const double cells_z = std::min(2.0 * reach / i.spacing_z, double(i.height));
+  const double pages = (std::ceil(cells_x / kPageCells) + 1) * (std::ceil(cells_z / kPageCells) + 1);
+  return std::size_t(pages * double(kPageEntries) * 12.0 * 4.0 / 3.0);
 }
 
 // Reads the edit table at `arg` (docs/deformation.md's fields) into plain data; raises on a bad
@@ -166,9 +179,19 @@ int file_op(lua_State* L, FileOp op, bool method) {
 int t_deform(lua_State* L) {
   Terrain& t = editable_terrain(L, 1);
   const Edit e = check_edit(L, 2);
+  auto* box = static_cast<TerrainBox*>(lua_touserdata(L, 1));
+  // A paged terrain keeps every page an edit copies: room for the pages under the brush first,
+  // then the charge follows what the terrain holds.
+  const bool charge_pages = t.paged() && box->terrain_charge && box->budget;
+  if (charge_pages) {
+    const std::size_t own = box->terrain_charge->bytes();
+    reserve_objects(L, box->budget, own + edit_page_bytes(t, e), "deform", own);
+  }
   char err[kErrSize];
   EditResult r;
-  if (!do_edit(t, e, &r, err)) {
+  const bool ok = do_edit(t, e, &r, err);
+  if (charge_pages) box->terrain_charge->set(paged_terrain_charge_bytes(t, box->cache_bytes));
+  if (!ok) {
     lua_pushnil(L);
     lua_pushstring(L, err);
     return 2;

@@ -9,6 +9,7 @@
 #include "lua_util.h"
 #include "ridgeline/detail.h"
 #include "ridgeline/io.h"
+#include "ridgeline/world_file.h"
 
 namespace ridgeline::lua::detail {
 namespace {
@@ -43,6 +44,8 @@ struct LoadArgs {
   bool fill_nearest = false;
   double detail_levels = 0, detail_seed = 1, detail_amplitude = 0, detail_gain = 0;
   bool has_amplitude = false, has_gain = false;
+  io::RawFormat raw;  // width 0: not a raw file
+  std::uint64_t max_samples = 0;  // 0: the module's cap
 };
 
 std::string fmt_spacing(double v) {
@@ -75,11 +78,27 @@ bool do_load(const ConfigBox& config, const LoadArgs& a, TerrainBox* box, std::s
     p.height_offset = a.height_offset;
     if (a.has_nodata) p.nodata = a.nodata;
     if (a.fill_nearest) p.fill = FillPolicy::kNearest;
-    p.max_samples = config.max_samples;
-    auto hf = io::load_heightmap(path, options);
+    p.max_samples = a.max_samples != 0 ? a.max_samples : config.max_samples;
+    auto hf = io::load_heightmap(path, options, a.raw.width != 0 ? &a.raw : nullptr);
     if (!hf) {
       // Under confinement, name the file as the script gave it, not the host's full path.
-      const std::string& m = hf.error().message;
+      std::string m = hf.error().message;
+      if (m.find("HeightfieldDesc::max_samples") != std::string::npos) {
+        const std::uint64_t limit = std::max(config.max_samples_limit, config.max_samples);
+        char more[320];
+        if (p.max_samples < limit)
+          std::snprintf(more, sizeof more,
+                        "; raise it with ridgeline.load{max_samples = N} (up to %llu here, "
+                        "HostOptions::max_samples_limit), or bake the map (ridge bake) and open it "
+                        "paged with ridgeline.open_world",
+                        static_cast<unsigned long long>(limit));
+        else
+          std::snprintf(more, sizeof more,
+                        "; this host allows at most %llu (HostOptions::max_samples_limit): bake "
+                        "the map (ridge bake) and open it paged with ridgeline.open_world",
+                        static_cast<unsigned long long>(limit));
+        m += more;
+      }
       if (config.confine_paths && std::strstr(m.c_str(), path) != nullptr) {
         std::string msg = m;
         const auto at = msg.find(path);
@@ -117,14 +136,130 @@ bool do_load(const ConfigBox& config, const LoadArgs& a, TerrainBox* box, std::s
   }
 }
 
+// The `raw = {width=, height=, type=}` field of ridgeline.load (a headerless little-endian file).
+void read_raw_format(lua_State* L, int t, io::RawFormat& raw) {
+  const int type = lua_getfield(L, t, "raw");
+  if (type == LUA_TNIL) {
+    lua_pop(L, 1);
+    return;
+  }
+  if (type != LUA_TTABLE)
+    luaL_argerror(L, t, lua_pushfstring(L, "field 'raw': table {width=, height=, type=} expected, "
+                                           "got %s", luaL_typename(L, -1)));
+  const int r = lua_gettop(L);
+  static const char* const kRawFields[] = {"width", "height", "type", nullptr};
+  check_fields(L, r, kRawFields);
+  double size[2] = {0, 0};
+  const char* names[2] = {"width", "height"};
+  for (int k = 0; k < 2; ++k)
+    if (!get_number_field(L, r, names[k], &size[k]) || size[k] != std::floor(size[k]) ||
+        size[k] < 2 || size[k] > 4294967295.0)
+      luaL_argerror(L, t, lua_pushfstring(L, "field 'raw.%s': whole number >= 2 expected",
+                                          names[k]));
+  raw.width = std::uint32_t(size[0]);
+  raw.height = std::uint32_t(size[1]);
+  if (lua_getfield(L, r, "type") != LUA_TNIL) {
+    const char* text = lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : "";
+    if (std::strcmp(text, "u16") == 0)
+      raw.type = io::RawType::kU16;
+    else if (std::strcmp(text, "f32") == 0)
+      raw.type = io::RawType::kF32;
+    else
+      luaL_argerror(L, t, "field 'raw.type': 'u16' or 'f32' expected");
+  }
+  lua_pop(L, 2);
+}
+
+// Opens a baked world for a script: plain data in, the terrain or a message out (no Lua calls).
+bool do_open_world(const ConfigBox& config, const char* name, const WorldCacheDesc& desc,
+                   TerrainBox* box, char* err) noexcept {
+  try {
+    char path[4096];
+    if (!resolve_path(config, name, path, sizeof path, err)) return false;
+    auto source = io::open_world(path);
+    if (!source) {
+      std::string m = source.error().message;
+      if (config.confine_paths)
+        for (auto at = m.find(path); at != std::string::npos; at = m.find(path))
+          m.replace(at, std::strlen(path), name);
+      copy_error(err, m.c_str());
+      return false;
+    }
+    auto t = Terrain::open(std::move(*source), desc);
+    if (!t) {
+      copy_error(err, t.error().message.c_str());
+      return false;
+    }
+    box->terrain = std::move(*t);
+    set_path_rules(box, config);
+    return true;
+  } catch (const std::exception& e) {
+    copy_error(err, e.what());
+    return false;
+  }
+}
+
+// ridgeline.open_world{world=, cache_mb=, workers=} -> terrain or nil, message: a baked world
+// (ridge bake) paged in under a cache budget.
+int r_open_world(lua_State* L) {
+  const ConfigBox* config = config_of(L);
+  luaL_checktype(L, 1, LUA_TTABLE);
+  static const char* const kFields[] = {"world", "cache_mb", "workers", nullptr};
+  check_fields(L, 1, kFields);
+  lua_settop(L, 1);
+  if (lua_getfield(L, 1, "world") != LUA_TSTRING)
+    luaL_argerror(L, 1, lua_pushfstring(L, "field 'world': string expected, got %s",
+                                        luaL_typename(L, -1)));
+  const char* name = lua_tostring(L, -1);  // stays at index 2
+  if (std::strlen(name) != lua_rawlen(L, -1))
+    luaL_argerror(L, 1, "field 'world': embedded zero in file name");
+  WorldCacheDesc desc;
+  // Under an object budget the pages get a quarter of it unless the script asks.
+  if (config->budget && config->budget->limit != 0)
+    desc.budget_bytes =
+        std::min(desc.budget_bytes, std::max(config->budget->limit / 4, std::size_t{4} << 20));
+  double v = 0;
+  if (get_number_field(L, 1, "cache_mb", &v)) {
+    if (!(v >= 4 && v <= 1048576) || v != std::floor(v))
+      luaL_argerror(L, 1, "field 'cache_mb': whole number in 4..1048576 expected");
+    desc.budget_bytes = std::size_t(v) << 20;
+  }
+  if (get_number_field(L, 1, "workers", &v)) {
+    if (!(v >= 0 && v <= 8) || v != std::floor(v))
+      luaL_argerror(L, 1, "field 'workers': whole number in 0..8 expected");
+    desc.worker_threads = std::uint32_t(v);
+  }
+  // The cache may fill to its budget: reserved before anything is read.
+  reserve_objects(L, config->budget, desc.budget_bytes, "open_world");
+  TerrainBox* box = push_terrain_box(L);
+  char err[kErrSize];
+  if (!do_open_world(*config, name, desc, box, err)) {
+    lua_pushnil(L);
+    lua_pushstring(L, err);
+    return 2;
+  }
+  const std::size_t bytes = paged_terrain_charge_bytes(*box->terrain, desc.budget_bytes);
+  if (!make_room(L, config->budget, bytes)) {
+    box->terrain.reset();
+    char detail[96];
+    std::snprintf(detail, sizeof detail, "the world's page cache needs %.1f MiB",
+                  double(bytes) / (1024.0 * 1024.0));
+    return object_budget_error(L, *config->budget, "open_world", detail);
+  }
+  if (!charge_terrain(box, config->budget, bytes, err)) return luaL_error(L, "open_world: %s", err);
+  box->cache_bytes = desc.budget_bytes;
+  return 1;
+}
+
 // ridgeline.load{heightmap=, spacing=, origin=, height_scale=, height_offset=, nodata=, fill=}
 //   -> terrain or nil, message
 int r_load(lua_State* L) {
   const ConfigBox* config = config_of(L);
   luaL_checktype(L, 1, LUA_TTABLE);
   static const char* const kFields[] = {
-      "heightmap", "spacing",       "origin",      "height_scale",     "height_offset", "nodata",
-      "fill",      "detail_levels", "detail_seed", "detail_amplitude", "detail_gain",   nullptr};
+      "heightmap",   "spacing",       "origin",      "height_scale",     "height_offset",
+      "nodata",      "fill",          "detail_levels", "detail_seed",    "detail_amplitude",
+      "detail_gain", "raw",           "max_samples",   nullptr};
   check_fields(L, 1, kFields);
   lua_settop(L, 1);
   LoadArgs a;
@@ -165,6 +300,20 @@ int r_load(lua_State* L) {
     luaL_argerror(L, 1, "field 'detail_seed': whole number in 0..2^53 expected");
   a.has_amplitude = get_number_field(L, 1, "detail_amplitude", &a.detail_amplitude);
   a.has_gain = get_number_field(L, 1, "detail_gain", &a.detail_gain);
+  read_raw_format(L, 1, a.raw);
+  double max_samples = 0;
+  if (get_number_field(L, 1, "max_samples", &max_samples)) {
+    const std::uint64_t limit = std::max(config->max_samples_limit, config->max_samples);
+    if (!(max_samples >= 1) || max_samples != std::floor(max_samples) || max_samples > 9.0e15)
+      luaL_argerror(L, 1, "field 'max_samples': whole number >= 1 expected");
+    if (max_samples > double(limit))
+      luaL_argerror(L, 1, lua_pushfstring(L, "field 'max_samples': %I is above this host's limit "
+                                             "%I (HostOptions::max_samples_limit)",
+                                          static_cast<lua_Integer>(max_samples),
+                                          static_cast<lua_Integer>(std::min<std::uint64_t>(
+                                              limit, std::uint64_t{1} << 62))));
+    a.max_samples = std::uint64_t(max_samples);
+  }
   TerrainBox* box = push_terrain_box(L);
   char err[kErrSize];
   std::size_t bytes = 0;
@@ -243,6 +392,7 @@ int config_gc(lua_State* L) {
 
 const luaL_Reg kFunctions[] = {
     {"load", r_load},
+    {"open_world", r_open_world},
     {"default_terrain", r_default_terrain},
     {"budget_controller", new_budget_controller},
     {"save_edits", r_save_edits},
@@ -280,6 +430,7 @@ int open_module(lua_State* L, const ModuleConfig& config) {
   lua_setmetatable(L, -2);
   box->confine_paths = config.confine_paths;
   box->max_samples = config.max_samples;
+  box->max_samples_limit = std::max(config.max_samples_limit, config.max_samples);
   try {
     box->budget = std::make_shared<ObjectBudget>();
   } catch (const std::exception&) {

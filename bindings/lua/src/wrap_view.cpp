@@ -82,8 +82,9 @@ std::size_t default_patches(const Terrain& t) {
 
 // Before a landscape exists: its bounds are 6 bytes a stored diamond of the level-0 pages (about
 // half the samples, aprons included) plus the coarser levels' (docs/roam.md, "Error bounds"):
-// under 4 bytes a sample.
+// under 4 bytes a sample. A paged terrain's bounds live in its pages (charged with its cache).
 std::size_t landscape_estimate(const Terrain& t) {
+  if (t.paged()) return kLandscapeLogBytes;
   const WorldInfo& info = t.info();
   return std::size_t{info.width} * info.height * 4 + kLandscapeLogBytes;
 }
@@ -103,7 +104,8 @@ bool build_view(TerrainBox* terrain, ViewBox* view, const RoamSettings& settings
       }
       terrain->landscape = std::move(*landscape);
       terrain->landscape_charge = std::make_shared<Charge>(
-          terrain->budget, terrain->landscape->bound_bytes() + kLandscapeLogBytes);
+          terrain->budget,
+          (terrain->terrain->paged() ? 0 : terrain->landscape->bound_bytes()) + kLandscapeLogBytes);
     }
     auto created = RoamView::create(terrain->landscape, settings);
     if (!created) {

@@ -379,7 +379,7 @@ Result<std::shared_ptr<const Landscape>> Landscape::create(std::shared_ptr<const
     if (K == 0) K = baked.patch_exponent;
     if (K != baked.patch_exponent || desc.morph_window != baked.morph_window ||
         (desc.morph_window > 0.0 && desc.morph_delay != baked.morph_delay))
-      return Error{fmt("landscape: world '%s' was baked for patch exponent %u, morph window %s "
+      return Error{fmt("landscape: %s was baked for patch exponent %u, morph window %s "
                        "and delay %s; this landscape asks for %u, %s and %s (bake it again "
                        "with ridge bake --patch-exponent / --morph-window / --morph-delay)",
                        info.name.c_str(), baked.patch_exponent, num(baked.morph_window).c_str(),

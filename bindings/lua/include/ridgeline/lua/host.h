@@ -47,8 +47,12 @@ struct HostOptions {
   /// Folder sandboxed scripts may read from (ridgeline.load); empty: no file access. Paths given
   /// by scripts are relative to it, without `..`, never absolute. Unused without the sandbox.
   std::string data_root;
-  /// Largest heightmap a script may load, samples.
-  std::uint64_t max_samples = std::uint64_t{1} << 24;
+  /// Largest heightmap a script may load, samples (default 4097 x 4097). Larger maps are baked
+  /// (`ridge bake`) and opened paged with ridgeline.open_world, whose memory is the cache budget.
+  std::uint64_t max_samples = std::uint64_t{4097} * 4097;
+  /// How far a script may raise that cap for one load (`ridgeline.load{max_samples = N}`);
+  /// below max_samples it is max_samples (the default: scripts cannot raise it).
+  std::uint64_t max_samples_limit = 0;
 };
 
 /// Owns or borrows a lua_State and runs chunks and callbacks under a traceback message handler.

@@ -33,8 +33,12 @@ struct ModuleConfig {
   bool confine_paths = false;
   /// Folder granted to scripts (used only with confine_paths; empty: no file access at all).
   const char* root = "";
-  /// Largest heightmap ridgeline.load accepts, in samples (checked before allocating).
-  std::uint64_t max_samples = std::uint64_t{1} << 26;
+  /// Largest heightmap ridgeline.load accepts, in samples (checked before allocating); default
+  /// 8193 x 8193.
+  std::uint64_t max_samples = std::uint64_t{8193} * 8193;
+  /// How far a script may raise that cap for one load (`ridgeline.load{max_samples = N}`); below
+  /// max_samples it is max_samples. Default: no limit (the stock interpreter's user owns it).
+  std::uint64_t max_samples_limit = ~std::uint64_t{0};
   /// Bytes of C++ memory the objects scripts make through this module table may hold together
   /// (terrains with their edit layers, change logs and detail caches, landscapes, views; 0 = no
   /// limit, the stock interpreter's default). Lua's allocator does not see this memory. A call
