@@ -26,6 +26,7 @@
 #include <thread>
 #include <vector>
 
+#include "ridgeline/edit.h"
 #include "ridgeline/landscape.h"
 #include "ridgeline/roam_view.h"
 #include "ridgeline/scenes.h"
@@ -204,6 +205,33 @@ nlohmann::json run_size(const Options& o, std::uint32_t n) {
                  {"open_to_first_mesh_ms", ms_between(t0, t5)},
                  {"first_mesh_triangles", first ? first->triangles : 0},
                  {"rss_growth_bytes", status_bytes("VmRSS") - std::min(rss_before, status_bytes("VmRSS"))}};
+
+  // ---- a snapshot for another thread (Terrain::clone), before and after edits ----------------
+  {
+    // On a terrain of its own over the same world (its edits stay out of the flight).
+    auto scratch = Terrain::open(*source, cache).value();
+    auto time_clone = [&] {
+      const std::size_t r0 = status_bytes("VmRSS");
+      const auto c0 = Clock::now();
+      auto copy = scratch->clone();
+      const auto c1 = Clock::now();
+      const std::size_t r1 = status_bytes("VmRSS");
+      return nlohmann::json{{"ms", ms_between(c0, c1)}, {"rss_growth_bytes", r1 - std::min(r0, r1)}};
+    };
+    nlohmann::json clone;
+    clone["pristine"] = time_clone();
+    for (int k = 0; k < 16; ++k) {
+      Edit e;
+      e.brush = Brush::kCrater;
+      e.x = w.origin_x + (0.2 + 0.04 * k) * w.extent_x();
+      e.z = w.origin_z + 0.3 * w.extent_z();
+      e.radius = 12;
+      e.depth = 2;
+      (void)scratch->apply_edit(e);
+    }
+    clone["after_16_craters"] = time_clone();
+    out["clone"] = clone;
+  }
 
   // ---- convergence after the open and after teleports ----------------------------------------
   const double period_s = 1.0 / o.fps;

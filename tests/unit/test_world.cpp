@@ -3,6 +3,7 @@
 // whatever is resident; its pages are evicted under the budget but edited ones never are; a bad
 // file is refused with a message naming it; a bake that fails leaves no half-written world.
 #include <gtest/gtest.h>
+#include <OpenImageIO/imageio.h>
 
 #include <cmath>
 #include <cstdint>
@@ -486,4 +487,50 @@ TEST(World, TheSizeCapTakesTwoToTheKPlusOneAndNamesItsOption) {
   const Status s = validate_heightfield_desc(d);
   ASSERT_FALSE(s);
   EXPECT_NE(s.message().find("HeightfieldDesc::max_samples"), std::string::npos) << s.message();
+}
+
+// A baked world is a tiled GeoTIFF with overviews that image and GIS tools read whole: every
+// sample of every level, the extra column and row of a 2^k + 1 size included (each level's tile
+// grid then has one more column and row than its pages), 16-bit and float.
+TEST(World, TheFileIsATiledTiffWithOverviewsThatImageToolsReadWhole) {
+  for (const bool floats : {false, true}) {
+    SCOPED_TRACE(floats ? "float" : "16-bit");
+    const std::uint32_t n = 1025;  // 4 pages a side at level 0, 5 tiles
+    Heightfield hf = generated(n, 769);
+    const double scale = hf.height_scale();
+    if (floats) {
+      std::vector<float> local(hf.local_heights().begin(), hf.local_heights().end());
+      for (std::size_t k = 0; k < local.size(); ++k) local[k] += 0.001f * float(k % 7);
+      HeightfieldDesc d;
+      d.width = n, d.height = 769;
+      hf = Heightfield::create(d, local).value();
+    }
+    const std::string path = tmp_path(floats ? "f32.tif" : "u16.tif");
+    ASSERT_TRUE(io::bake_world(hf, path, {})) << path;
+    auto in = OIIO::ImageInput::open(path);
+    ASSERT_TRUE(in) << OIIO::geterror();
+    int levels = 0;
+    for (int sub = 0; in->seek_subimage(sub, 0); ++sub, ++levels) {
+      const OIIO::ImageSpec& spec = in->spec();
+      const int shift = 2 * sub;  // level k holds every 4^k-th sample
+      ASSERT_EQ(spec.width, int(((n - 1) >> shift) + 1));
+      ASSERT_EQ(spec.height, int(((769 - 1) >> shift) + 1));
+      ASSERT_EQ(spec.tile_width, 256);
+      std::vector<float> px(std::size_t(spec.width) * std::size_t(spec.height));
+      ASSERT_TRUE(in->read_image(sub, 0, 0, 1, OIIO::TypeDesc::FLOAT, px.data())) << in->geterror();
+      std::size_t wrong = 0;
+      for (int j = 0; j < spec.height; ++j)
+        for (int i = 0; i < spec.width; ++i) {
+          const float want = hf.local_heights()[std::size_t(i << shift) +
+                                                std::size_t(j << shift) * n];
+          // 16-bit files hold the stored value: local = scale * value.
+          const float got = floats ? px[std::size_t(i) + std::size_t(j) * std::size_t(spec.width)]
+                                   : float(scale *
+                                           std::round(px[std::size_t(i) + std::size_t(j) * std::size_t(spec.width)] * 65535.0));
+          if (std::abs(got - want) > (floats ? 0.0f : 1e-3f)) ++wrong;
+        }
+      EXPECT_EQ(wrong, 0u) << "level " << sub << " of " << spec.width << " x " << spec.height;
+    }
+    EXPECT_GE(levels, 2);
+  }
 }

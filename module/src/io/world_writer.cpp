@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstring>
 #include <mutex>
+#include <unordered_map>
 #include <thread>
 
 #include "format.h"
@@ -113,6 +114,10 @@ void parallel_for(std::size_t n, unsigned threads, const Fn& fn) {
 // One compressed page as it goes to the file.
 struct CompressedPage {
   std::vector<std::uint8_t> tile, apron, materials, records;
+  // TIFF-only tiles past a level's last page (2^k + 1 sizes leave one sample column and row over
+  // the pages' 256-sample tiles): the column right of the page (x), the row below it (z) and the
+  // corner sample (xz), each as a whole TIFF tile; empty when the page has no such neighbour.
+  std::vector<std::uint8_t> edge_x, edge_z, edge_xz;
   std::uint64_t hash = 0;  // the content hash's page hash (level 0)
 };
 
@@ -433,6 +438,39 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
         cp.apron = deflate({reinterpret_cast<const std::uint8_t*>(ring.data()), ring.size() * 4},
                            o.compression_level);
       }
+      // The TIFF's extra tiles past the last page column / row (readers of the TIFF see the whole
+      // image; Ridgeline reads the same samples from the pages' aprons).
+      {
+        const std::uint32_t iw = std::uint32_t(((info.width - 1) >> ls) + 1);
+        const std::uint32_t ih = std::uint32_t(((info.height - 1) >> ls) + 1);
+        const bool more_x = (iw + kTile - 1) / kTile > std::uint32_t(grid.px[k]);
+        const bool more_z = (ih + kTile - 1) / kTile > std::uint32_t(grid.pz[k]);
+        const bool last_x = key.px == grid.px[k] - 1, last_z = key.pz == grid.pz[k] - 1;
+        // A tile whose every row repeats entry (fa(b), fb(b)) of this page along the row.
+        auto edge = [&](auto entry_of) {
+          if (store_u16) {
+            std::vector<std::uint16_t> t(kTileSamples);
+            for (std::size_t b = 0; b < kTile; ++b)
+              for (std::size_t a = 0; a < kTile; ++a)
+                t[a + b * kTile] = s->u16[entry_of(std::int32_t(a), std::int32_t(b))];
+            encode_u16(t);
+            return deflate({reinterpret_cast<const std::uint8_t*>(t.data()), t.size() * 2},
+                           o.compression_level);
+          }
+          std::vector<float> t(kTileSamples);
+          for (std::size_t b = 0; b < kTile; ++b)
+            for (std::size_t a = 0; a < kTile; ++a)
+              t[a + b * kTile] = s->f32[entry_of(std::int32_t(a), std::int32_t(b))];
+          return deflate(encode_f32(t), o.compression_level);
+        };
+        const std::int32_t E = kPageCells;
+        if (more_x && last_x)
+          cp.edge_x = edge([&](std::int32_t, std::int32_t b) { return world::entry_index(E, b); });
+        if (more_z && last_z)
+          cp.edge_z = edge([&](std::int32_t a, std::int32_t) { return world::entry_index(a, E); });
+        if (more_x && more_z && last_x && last_z)
+          cp.edge_xz = edge([&](std::int32_t, std::int32_t) { return world::entry_index(E, E); });
+      }
       if (mats) cp.materials = deflate(s->materials, o.compression_level);
       if (blocks[idx]) {
         const std::vector<std::uint8_t> raw = blocks[idx]->encode();
@@ -444,6 +482,8 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
         blocks[idx].reset();  // written: memory back
       }
     };
+    // Offsets and sizes of the TIFF-only edge tiles, by the page they follow.
+    std::unordered_map<std::size_t, std::pair<std::uint64_t, std::uint64_t>> edge_x, edge_z, edge_xz;
     const std::size_t batch = std::max<std::size_t>(threads * 4, 8);
     for (std::size_t first = 0; first < total_pages; first += batch) {
       const std::size_t count = std::min(batch, total_pages - first);
@@ -462,6 +502,13 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
           all.insert(all.end(), part->begin(), part->end());
         e.checksum = checksum(all.data(), all.size());
         if (auto s = out.write(all.data(), all.size()); !s) return Error{s.message()};
+        // The TIFF-only edge tiles, after the page's bytes (outside its checksum and the index).
+        for (auto [part, sink] : {std::pair{&cp.edge_x, &edge_x}, std::pair{&cp.edge_z, &edge_z},
+                                  std::pair{&cp.edge_xz, &edge_xz}}) {
+          if (part->empty()) continue;
+          (*sink)[first + k] = {out.size(), part->size()};
+          if (auto s = out.write(part->data(), part->size()); !s) return Error{s.message()};
+        }
         if (first + k < grid.count(0)) page_hashes[first + k] = cp.hash;
       }
       report(0.35 + 0.6 * double(first + count) / double(total_pages), "pages");
@@ -499,12 +546,26 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
       const int ls = world::level_shift(k);
       const std::uint32_t iw = std::uint32_t(((info.width - 1) >> ls) + 1);
       const std::uint32_t ih = std::uint32_t(((info.height - 1) >> ls) + 1);
+      // Tiles row by row: the pages' own, then past the last page column / row the edge tiles.
+      const std::uint32_t tx = (iw + kTile - 1) / kTile, tz = (ih + kTile - 1) / kTile;
       std::vector<std::uint64_t> offsets, counts;
-      for (std::size_t p = 0; p < grid.count(k); ++p) {
-        const PageEntry& e = entries[level_first[k] + p];
-        offsets.push_back(e.offset);
-        counts.push_back(e.tile);
-      }
+      for (std::uint32_t z = 0; z < tz; ++z)
+        for (std::uint32_t x = 0; x < tx; ++x) {
+          const std::uint32_t px = std::min<std::uint32_t>(x, std::uint32_t(grid.px[k]) - 1);
+          const std::uint32_t pz = std::min<std::uint32_t>(z, std::uint32_t(grid.pz[k]) - 1);
+          const std::size_t p = level_first[k] + px + std::size_t(pz) * std::size_t(grid.px[k]);
+          const bool past_x = x >= std::uint32_t(grid.px[k]), past_z = z >= std::uint32_t(grid.pz[k]);
+          std::pair<std::uint64_t, std::uint64_t> t{entries[p].offset, entries[p].tile};
+          if (past_x || past_z) {
+            auto& m = past_x && past_z ? edge_xz : past_x ? edge_x : edge_z;
+            const auto it = m.find(p);
+            if (it == m.end())
+              return Error{fmt("bake: internal error: no edge tile for page %zu of level %u", p, k)};
+            t = it->second;
+          }
+          offsets.push_back(t.first);
+          counts.push_back(t.second);
+        }
       std::vector<TiffEntry> tags = {
           entry<std::uint32_t>(254, kLong, {k == 0 ? 0u : 1u}),
           entry<std::uint32_t>(256, kLong, {iw}),

@@ -42,6 +42,7 @@ struct PageStore::Cache {
   std::deque<PageKey> queue;
   std::unordered_set<PageKey, PageKeyHash> pending;  // queued or loading
   std::unordered_set<PageKey, PageKeyHash> failed;   // the source refused: not asked again
+  std::unordered_set<PageKey, PageKeyHash> coarse;   // the resident levels: kept once loaded
   std::vector<std::shared_ptr<const Page>> done;     // loaded, waiting for update()
   std::size_t in_flight = 0;
   std::size_t bytes = 0;
@@ -73,7 +74,7 @@ struct PageStore::Cache {
       return;
     }
     lru.push_front(p->key);
-    Entry e{p, lru.begin(), 0, forever || p->edited, page_bytes(*p, s)};
+    Entry e{p, lru.begin(), 0, forever || p->edited || coarse.count(p->key) != 0, page_bytes(*p, s)};
     bytes += e.bytes;
     resident.emplace(p->key, std::move(e));
     pending.erase(p->key);
@@ -179,9 +180,12 @@ Result<std::shared_ptr<PageStore>> PageStore::open(std::shared_ptr<const PageSou
   c->stats.budget_bytes = desc.budget_bytes;
   s->cache_ = c;
   s->snapshot_ = std::make_shared<PageTable>(s->grid_);
-  // The coarse levels: every page of the top `resident_levels` levels, pinned, as long as they
-  // stay within 16 MiB (about 40 pages).
+  // The coarse levels: every page of the top `resident_levels` levels, kept, as long as they
+  // stay within 16 MiB (about 40 pages). The top level is read here (a first mesh needs it);
+  // with workers the levels below it are queued first, so that opening reads a few pages
+  // whatever the world's size.
   std::vector<std::shared_ptr<const Page>> top;
+  std::vector<PageKey> queued;
   std::size_t planned = 0;
   for (std::uint32_t r = 0; r < desc.resident_levels && r < s->grid_.levels; ++r) {
     const std::uint32_t k = s->grid_.levels - 1 - r;
@@ -190,6 +194,11 @@ Result<std::shared_ptr<PageStore>> PageStore::open(std::shared_ptr<const PageSou
     for (std::int32_t pz = 0; pz < s->grid_.pz[k]; ++pz)
       for (std::int32_t px = 0; px < s->grid_.px[k]; ++px) {
         const PageKey key{k, px, pz};
+        c->coarse.insert(key);
+        if (r > 0 && !c->synchronous) {
+          queued.push_back(key);
+          continue;
+        }
         PageData d;
         if (auto st = s->source_->load(key, d); !st) return Error{st.message()};
         if (auto st = check_page_data(info, key, d); !st) return Error{st.message()};
@@ -227,6 +236,7 @@ Result<std::shared_ptr<PageStore>> PageStore::open(std::shared_ptr<const PageSou
         }
       });
   }
+  if (!queued.empty()) s->request(queued, true);
   return s;
 }
 
