@@ -11,6 +11,8 @@
 #include <fstream>
 #include <random>
 #include <string>
+#include <thread>
+#include <chrono>
 #include <vector>
 
 #include "file_limit_child.h"
@@ -533,4 +535,29 @@ TEST(World, TheFileIsATiledTiffWithOverviewsThatImageToolsReadWhole) {
     }
     EXPECT_GE(levels, 2);
   }
+}
+
+// Pages loaded by workers before a landscape exists (opening queues the coarse levels; a game
+// prefetches around its player) get that landscape's bounds when they are integrated: the view
+// converges to the mesh the terrain in memory gives, crack-free.
+TEST(World, PagesLoadedBeforeTheLandscapeGetItsBounds) {
+  const std::string path = tmp_path("w.tif");
+  ASSERT_TRUE(io::bake_world(generated(1025, 1025), path));
+  auto source = io::open_world(path);
+  ASSERT_TRUE(source);
+  WorldCacheDesc cache;
+  cache.worker_threads = 2;
+  auto world = Terrain::open(*source, cache).value();
+  const WorldInfo& w = world->info();
+  world->prefetch({{w.origin_x, -1e9, w.origin_z}, {w.origin_x + w.extent_x(), 1e9, w.origin_z + w.extent_z()}});
+  // Loaded (not yet integrated: no update_pages() until the view's first update).
+  for (int k = 0; k < 1000 && world->world_stats().loaded < 17; ++k)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  EXPECT_EQ(world->world_stats().loaded, 17u) << "every page (16 + the top one) loaded first";
+  auto memory = Terrain::create(generated(1025, 1025)).value();
+  const Camera cam = looking_over(*memory, 0.2, 0.2);
+  std::string cracks;
+  const std::uint64_t from_world = converged_mesh(world, cam, &cracks);
+  EXPECT_EQ(cracks, "");
+  EXPECT_EQ(from_world, converged_mesh(memory, cam));
 }

@@ -57,8 +57,9 @@ struct PageStore::Cache {
   void touch(Entry& e) { lru.splice(lru.begin(), lru, e.lru); }
   std::size_t page_bytes(const Page& p, const PageStore& s) const {
     std::size_t b = p.memory_bytes();
+    const auto makers = s.makers();
     for (std::size_t k = 0; k < kRecordSlots; ++k)
-      if (p.records[k] && s.makers_[k]) b += s.makers_[k]->bytes(*p.records[k]);
+      if (p.records[k] && makers[k]) b += makers[k]->bytes(*p.records[k]);
     return b;
   }
   // Puts a page in the resident set (replacing an older version). Holds mu.
@@ -327,8 +328,21 @@ std::shared_ptr<const Page> PageStore::make_page(const PageKey& key, PageData&& 
   if (key.level == 0) p->rays = make_rays(*p);
   if (!d.records.empty())
     p->baked = std::make_shared<const std::vector<std::uint8_t>>(std::move(d.records));
+  const auto makers = this->makers();
   for (std::size_t k = 0; k < kRecordSlots; ++k)
-    if (makers_[k]) p->records[k] = makers_[k]->make(*p);
+    if (makers[k]) p->records[k] = makers[k]->make(*p);
+  return p;
+}
+
+std::shared_ptr<const Page> PageStore::with_all_records(std::shared_ptr<const Page> p) const {
+  const auto makers = this->makers();
+  std::shared_ptr<Page> copy;
+  for (std::size_t k = 0; k < kRecordSlots; ++k)
+    if (makers[k] && !p->records[k]) {
+      if (!copy) copy = p->copy();
+      copy->records[k] = makers[k]->make(*copy);
+    }
+  if (copy) return copy;
   return p;
 }
 
@@ -397,6 +411,7 @@ const Page* PageStore::require(const PageKey& key, std::shared_ptr<const PageTab
     for (auto& p : loaded) pages.push_back(std::move(p));
   }
   if (pages.empty()) return nullptr;
+  for (auto& p : pages) p = with_all_records(std::move(p));
   {
     std::lock_guard lock(cache_->mu);
     for (const auto& p : pages) cache_->insert(p, *this, false);
@@ -485,6 +500,7 @@ void PageStore::update(std::size_t max_integrations) const {
       auto p = std::move(c.done.front());
       c.done.erase(c.done.begin());
       if (!c.resident.count(p->key)) {
+        p = with_all_records(std::move(p));
         c.insert(p, *this, false);
         changed.push_back(std::move(p));
         ++n;
@@ -544,6 +560,7 @@ WorldStats PageStore::stats() const {
 // ---- record slots -------------------------------------------------------------------------------
 
 int PageStore::add_slot(std::shared_ptr<const RecordMaker> maker) {
+  std::lock_guard lock(makers_mu_);
   for (std::size_t k = 0; k < kRecordSlots; ++k)
     if (!makers_[k]) {
       makers_[k] = std::move(maker);
@@ -567,12 +584,14 @@ void PageStore::remove_slot(int slot) {
       cache_->bytes += e.bytes;
       changed.push_back(e.page);
     }
+    std::lock_guard mlock(makers_mu_);
     makers_[std::size_t(slot)] = nullptr;
   }
   if (!changed.empty()) publish(changed, {});
 }
 
 const RecordMaker* PageStore::maker(int slot) const noexcept {
+  std::lock_guard lock(makers_mu_);
   return slot >= 0 && std::size_t(slot) < kRecordSlots ? makers_[std::size_t(slot)].get()
                                                          : nullptr;
 }

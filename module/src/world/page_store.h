@@ -159,7 +159,16 @@ class PageStore {
   BakedRecords baked_;
   std::vector<PageSummary> summaries_;
   std::vector<RayLevel> upper_;
+  // The record makers by slot (Landscapes add and remove theirs while workers make pages):
+  // read through makers() under makers_mu_.
+  mutable std::mutex makers_mu_;
   std::array<std::shared_ptr<const RecordMaker>, kRecordSlots> makers_;
+  std::array<std::shared_ptr<const RecordMaker>, kRecordSlots> makers() const {
+    std::lock_guard lock(makers_mu_);
+    return makers_;
+  }
+  // `p` with the records of every slot it lacks (a page made before its slot was added).
+  std::shared_ptr<const Page> with_all_records(std::shared_ptr<const Page> p) const;
   mutable std::mutex snapshot_mu_;
   mutable std::shared_ptr<const PageTable> snapshot_;
   mutable std::atomic<std::uint64_t> generation_{0};
