@@ -3,14 +3,14 @@
 # UndefinedBehaviorSanitizer build of the tests, then the fuzz targets (libFuzzer, bounded time).
 # Installs missing Debian packages first.
 # Usage: scripts/test.sh            (all stages)
-#        STAGES="release" scripts/test.sh   (a subset: release asan fuzz)
+#        STAGES="release" scripts/test.sh   (a subset: release portable asan fuzz)
 #        FUZZ_SECONDS=600 FUZZ_SEED=$RANDOM STAGES=fuzz scripts/test.sh   (a longer, fresh fuzz run;
 #        default 30 s a target with the fixed seed 1, so that CI explores the same inputs each run)
 set -uo pipefail
 source "$(dirname "$0")/lib/common.sh"
 cd "$RIDGELINE_ROOT"
 
-STAGES=${STAGES:-"release asan fuzz"}
+STAGES=${STAGES:-"release portable asan fuzz"}
 JOBS=$(nproc)
 total0=$SECONDS
 
@@ -59,10 +59,22 @@ release() {
   LP_NUM_THREADS=2 run_ctest release build/release with_display
 }
 
+# The core and its tests from standard C++ alone (RIDGELINE_PORTABLE: plain allocations instead
+# of reserved address space, no SIMD dispatch, no prefetch hints), without the optional targets:
+# what an engine on another platform builds.
+portable() {
+  configure_and_build build/portable -DCMAKE_BUILD_TYPE=Release -DRIDGELINE_PORTABLE=ON \
+    -DRIDGELINE_BUILD_IO=OFF -DRIDGELINE_BUILD_BENCHMARKS=OFF -DRIDGELINE_BUILD_BULLET=OFF ||
+    return 1
+  run_ctest portable build/portable
+}
+
 # One clang build with ASan, UBSan and libFuzzer instrumentation serves the sanitizer tests and
-# the fuzz stage (the fuzz targets are libFuzzer binaries there; ctest replays their corpus).
+# the fuzz stage (the fuzz targets are libFuzzer binaries there; ctest replays their corpus). It
+# also checks every ROAM view's invariants after each phase of each update (RIDGELINE_ROAM_PARANOID).
 ASAN_CMAKE_ARGS=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++-14
-  -DRIDGELINE_SANITIZE=address,undefined -DRIDGELINE_FUZZ=ON -DRIDGELINE_BUILD_BENCHMARKS=OFF)
+  -DRIDGELINE_SANITIZE=address,undefined -DRIDGELINE_FUZZ=ON -DRIDGELINE_BUILD_BENCHMARKS=OFF
+  -DRIDGELINE_ROAM_PARANOID=ON)
 
 asan() {
   configure_and_build build/asan "${ASAN_CMAKE_ARGS[@]}" || return 1

@@ -8,8 +8,10 @@
 
 namespace ridgeline::detail {
 
-/// printf-style formatting into a std::string.
+/// printf-style formatting into a std::string (format strings checked where the compiler can).
+#if defined(__GNUC__) || defined(__clang__)
 inline std::string fmt(const char* format, ...) __attribute__((format(printf, 1, 2)));
+#endif
 inline std::string fmt(const char* format, ...) {
   va_list args;
   va_start(args, format);

@@ -11,6 +11,7 @@
 #include "ridgeline/camera.h"
 #include "ridgeline/landscape.h"
 #include "ridgeline/result.h"
+#include "ridgeline/roam_memory.h"
 
 namespace ridgeline {
 
@@ -165,10 +166,21 @@ float morphed_height(const MeshVertex& v, const glm::vec3& eye, double projectio
 /// pulls the regions changed since its last update (Landscape::changes_since()): it refreshes the
 /// diamonds there and rewrites the vertices whose heights, normals or bounds changed. Nothing
 /// runs inside the edit call; no view call may run during an edit.
+///
+/// Memory: the view's nodes and front live in arrays that grow as the mesh does (RoamMemory;
+/// about 90 bytes per triangle, docs/roam.md); its patch buffers in ordinary allocations. When
+/// an array cannot grow (past the RoamMemory's cap, past the address space reserved for it, or
+/// refused by the system), update() returns an out-of-memory error; no exception leaves the
+/// view.
 class RoamView {
  public:
+  /// A view of `landscape` (not null). `memory`: where its nodes and front live, shared with
+  /// the other views created with it (RoamMemory); null gives the view memory of its own, given
+  /// back to the system when the view is destroyed. Fails for a null landscape, invalid
+  /// settings (set_settings()) or when even the root triangles find no memory.
   static Result<std::unique_ptr<RoamView>> create(std::shared_ptr<const Landscape> landscape,
-                                                  const RoamSettings& settings = {});
+                                                  const RoamSettings& settings = {},
+                                                  std::shared_ptr<RoamMemory> memory = nullptr);
   ~RoamView();
   RoamView(const RoamView&) = delete;
   RoamView& operator=(const RoamView&) = delete;
@@ -179,12 +191,18 @@ class RoamView {
   const RoamSettings& settings() const noexcept { return settings_; }
 
   /// Tessellates for `camera` (ignored with ErrorMetric::kWorldMetres): splits and merges until
-  /// converged or a budget stops it; what is left continues on the next update. Fails only for an
-  /// invalid camera (nothing changes then).
+  /// converged or a budget stops it; what is left continues on the next update. Fails:
+  /// - for an invalid camera (validate_camera()'s message): nothing changes;
+  /// - when memory runs out ("roam view: out of memory: ..." naming the array, its size and
+  ///   the limit reached): the mesh is reset to the root triangles (every patch comes out of
+  ///   take_dirty_patches() resized) and the next update rebuilds it from the roots, so a view
+  ///   whose RoamMemory cap was raised, or whose threshold was raised, carries on.
+  /// Never throws.
   Result<RoamStats> update(const Camera& camera);
 
   /// Converges fully for a static camera (no time budget): what `ridge mesh` uses. On a paged
-  /// world it waits for the pages the mesh needs (updating again until none is missing).
+  /// world it waits for the pages the mesh needs (updating again until none is missing). Fails
+  /// as update() does.
   Result<RoamStats> converge(const Camera& camera);
 
   const Landscape& landscape() const noexcept { return *landscape_; }
@@ -222,7 +240,7 @@ class RoamView {
   std::string check_invariants() const;
 
  private:
-  struct Impl;
+  struct Impl;  // the view's parts (module/src/roam/view/view.h)
   RoamView() = default;
   std::shared_ptr<const Landscape> landscape_;
   RoamSettings settings_;

@@ -320,20 +320,21 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
 
     // ---- the tessellator's coarse bounds --------------------------------------------------------
     const auto tb = std::chrono::steady_clock::now();
-    std::uint32_t K = o.landscape.patch_exponent;
-    if (K == 0) K = roam::default_patch_exponent(info.width, info.height);
-    if (K < 2 || K > 10)
-      return Error{fmt("%s: patch exponent %u; need 2..10 (--patch-exponent)", what.c_str(), K)};
+    std::uint32_t exponent = o.landscape.patch_exponent;
+    if (exponent == 0) exponent = roam::default_patch_exponent(info.width, info.height);
+    if (exponent < 2 || exponent > 10)
+      return Error{
+          fmt("%s: patch exponent %u; need 2..10 (--patch-exponent)", what.c_str(), exponent)};
     const double window = o.landscape.morph_window;
     const double delay = window > 0.0 ? o.landscape.morph_delay : 0.0;
     if (!(window >= 0.0 && window <= 4.0) || !(delay >= 0.0 && delay <= 1.0))
       return Error{fmt("%s: morph window %s / delay %s; need 0..4 and 0..1", what.c_str(),
                        num(window).c_str(), num(delay).c_str())};
     roam::RecordConfig rc;
-    rc.K = int(K);
+    rc.patch_log2 = int(exponent);
     rc.growth = std::sqrt(1.0 + delay + window);
     rc.last_i = info.width - 1, rc.last_j = info.height - 1;
-    const std::int64_t P = std::int64_t{1} << K;
+    const std::int64_t P = std::int64_t{1} << exponent;
     rc.pad_i = ((rc.last_i + P - 1) / P) * P, rc.pad_j = ((rc.last_j + P - 1) / P) * P;
     rc.spacing_x = info.spacing_x, rc.spacing_z = info.spacing_z;
     std::vector<std::size_t> level_first;
@@ -353,7 +354,7 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
         threads, false);
     rep.bounds_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - tb).count();
-    rep.patch_exponent = K;
+    rep.patch_exponent = exponent;
     report(0.35, "pages");
 
     // ---- pages ------------------------------------------------------------------------------
@@ -529,7 +530,7 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
     w.put(std::uint8_t(mats ? 1 : 0));
     w.put(info.filled_samples), w.put(info.content_hash);
     w.put_string(info.name);
-    w.put(K), w.put(window), w.put(delay);
+    w.put(exponent), w.put(window), w.put(delay);
     w.put(grid.levels);
     for (std::uint32_t k = 0; k < grid.levels; ++k) w.put(grid.px[k]), w.put(grid.pz[k]);
     for (const PageSummary& s : summaries) w.put(s.lo), w.put(s.hi), w.put(s.lo8), w.put(s.hi8);

@@ -25,13 +25,16 @@
 #pragma once
 
 #include <algorithm>
+#include <bit>
 #include <cstdint>
+
+#include "ridgeline/landscape.h"
 
 namespace ridgeline::roam {
 
 /// Trailing zero bits of x, 64 for 0.
 inline int ctz64(std::int64_t x) noexcept {
-  return x == 0 ? 64 : __builtin_ctzll(static_cast<std::uint64_t>(x));
+  return std::countr_zero(static_cast<std::uint64_t>(x));
 }
 
 struct Diamond {
@@ -42,8 +45,9 @@ struct Diamond {
   bool top = false;           ///< a patch centre: the two roots, no parents
   bool corner = false;        ///< a patch corner: not a diamond at all
 
-  /// Bintree level of the diamond's triangles (0 for the roots).
-  int depth(int K) const noexcept { return 2 * (K - 1 - t) + (square ? 0 : 1); }
+  /// Bintree level of the diamond's triangles (0 for the roots), for patches of 2^patch_log2
+  /// finest cells.
+  int depth(int patch_log2) const noexcept { return 2 * (patch_log2 - 1 - t) + (square ? 0 : 1); }
 
   /// The two ends of the shared hypotenuse.
   void hypotenuse(std::int64_t& ax, std::int64_t& az, std::int64_t& bx,
@@ -99,12 +103,12 @@ inline std::uint32_t apex_side(std::int64_t ax, std::int64_t az, std::int64_t i,
   return (ax > i || (ax == i && az > j)) ? 1u : 0u;
 }
 
-/// Classifies lattice vertex (i, j) for patches of 2^K finest cells.
-inline Diamond diamond_at(std::int64_t i, std::int64_t j, int K) noexcept {
+/// Classifies lattice vertex (i, j) for patches of 2^patch_log2 finest cells (K above).
+inline Diamond diamond_at(std::int64_t i, std::int64_t j, int patch_log2) noexcept {
   Diamond d;
   d.i = i, d.j = j;
   const int t = std::min(ctz64(i), ctz64(j));
-  if (t >= K) {
+  if (t >= patch_log2) {
     d.corner = true;
     return d;
   }
@@ -112,7 +116,7 @@ inline Diamond diamond_at(std::int64_t i, std::int64_t j, int K) noexcept {
   d.s = std::int64_t{1} << t;
   const bool oi = ((i >> t) & 1) != 0, oj = ((j >> t) & 1) != 0;
   d.square = oi && oj;
-  d.top = d.square && t == K - 1;
+  d.top = d.square && t == patch_log2 - 1;
   return d;
 }
 
@@ -132,13 +136,24 @@ inline void canonical_half(std::int64_t& hu, std::int64_t& hw) noexcept {
 }
 
 /// The canonical half hypotenuse of the diamond centred at (i, j) (not a patch corner).
-inline void half_hypotenuse(std::int64_t i, std::int64_t j, int K, std::int64_t& hu,
+inline void half_hypotenuse(std::int64_t i, std::int64_t j, int patch_log2, std::int64_t& hu,
                             std::int64_t& hw) noexcept {
-  const Diamond d = diamond_at(i, j, K);
+  const Diamond d = diamond_at(i, j, patch_log2);
   std::int64_t x0, z0, x1, z1;
   d.hypotenuse(x0, z0, x1, z1);
   hu = x1 - i, hw = z1 - j;
   canonical_half(hu, hw);
+}
+
+/// The triangle of side `side` (apex_side()) of the diamond centred at (i, j) with canonical
+/// half hypotenuse (hu, hw) (canonical_half()): apex c + sigma p, left c + sigma h, right
+/// c - sigma h, with sigma = +1 for side 1 and -1 for side 0 and p = (-hw, hu).
+/// (Inline: called per split, merge and built diamond from several files; out of line, the
+/// returned triangle went through memory and its 16-byte reloads missed store forwarding.)
+inline LatticeTriangle triangle_of_diamond(std::int64_t i, std::int64_t j, std::int64_t hu,
+                                           std::int64_t hw, std::uint32_t side) noexcept {
+  const std::int64_t su = side ? hu : -hu, sw = side ? hw : -hw;
+  return {i - sw, j + su, i + su, j + sw, i - su, j - sw};
 }
 
 }  // namespace ridgeline::roam

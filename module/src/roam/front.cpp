@@ -10,10 +10,7 @@
 #include <bit>
 #include <cmath>
 
-#if defined(__x86_64__) || defined(__i386__)
-#include <immintrin.h>
-#define RIDGELINE_FRONT_AVX2 1
-#endif
+#include "platform/cpu_features.h"
 
 namespace ridgeline::roam {
 
@@ -74,7 +71,7 @@ float screen_pass_scalar(Front::Hot* hot, std::size_t nb, std::uint32_t first, c
     h.m.view = std::uint8_t(view & h.m.valid);
     if (changed == nullptr) continue;
     for (std::uint32_t d = std::uint32_t(h.m.active ^ h.m.split) & h.m.valid; d != 0; d &= d - 1) {
-      const std::uint32_t l = std::uint32_t(__builtin_ctz(d));
+      const std::uint32_t l = std::uint32_t(std::countr_zero(d));
       changed->push_back(
           {(h.m.view >> l) & 1 ? p[l] : -1.0f,
            ((first + std::uint32_t(b)) * Front::kLanes + l) | (((h.m.split >> l) & 1u) << 31)});
@@ -83,10 +80,10 @@ float screen_pass_scalar(Front::Hot* hot, std::size_t nb, std::uint32_t first, c
   return worst;
 }
 
-#ifdef RIDGELINE_FRONT_AVX2
+#if RIDGELINE_HAS_AVX2_DISPATCH
 // Eight lanes at a time, the same operations as screen_test() in the same order (no fused
 // multiply-adds). Writes only the masks.
-__attribute__((target("avx2"))) float screen_pass_avx2(Front::Hot* hot, std::size_t nb,
+RIDGELINE_TARGET_AVX2 float screen_pass_avx2(Front::Hot* hot, std::size_t nb,
                                                        std::uint32_t first, const FrontCamera& c,
                                                        std::vector<Front::Keyed>* changed,
                                                        float w) {
@@ -153,7 +150,7 @@ __attribute__((target("avx2"))) float screen_pass_avx2(Front::Hot* hot, std::siz
     alignas(32) float p[8];
     _mm256_store_ps(p, _mm256_div_ps(_mm256_mul_ps(mu, scale), den));
     for (std::uint32_t x = d; x != 0; x &= x - 1) {
-      const std::uint32_t l = std::uint32_t(__builtin_ctz(x));
+      const std::uint32_t l = std::uint32_t(std::countr_zero(x));
       changed->push_back(
           {(view_bits >> l) & 1 ? p[l] : -1.0f, ((first + std::uint32_t(b)) * Front::kLanes + l) |
                                                     (((hot[b].m.split >> l) & 1u) << 31)});
@@ -165,17 +162,12 @@ __attribute__((target("avx2"))) float screen_pass_avx2(Front::Hot* hot, std::siz
   }
   return w;
 }
-
-bool have_avx2() {
-  static const bool yes = __builtin_cpu_supports("avx2");
-  return yes;
-}
 #endif
 
 }  // namespace
 
 FrontCamera FrontCamera::screen(const Camera& camera, double threshold_px, double ox, double oy,
-                                double oz, double sx, double sz, double extent) {
+                                double oz, double extent) {
   FrontCamera c;
   const Frustum f(camera);
   c.ex = float(camera.eye.x - ox);
@@ -188,8 +180,6 @@ FrontCamera FrontCamera::screen(const Camera& camera, double threshold_px, doubl
   c.far_m = float(camera.far_m);
   c.near_m = float(camera.near_m);
   c.threshold = float(threshold_px);
-  c.sx = float(sx);
-  c.sz = float(sz);
   // Positions are floats of magnitude up to the extent (and the eye's): their rounding, a few
   // units in the last place, is what the test must not lose: 2^-17 of the magnitude, ~64 ulps.
   const double mag =
@@ -219,7 +209,7 @@ constexpr std::uint32_t kLaneBits = 0x01010101u;  // lane 0's bit in each of the
 std::uint32_t Front::add(std::int32_t i, std::int32_t j, std::int32_t hu, std::int32_t hw,
                          std::uint32_t t, float x, float y, float z, float mu, float r,
                          std::uint32_t node, bool split, bool provisional) {
-  const std::uint32_t e = n_++;
+  const std::uint32_t e = n_;
   const std::uint32_t l = e & 7;
   if (l == 0) {
     // A new block (zero bound and radius in its free lanes: never active), with room for a
@@ -227,6 +217,7 @@ std::uint32_t Front::add(std::int32_t i, std::int32_t j, std::int32_t hu, std::i
     if (e >= capacity_) grow();
     block(e >> 3) = Hot{};
   }
+  ++n_;
   Hot& h = block(e >> 3);
   h.x[l] = x, h.y[l] = y, h.z[l] = z, h.mu[l] = mu, h.r[l] = r;
   // The half hypotenuse's kind: (s, 0), (0, -s), (-s, -s), (s, -s) (canonical: diamond.h).
@@ -263,10 +254,12 @@ void Front::grow() {
   // Entries never outnumber the nodes: each is a diamond with a node.
   constexpr std::size_t kMaxEntries = NodePool::kMaxNodes;
   const std::size_t n = std::size_t(capacity_) + kChunkEntries;
+  // Each pointer read again as soon as its array grew: a plain allocation moves (reserved.h),
+  // and the second growth may fail.
   hot_mem_.grow_to(n / kLanes * sizeof(Hot), kChunkBlocks * sizeof(Hot),
                    kMaxEntries / kLanes * sizeof(Hot));
-  cold_mem_.grow_to(n * sizeof(Cold), kChunkEntries * sizeof(Cold), kMaxEntries * sizeof(Cold));
   hot_ = static_cast<Hot*>(hot_mem_.data());
+  cold_mem_.grow_to(n * sizeof(Cold), kChunkEntries * sizeof(Cold), kMaxEntries * sizeof(Cold));
   cold_ = static_cast<Cold*>(cold_mem_.data());
   set_capacity();
 }
@@ -285,6 +278,8 @@ void Front::trim() noexcept {
   if (keep >= capacity_) return;
   hot_mem_.shrink_to(keep / kLanes * sizeof(Hot));
   cold_mem_.shrink_to(keep * sizeof(Cold));
+  hot_ = static_cast<Hot*>(hot_mem_.data());  // a plain allocation moves (reserved.h)
+  cold_ = static_cast<Cold*>(cold_mem_.data());
   set_capacity();
 }
 
@@ -321,8 +316,8 @@ float Front::pass_chunk(std::uint32_t k, const FrontCamera& c, std::vector<Keyed
   const std::uint32_t first = k * kChunkBlocks;
   Hot* hot = hot_ + std::size_t(first);
   const std::size_t n = std::min<std::size_t>(kChunkBlocks, blocks() - first);
-#ifdef RIDGELINE_FRONT_AVX2
-  if (have_avx2()) return screen_pass_avx2(hot, n, first, c, changed, worst);
+#if RIDGELINE_HAS_AVX2_DISPATCH
+  if (detail::cpu_has_avx2()) return screen_pass_avx2(hot, n, first, c, changed, worst);
 #endif
   return screen_pass_scalar(hot, n, first, c, changed, worst);
 }

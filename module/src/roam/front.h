@@ -26,7 +26,7 @@
 #include <memory>
 #include <vector>
 
-#include "memory_hints.h"
+#include "platform/memory_hints.h"
 #include "roam/reserved.h"
 #include "ridgeline/camera.h"
 
@@ -45,7 +45,6 @@ struct FrontCamera {
   float far_m = 1e30f;
   float scale = 1;       ///< projection scale K: pixels per metre at 1 m
   float near_m = 0.5f;   ///< distances below this count as this in priorities
-  float sx = 1, sz = 1;  ///< metres per finest-lattice step (a centre's x is i * sx)
   /// Metres added to every radius: more than the float rounding of the positions and the eye
   /// (so that the test stays conservative against the exact distances).
   float margin = 0;
@@ -53,9 +52,9 @@ struct FrontCamera {
   float threshold = 0;
 
   /// The camera in the frame whose origin is (ox, oy, oz) in world coordinates, over a lattice
-  /// of spacing (sx, sz) whose coordinates and heights stay within `extent` metres of it.
+  /// whose coordinates and heights stay within `extent` metres of it.
   static FrontCamera screen(const Camera& camera, double threshold_px, double ox, double oy,
-                            double oz, double sx, double sz, double extent);
+                            double oz, double extent);
   static FrontCamera world_metres(double threshold_m);
 };
 
@@ -91,6 +90,10 @@ class Front {
 
   /// Blocks per chunk (a power of two).
   static constexpr std::uint32_t kChunkBlocks = 128;
+
+  /// `pool`, when given, must outlive the front (reserved.h).
+  explicit Front(RangePool* pool = nullptr) noexcept
+      : hot_mem_("front's blocks", pool), cold_mem_("front's records", pool) {}
 
   std::uint32_t size() const noexcept { return n_; }
   std::uint32_t blocks() const noexcept { return (n_ + kLanes - 1) / kLanes; }
@@ -136,7 +139,7 @@ class Front {
   float priority(std::uint32_t e, const FrontCamera& c) const noexcept;
 
   /// Appends an entry; returns its index. (hu, hw) is the canonical half hypotenuse, t = log2
-  /// of the diamond's size; (x, z) the centre in metres (i * sx, j * sz as floats), y its
+  /// of the diamond's size; (x, z) the centre in metres (i and j times the lattice spacing, as floats), y its
   /// height.
   std::uint32_t add(std::int32_t i, std::int32_t j, std::int32_t hu, std::int32_t hw,
                     std::uint32_t t, float x, float y, float z, float mu, float r,

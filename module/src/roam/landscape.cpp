@@ -6,6 +6,7 @@
 #include "ridgeline/landscape.h"
 
 #include <algorithm>
+#include <bit>
 #include <cfloat>
 #include <chrono>
 #include <cmath>
@@ -112,7 +113,7 @@ LatticeTriangle Landscape::triangle(std::uint32_t root, std::uint64_t heap) cons
   const std::int64_t oz = std::int64_t(patch / patches_x_) * p;
   LatticeTriangle t = (root & 1) == 0 ? LatticeTriangle{ox + p, oz, ox, oz, ox + p, oz + p}
                                       : LatticeTriangle{ox, oz + p, ox + p, oz + p, ox, oz};
-  const int depth = 63 - __builtin_clzll(heap);
+  const int depth = int(std::bit_width(heap)) - 1;
   for (int bit = depth - 1; bit >= 0; --bit) t = child_triangle(t, int((heap >> bit) & 1));
   return t;
 }
@@ -124,7 +125,7 @@ LatticeTriangle LandscapeAccess::triangle_at(const Landscape& l, std::int64_t ax
   // back by 90 for every child 1 on the path: an index into eight compass directions.
   static constexpr int kUx[8] = {1, 1, 0, -1, -1, -1, 0, 1};
   static constexpr int kUz[8] = {0, 1, 1, 1, 0, -1, -1, -1};
-  const int level = 63 - __builtin_clzll(heap);
+  const int level = int(std::bit_width(heap)) - 1;
   const int k = (((root & 1) ? 7 : 3) + 3 * level + 2 * (popcount64(heap) - 1)) & 7;
   const std::int64_t s2 = l.patch_cells() >> (level / 2);  // twice the apex-midpoint distance
   const std::int64_t ux = kUx[k], uz = kUz[k], px = -uz, pz = ux;  // p: u turned +90 degrees
@@ -174,7 +175,7 @@ DiamondBound Landscape::diamond(std::int64_t i, std::int64_t j) const noexcept {
 }
 
 float Landscape::bound(std::uint32_t root, std::uint64_t heap) const noexcept {
-  const int level = 63 - __builtin_clzll(heap);
+  const int level = int(std::bit_width(heap)) - 1;
   if (level >= int(max_level())) return 0.0f;
   const LatticeTriangle t = triangle(root, heap);
   return diamond((t.lx + t.rx) / 2, (t.lz + t.rz) / 2).error;
@@ -195,9 +196,9 @@ float LandscapeAccess::detail_offset_bound(const Landscape& l, std::int64_t i,
 DiamondBound LandscapeAccess::compute_detail(const Landscape& l, std::int64_t i,
                                              std::int64_t j) noexcept {
   const Landscape::Impl& m = *l.impl_;
-  const int K = l.patch_log2(), L = int(l.detail_levels());
-  const Diamond d = diamond_at(i, j, K);
-  const int depth = d.depth(K);
+  const int patch_log2 = l.patch_log2(), L = int(l.detail_levels());
+  const Diamond d = diamond_at(i, j, patch_log2);
+  const int depth = d.depth(patch_log2);
   const int base = int(l.base_level());
   const int from = (depth - base) / 2 + 1;  // the first detail level not resolved
   const Surface& surface = l.terrain().surface();
@@ -237,10 +238,10 @@ DiamondBound LandscapeAccess::compute_detail(const Landscape& l, std::int64_t i,
                      sj0 = std::clamp<std::int64_t>(j0 >> L, 0, g.last_j),
                      sj1 = std::clamp<std::int64_t>((j1 >> L) + 1, 0, g.last_j);
   float lo = INFINITY, hi = -INFINITY;
-  const detail::StoredLattice st = detail::stored_lattice(surface);
+  const detail::StoredLattice stored = detail::stored_lattice(surface);
   for (std::int64_t sj = sj0; sj <= sj1; ++sj)
     for (std::int64_t si = si0; si <= si1; ++si) {
-      const float h = st.local(si, sj);
+      const float h = stored.local(si, sj);
       lo = std::min(lo, h), hi = std::max(hi, h);
     }
   const double height_range = double(hi - lo) + 2.0 * analytic(1);
@@ -254,15 +255,15 @@ DiamondBound LandscapeAccess::compute_detail(const Landscape& l, std::int64_t i,
 
 namespace {
 
-// Area-weighted normal at a vertex of a lattice of spacing (sx, sz) from the 3 x 3 heights
-// around it, h[dz + 1][dx + 1]: every triangle has the same area, so it is the normalised sum of
-// the up normals (-dh/dx, 1, -dh/dz) of the triangles around the vertex, 4 or 8 of them by the
+// Area-weighted normal at a vertex of a lattice of spacing (spacing_x, spacing_z) metres from the
+// 3 x 3 heights around it, h[dz + 1][dx + 1]: every triangle has the same area, so it is the
+// normalised sum of the up normals (-dh/dx, 1, -dh/dz) of the triangles around the vertex, 4 or 8 of them by the
 // diagonal rule (in the lattice's own indices ci, cj of the cell whose low corner is the
 // vertex). `inside(cx, cz)` says whether cell (cx, cz) of the 2 x 2 around counts.
 template <class Inside>
-glm::vec3 area_normal(const float (&h)[3][3], std::int64_t ci, std::int64_t cj, double sx,
-                      double sz, const Inside& inside) {
-  const double isx = 1.0 / sx, isz = 1.0 / sz;
+glm::vec3 area_normal(const float (&h)[3][3], std::int64_t ci, std::int64_t cj, double spacing_x,
+                      double spacing_z, const Inside& inside) {
+  const double per_x = 1.0 / spacing_x, per_z = 1.0 / spacing_z;
   double gx = 0, gz = 0;
   int count = 0;
   for (int cz = -1; cz <= 0; ++cz)
@@ -273,12 +274,12 @@ glm::vec3 area_normal(const float (&h)[3][3], std::int64_t ci, std::int64_t cj, 
       const int du = -cx, dv = -cz;  // the vertex's corner in the cell
       if (cell_has_main_diagonal(ci + cx, cj + cz)) {
         // (00, 10, 11) and (00, 11, 01): the vertex is in both when on the diagonal.
-        if (!(du == 0 && dv == 1)) gx += (h10 - h00) * isx, gz += (h11 - h10) * isz, ++count;
-        if (!(du == 1 && dv == 0)) gx += (h11 - h01) * isx, gz += (h01 - h00) * isz, ++count;
+        if (!(du == 0 && dv == 1)) gx += (h10 - h00) * per_x, gz += (h11 - h10) * per_z, ++count;
+        if (!(du == 1 && dv == 0)) gx += (h11 - h01) * per_x, gz += (h01 - h00) * per_z, ++count;
       } else {
         // (00, 10, 01) and (10, 11, 01).
-        if (!(du == 1 && dv == 1)) gx += (h10 - h00) * isx, gz += (h01 - h00) * isz, ++count;
-        if (!(du == 0 && dv == 0)) gx += (h11 - h01) * isx, gz += (h11 - h10) * isz, ++count;
+        if (!(du == 1 && dv == 1)) gx += (h10 - h00) * per_x, gz += (h01 - h00) * per_z, ++count;
+        if (!(du == 0 && dv == 0)) gx += (h11 - h01) * per_x, gz += (h11 - h10) * per_z, ++count;
       }
     }
   if (count == 0) return {0, 1, 0};
@@ -291,7 +292,7 @@ glm::vec3 area_normal(const float (&h)[3][3], std::int64_t ci, std::int64_t cj, 
 bool roam::Reader::stored_shading(std::int64_t si, std::int64_t sj, const Diamond& d, int t,
                                   VertexShading& out, float* height) const noexcept {
   // A vertex's shading is its level's (t / 2, capped at the coarsest level): patch corners pass
-  // t = K, the coarsest level holding them, which is always resident.
+  // t = patch_log2, the coarsest level holding them, which is always resident.
   std::int32_t a = 0, b = 0;
   PageKey key;
   const int level_t = std::min(t, 2 * (int(im_->store->grid().levels) - 1) + 1);
@@ -370,29 +371,29 @@ Result<std::shared_ptr<const Landscape>> Landscape::create(std::shared_ptr<const
   auto& store = const_cast<world::PageStore&>(detail::SurfaceAccess::store(surface));
   const WorldInfo& info = store.info();
   const BakedRecords baked = store.source() ? store.source()->baked_records() : BakedRecords{};
-  std::uint32_t K = desc.patch_exponent;
+  std::uint32_t exponent = desc.patch_exponent;
   if (store.paged()) {
     if (baked.patch_exponent == 0)
       return Error{fmt("landscape: world '%s' carries no tessellator bounds (bake it with "
                        "ridge bake)",
                        info.name.c_str())};
-    if (K == 0) K = baked.patch_exponent;
-    if (K != baked.patch_exponent || desc.morph_window != baked.morph_window ||
+    if (exponent == 0) exponent = baked.patch_exponent;
+    if (exponent != baked.patch_exponent || desc.morph_window != baked.morph_window ||
         (desc.morph_window > 0.0 && desc.morph_delay != baked.morph_delay))
       return Error{fmt("landscape: %s was baked for patch exponent %u, morph window %s "
                        "and delay %s; this landscape asks for %u, %s and %s (bake it again "
                        "with ridge bake --patch-exponent / --morph-window / --morph-delay)",
                        info.name.c_str(), baked.patch_exponent, num(baked.morph_window).c_str(),
-                       num(baked.morph_delay).c_str(), K, num(desc.morph_window).c_str(),
+                       num(baked.morph_delay).c_str(), exponent, num(desc.morph_window).c_str(),
                        num(desc.morph_delay).c_str())};
   }
-  if (K == 0) K = roam::default_patch_exponent(info.width, info.height);
+  if (exponent == 0) exponent = roam::default_patch_exponent(info.width, info.height);
   std::shared_ptr<Landscape> l(new Landscape());
   l->terrain_ = std::move(terrain);
-  l->exponent_ = K;
+  l->exponent_ = exponent;
   l->detail_ = surface.detail_levels();
   l->geomorph_ = {desc.morph_window, desc.morph_window > 0.0 ? desc.morph_delay : 0.0};
-  const std::int64_t p = std::int64_t{1} << K;  // stored cells per patch
+  const std::int64_t p = std::int64_t{1} << exponent;  // stored cells per patch
   l->patches_x_ = static_cast<std::uint32_t>((info.width - 1 + p - 1) / p);
   l->patches_z_ = static_cast<std::uint32_t>((info.height - 1 + p - 1) / p);
   if (std::uint64_t{l->patches_x_} * l->patches_z_ > (std::uint64_t{1} << 26))
@@ -426,10 +427,10 @@ Result<std::shared_ptr<const Landscape>> Landscape::create(std::shared_ptr<const
     }
   }
   roam::RecordConfig& c = im->config;
-  c.K = int(K);
+  c.patch_log2 = int(exponent);
   c.growth = im->morph_growth;
   c.last_i = info.width - 1, c.last_j = info.height - 1;
-  c.pad_i = std::int64_t(l->patches_x_) << K, c.pad_j = std::int64_t(l->patches_z_) << K;
+  c.pad_i = std::int64_t(l->patches_x_) << exponent, c.pad_j = std::int64_t(l->patches_z_) << exponent;
   c.spacing_x = info.spacing_x, c.spacing_z = info.spacing_z;
   c.L = l->detail_;
   if (c.L > 0) {
@@ -458,10 +459,10 @@ Result<std::shared_ptr<const Landscape>> Landscape::create(std::shared_ptr<const
     const world::PageGrid& g = store.grid();
     std::vector<float> dense(std::size_t(info.width) * info.height);
     {
-      const detail::StoredLattice st(store, SurfaceLattice{});
+      const detail::StoredLattice stored(store, SurfaceLattice{});
       for (std::int64_t j = 0; j <= g.last_j; ++j)
         for (std::int64_t i = 0; i <= g.last_i; ++i)
-          dense[std::size_t(i) + std::size_t(j) * info.width] = st.local(i, j);
+          dense[std::size_t(i) + std::size_t(j) * info.width] = stored.local(i, j);
     }
     roam::Heights h;
     h.f32 = dense.data(), h.stride = info.width, h.last_i = g.last_i, h.last_j = g.last_j;

@@ -2,6 +2,7 @@
 #include "roam/patch_output.h"
 
 #include <algorithm>
+#include <bit>
 #include <cfloat>
 #include <glm/geometric.hpp>
 
@@ -201,7 +202,7 @@ void to_ranges(std::vector<std::uint64_t>& bits, std::vector<MeshRange>& out) {
     std::uint64_t b = bits[w];
     bits[w] = 0;
     while (b != 0) {
-      const auto s = std::uint32_t(w * 64 + std::size_t(__builtin_ctzll(b)));
+      const auto s = std::uint32_t(w * 64 + std::size_t(std::countr_zero(b)));
       b &= b - 1;
       if (!out.empty() && out.back().first + out.back().count == s)
         ++out.back().count;

@@ -19,7 +19,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "memory_hints.h"
+#include "platform/memory_hints.h"
 #include "ridgeline/landscape.h"
 #include "ridgeline/roam_view.h"
 #include "roam/landscape_access.h"

@@ -172,10 +172,10 @@ struct RecordBlock {
 
 /// What the bounds depend on besides the heights (a Landscape's configuration).
 struct RecordConfig {
-  int K = 6;                      ///< patch exponent of the stored lattice
+  int patch_log2 = 6;             ///< patch exponent of the stored lattice
   double growth = 1.0;            ///< the morph bound's growth per level
   std::int64_t last_i = 0, last_j = 0;  ///< the last stored sample
-  std::int64_t pad_i = 0, pad_j = 0;    ///< the padded extent: patches * 2^K
+  std::int64_t pad_i = 0, pad_j = 0;    ///< the padded extent: patches * 2^patch_log2
   double spacing_x = 1, spacing_z = 1;  ///< stored spacing, metres
   /// Procedural detail (L > 0): the stored diamonds' bounds include it (in memory only).
   std::uint32_t L = 0;
@@ -210,11 +210,11 @@ struct Heights {
 /// bake's default: 6 (65 x 65 samples), raised until there are at most 64 patches per side (at
 /// most 10).
 inline std::uint32_t default_patch_exponent(std::uint32_t width, std::uint32_t height) noexcept {
-  std::uint32_t K = 6;
-  while (K < 10 && ((std::int64_t(width - 1) + (std::int64_t{1} << K) - 1) >> K > 64 ||
-                    (std::int64_t(height - 1) + (std::int64_t{1} << K) - 1) >> K > 64))
-    ++K;
-  return K;
+  std::uint32_t exponent = 6;
+  while (exponent < 10 && ((std::int64_t(width - 1) + (std::int64_t{1} << exponent) - 1) >> exponent > 64 ||
+                    (std::int64_t(height - 1) + (std::int64_t{1} << exponent) - 1) >> exponent > 64))
+    ++exponent;
+  return exponent;
 }
 
 /// v rounded up to a float (never below the double).

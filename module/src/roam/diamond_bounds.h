@@ -1,0 +1,340 @@
+// Private (records.cpp): the bound and sphere of one stored diamond from the heights: the exact
+// error of its triangles (a table of the small ones), made nested over its children, and the
+// t <= 1 diamonds of a block of samples that the level-0 blocks and the bake share. Templates
+// over the height accessor, so that the dense paths read plain arrays.
+#pragma once
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <vector>
+
+#include "ridgeline/detail.h"
+#include "ridgeline/log.h"
+#include "roam/diamond.h"
+#include "roam/records.h"
+
+namespace ridgeline::roam::bounds {
+
+// True when a diamond at v with reach r has every existing descendant within samples [lo, hi]
+// along one axis (descendants past the world's first sample or its padded extent do not exist).
+inline bool within(std::int64_t v, std::int64_t r, std::int64_t lo, std::int64_t hi,
+            std::int64_t pad) noexcept {
+  return (v - r >= lo || lo <= 0) && (v + r <= hi || hi >= pad);
+}
+
+inline std::int64_t floor_div(std::int64_t n, std::int64_t d) noexcept {  // d > 0
+  return n >= 0 ? n / d : -((-n + d - 1) / d);
+}
+// floor_div() by a shift when d is a power of two (the bintree's triangles' edges always are).
+inline std::int64_t floor_div_fast(std::int64_t n, std::int64_t d) noexcept {  // d > 0
+  if ((d & (d - 1)) == 0) return n >> std::countr_zero(std::uint64_t(d));
+  return floor_div(n, d);
+}
+
+// Heights of samples lo .. hi of row z into out[0 .. hi - lo]: the accessor's rule, with fast
+// paths for dense rows (the values are the accessor's, bit for bit).
+template <class H>
+void read_row(const H& h, std::int64_t z, std::int64_t lo, std::int64_t hi, float* out) {
+  for (std::int64_t x = lo; x <= hi; ++x) out[x - lo] = h(x, z);
+}
+inline void read_row(const Heights& h, std::int64_t z, std::int64_t lo, std::int64_t hi, float* out) {
+  if ((h.f32 == nullptr && h.u16 == nullptr) || z < 0 || z > h.last_j || lo < 0 ||
+      hi > h.last_i) {
+    for (std::int64_t x = lo; x <= hi; ++x) out[x - lo] = h(x, z);
+    return;
+  }
+  const std::size_t e = std::size_t(lo) + std::size_t(z) * std::size_t(h.stride);
+  const std::size_t n = std::size_t(hi - lo + 1);
+  if (h.f32 != nullptr) {
+    std::memcpy(out, h.f32 + e, n * sizeof(float));
+  } else {
+    const std::uint16_t* u = h.u16 + e;
+    const double scale = h.scale;
+    for (std::size_t k = 0; k < n; ++k) out[k] = static_cast<float>(scale * double(u[k]));
+  }
+}
+
+// Heights of a square block of samples copied out of an accessor (its values bit for bit): what
+// the finest diamonds' bounds read, without the accessor's clamping and branches.
+struct DenseBlock {
+  const float* p;
+  std::int64_t i0, j0, n;
+  float operator()(std::int64_t i, std::int64_t j) const noexcept {
+    RIDGELINE_ASSERT(i >= i0 && j >= j0 && i < i0 + n && j < j0 + n);
+    return p[std::size_t(i - i0) + std::size_t(j - j0) * std::size_t(n)];
+  }
+};
+
+// The samples inside the small bintree triangles (legs of at most 4 cells: the diamonds of
+// t <= 1, most of every world's diamonds), with their edge functions, by the apex's legs: a table
+// built once instead of each row's span.
+struct SmallTriangles {
+  struct Sample {
+    std::int8_t dx, dz;        // from the apex
+    std::int16_t wa, wl, wr;   // plane * |w| = wa ha + wl hl + wr hr
+  };
+  static constexpr int kMax = 4;
+  static constexpr int kSide = 2 * kMax + 1;
+  // Entry (ux, uz, turn): L - A = (ux, uz), R - A = (ux, uz) turned by +-90 degrees.
+  std::vector<Sample> samples[kSide * kSide * 2];
+  int aw[kSide * kSide * 2] = {};
+
+  static int index(std::int64_t ux, std::int64_t uz, bool left) noexcept {
+    return int((ux + kMax) + (uz + kMax) * kSide) * 2 + (left ? 1 : 0);
+  }
+  SmallTriangles() {
+    for (int uz = -kMax; uz <= kMax; ++uz)
+      for (int ux = -kMax; ux <= kMax; ++ux)
+        for (const bool left : {false, true}) {
+          if (ux == 0 && uz == 0) continue;
+          const int vx = left ? -uz : uz, vz = left ? ux : -ux;  // R - A
+          const int w = ux * vz - uz * vx;
+          const int sgn = w > 0 ? 1 : -1;
+          const int k = index(ux, uz, left);
+          aw[k] = w * sgn;
+          const int x0 = std::min({0, ux, vx}), x1 = std::max({0, ux, vx});
+          const int z0 = std::min({0, uz, vz}), z1 = std::max({0, uz, vz});
+          for (int z = z0; z <= z1; ++z)
+            for (int x = x0; x <= x1; ++x) {
+              if ((x == 0 && z == 0) || (x == ux && z == uz) || (x == vx && z == vz)) continue;
+              const int e_ab = (ux * z - uz * x) * sgn;                         // A -> L
+              const int e_lr = ((vx - ux) * (z - uz) - (vz - uz) * (x - ux)) * sgn;  // L -> R
+              const int e_ra = ((-vx) * (z - vz) - (-vz) * (x - vx)) * sgn;     // R -> A
+              if (e_ab < 0 || e_lr < 0 || e_ra < 0) continue;
+              samples[k].push_back({std::int8_t(x), std::int8_t(z), std::int16_t(e_lr),
+                                    std::int16_t(e_ra), std::int16_t(e_ab)});
+            }
+        }
+  }
+  // The table entry of triangle t, or null when it is not a small right isosceles triangle with
+  // its right angle at the apex.
+  int find(const LatticeTriangle& t) const noexcept {
+    const std::int64_t ux = t.lx - t.ax, uz = t.lz - t.az, vx = t.rx - t.ax, vz = t.rz - t.az;
+    if (ux < -kMax || ux > kMax || uz < -kMax || uz > kMax) return -1;
+    if (vx == -uz && vz == ux) return index(ux, uz, true);
+    if (vx == uz && vz == -ux) return index(ux, uz, false);
+    return -1;
+  }
+};
+
+inline const SmallTriangles& small_triangles() {
+  static const SmallTriangles table;
+  return table;
+}
+
+// Exact error against the stored lattice of a triangle in stored coordinates: the largest
+// |height - plane| over the samples inside it (edge functions in integer arithmetic, the span of
+// each row found exactly). Heights past the data repeat the edge (the accessor clamps). The
+// plane is evaluated scaled by the triangle's doubled area w (|h w - (S x + T)|, then / |w|):
+// the products of heights and integers are exact in doubles.
+template <class H>
+float exact_triangle(const H& h, const LatticeTriangle& t) {
+  const std::int64_t x0 = std::min({t.ax, t.lx, t.rx}), x1 = std::max({t.ax, t.lx, t.rx});
+  const std::int64_t z0 = std::min({t.az, t.lz, t.rz}), z1 = std::max({t.az, t.lz, t.rz});
+  const double ha = h(t.ax, t.az), hl = h(t.lx, t.lz), hr = h(t.rx, t.rz);
+  auto cross = [](std::int64_t ux, std::int64_t uz, std::int64_t vx, std::int64_t vz) {
+    return ux * vz - uz * vx;
+  };
+  const std::int64_t w = cross(t.lx - t.ax, t.lz - t.az, t.rx - t.ax, t.rz - t.az);
+  if (w == 0) return 0.0f;
+  const std::int64_t sgn = w > 0 ? 1 : -1;
+  const double aw = double(w * sgn);
+  const SmallTriangles& small = small_triangles();
+  if (const int k = small.find(t); k >= 0) {
+    double worst = 0.0;
+    for (const SmallTriangles::Sample& q : small.samples[k]) {
+      const double d = std::abs(double(h(t.ax + q.dx, t.az + q.dz)) * aw -
+                                (double(q.wa) * ha + double(q.wl) * hl + double(q.wr) * hr));
+      worst = d > worst ? d : worst;
+    }
+    return round_up(worst / aw);
+  }
+  thread_local std::vector<float> row;
+  if (row.size() < std::size_t(x1 - x0 + 1)) row.resize(std::size_t(x1 - x0 + 1));
+  double worst = 0.0;
+  const std::int64_t ex[3][2] = {{t.ax, t.az}, {t.lx, t.lz}, {t.rx, t.rz}};
+  const int from[3] = {0, 1, 2}, to[3] = {1, 2, 0};
+  for (std::int64_t z = z0; z <= z1; ++z) {
+    std::int64_t lo = x0, hi = x1;
+    std::int64_t coef[3], off[3];
+    for (int k = 0; k < 3; ++k) {
+      const std::int64_t px = ex[from[k]][0], pz = ex[from[k]][1];
+      const std::int64_t ux = ex[to[k]][0] - px, uz = ex[to[k]][1] - pz;
+      // e(x) = ux * (z - pz) - uz * (x - px) = a * x + c, made >= 0 inside by the sign.
+      const std::int64_t a = -uz * sgn, c = (ux * (z - pz) + uz * px) * sgn;
+      coef[k] = a, off[k] = c;
+      if (a > 0)
+        lo = std::max(lo, -floor_div_fast(c, a));  // x >= ceil(-c / a)
+      else if (a < 0)
+        hi = std::min(hi, floor_div_fast(c, -a));  // x <= floor(c / -a)
+      else if (c < 0)
+        lo = hi + 1;  // edge parallel to x, row outside
+    }
+    if (lo > hi) continue;
+    // plane(x) * |w| = e_lr(x) ha + e_ra(x) hl + e_ab(x) hr = S x + T, with x relative to lo.
+    const double S = double(coef[1]) * ha + double(coef[2]) * hl + double(coef[0]) * hr;
+    const double T = double(coef[1] * lo + off[1]) * ha + double(coef[2] * lo + off[2]) * hl +
+                     double(coef[0] * lo + off[0]) * hr;
+    read_row(h, z, lo, hi, row.data());
+    const std::int64_t n = hi - lo + 1;
+    double m0 = 0.0, m1 = 0.0;
+    std::int64_t x = 0;
+    for (; x + 1 < n; x += 2) {
+      const double d0 = std::abs(double(row[std::size_t(x)]) * aw - (S * double(x) + T));
+      const double d1 = std::abs(double(row[std::size_t(x + 1)]) * aw - (S * double(x + 1) + T));
+      m0 = d0 > m0 ? d0 : m0;
+      m1 = d1 > m1 ? d1 : m1;
+    }
+    if (x < n) {
+      const double d0 = std::abs(double(row[std::size_t(x)]) * aw - (S * double(x) + T));
+      m0 = d0 > m0 ? d0 : m0;
+    }
+    worst = std::max(worst, std::max(m0, m1));
+  }
+  return round_up(worst / aw);  // never below the double error
+}
+
+// diamond_bound() over any height accessor.
+template <class H, class Child>
+DiamondBound bound_of(const RecordConfig& c, const H& h, std::int64_t i, std::int64_t j,
+                      const Child& child) {
+  const int L = int(c.L);
+  const Diamond d = diamond_at(i, j, c.patch_log2);
+  if (L == 0 && d.t == 0 && !d.square) {
+    const bool horizontal = (i & 1) != 0;
+    return edge_bound_of(c, h(i, j), horizontal ? h(i - 1, j) : h(i, j - 1),
+                         horizontal ? h(i + 1, j) : h(i, j + 1), i, j, horizontal);
+  }
+  const std::int64_t W = c.pad_i, Hh = c.pad_j;
+  std::int64_t hx0, hz0, hx1, hz1, ax0, az0, ax1, az1;
+  d.hypotenuse(hx0, hz0, hx1, hz1);
+  d.apexes(ax0, az0, ax1, az1);
+  const std::int64_t wi = c.last_i, hj = c.last_j;
+  double err = 0;
+  bool any_data = false, straddles = false;
+  const std::int64_t apex[2][2] = {{ax0, az0}, {ax1, az1}};
+  for (const auto& a : apex) {
+    if (a[0] < 0 || a[1] < 0 || a[0] > W || a[1] > Hh) continue;
+    const LatticeTriangle t{a[0], a[1], hx0, hz0, hx1, hz1};
+    const Landscape::LatticeBox b = Landscape::box_of(t);
+    // A triangle over the data's border must split until none does: the mesh then ends on it.
+    straddles |= (b.i0 < wi && wi < b.i1) || (b.j0 < hj && hj < b.j1);
+    if (b.i0 >= wi || b.j0 >= hj) continue;  // wholly padding: not terrain, never refined
+    any_data = true;
+    double e = exact_triangle(h, t);
+    if (L > 0)
+      e += c.detail->contribution_bound(1, std::uint32_t(L), b.i0 << L, b.j0 << L, b.i1 << L,
+                                        b.j1 << L);
+    err = std::max(err, e);
+  }
+  if (!any_data) err = 0;
+  double morph = err, radius = 0;
+  const double hv = h(i, j);
+  auto visit = [&](const DiamondBound& cb, double dist) {
+    err = std::max(err, double(cb.error));
+    morph = std::max(morph, c.growth * double(cb.morph));
+    radius = std::max(radius, double(cb.radius) + dist);
+    straddles |= cb.radius >= FLT_MAX;
+  };
+  if (d.has_children()) {
+    for (int k = 0; k < 4; ++k) {
+      std::int64_t ci, cj;
+      d.child(k, ci, cj);
+      if (ci < 0 || cj < 0 || ci > W || cj > Hh) continue;
+      const double dx = double(ci - i) * c.spacing_x, dz = double(cj - j) * c.spacing_z;
+      const double dy = double(h(ci, cj)) - hv;
+      visit(child(ci, cj), std::sqrt(dx * dx + dz * dz + dy * dy));
+    }
+  } else if (L > 0) {
+    // The finest stored diamonds' children are detail diamonds at half the stored spacing (in
+    // finest coordinates, half of 2^L): their heights are only known within the detail bound.
+    const Diamond fd = diamond_at(i << L, j << L, c.patch_log2 + L);
+    const double fsx = std::ldexp(c.spacing_x, -L), fsz = std::ldexp(c.spacing_z, -L);
+    for (int k = 0; k < 4; ++k) {
+      std::int64_t ci, cj;
+      fd.child(k, ci, cj);
+      if (ci < 0 || cj < 0 || ci > (W << L) || cj > (Hh << L)) continue;
+      const double dx = double(ci - (i << L)) * fsx, dz = double(cj - (j << L)) * fsz;
+      // The child's base height: the stored cell's plane at the child (a half-cell midpoint:
+      // the mean of the two stored samples at the ends of the edge or diagonal it halves).
+      const std::int64_t e0x = (ci - (std::int64_t{1} << (L - 1))) >> L;
+      const std::int64_t e1x = (ci + (std::int64_t{1} << (L - 1))) >> L;
+      const std::int64_t e0z = (cj - (std::int64_t{1} << (L - 1))) >> L;
+      const std::int64_t e1z = (cj + (std::int64_t{1} << (L - 1))) >> L;
+      const bool midx = ((ci >> (L - 1)) & 1) != 0, midz = ((cj >> (L - 1)) & 1) != 0;
+      double base;
+      if (midx && midz) {
+        // A cell's centre: the diagonal of the diagonal rule.
+        const bool main = cell_has_main_diagonal(e0x, e0z);
+        base = main ? 0.5 * (double(h(e0x, e0z)) + double(h(e1x, e1z)))
+                    : 0.5 * (double(h(e1x, e0z)) + double(h(e0x, e1z)));
+      } else if (midx) {
+        base = 0.5 * (double(h(e0x, cj >> L)) + double(h(e1x, cj >> L)));
+      } else {
+        base = 0.5 * (double(h(ci >> L, e0z)) + double(h(ci >> L, e1z)));
+      }
+      const double dy = std::abs(base - hv) + double(c.detail_offset(ci, cj));
+      visit(c.detail_child(ci, cj), std::sqrt(dx * dx + dz * dz + dy * dy));
+    }
+  }
+  if (straddles) radius = FLT_MAX;
+  return quantized(
+      {round_up(err), round_up(morph), radius >= FLT_MAX ? FLT_MAX : round_up(radius)});
+}
+
+template <class H>
+DiamondBound edge_of(const RecordConfig& c, const H& h, std::int64_t i, std::int64_t j) {
+  // No children, and no detail: the only vertex under the two triangles but their corners is
+  // the centre, on the hypotenuse. bound_of() with no children does exactly this.
+  return bound_of(c, h, i, j, [](std::int64_t, std::int64_t) { return DiamondBound{}; });
+}
+
+
+// The bounds of every t <= 1 diamond whose descendants lie in the block of samples
+// [i0, i0 + n) x [j0, j0 + n) (or past the padded extent, where they do not exist), finest
+// first, into out[(i - i0) + (j - j0) n]; other entries are left as they are. `h`: the block's
+// heights. The level-0 blocks and the bake's t = 1 squares both come from here, so both hold
+// the same values.
+inline void small_bounds(const RecordConfig& c, const DenseBlock& h, std::vector<DiamondBound>& out) {
+  const std::int64_t i0 = h.i0, j0 = h.j0, n = h.n;
+  out.resize(std::size_t(n * n));
+  auto at = [&](std::int64_t i, std::int64_t j) -> DiamondBound {
+    const std::int64_t a = i - i0, b = j - j0;
+    if (a < 0 || b < 0 || a >= n || b >= n) return DiamondBound{};
+    return out[std::size_t(a + b * n)];
+  };
+  // Kinds in order: t = 0 edge, t = 0 square, t = 1 edge, t = 1 square; the residues of their
+  // centres (i mod m, j mod m).
+  struct Kind {
+    int t;
+    bool square;
+    std::int64_t m;
+    int count;
+    std::int64_t ri[2], rj[2];
+  };
+  static constexpr Kind kinds[4] = {{0, false, 2, 2, {1, 0}, {0, 1}},
+                                    {0, true, 2, 1, {1, 0}, {1, 0}},
+                                    {1, false, 4, 2, {2, 0}, {0, 2}},
+                                    {1, true, 4, 1, {2, 0}, {2, 0}}};
+  for (const Kind& k : kinds) {
+    const std::int64_t r = (k.square ? 3 : 2) << k.t;
+    for (int v = 0; v < k.count; ++v) {
+      auto first = [&](std::int64_t lo, std::int64_t res) {
+        return lo + (((res - lo) % k.m) + k.m) % k.m;
+      };
+      for (std::int64_t j = first(j0, k.rj[v]); j < j0 + n; j += k.m) {
+        if (j < 0 || j > c.pad_j || !within(j, r, j0, j0 + n - 1, c.pad_j)) continue;
+        for (std::int64_t i = first(i0, k.ri[v]); i < i0 + n; i += k.m) {
+          if (i < 0 || i > c.pad_i || !within(i, r, i0, i0 + n - 1, c.pad_i)) continue;
+          // The residues make (i, j) a diamond of this kind (t <= 1 < patch_log2: never a corner).
+          out[std::size_t((i - i0) + (j - j0) * n)] = bound_of(c, h, i, j, at);
+        }
+      }
+    }
+  }
+}
+
+}  // namespace ridgeline::roam::bounds
