@@ -14,10 +14,12 @@ namespace ridgeline::bench {
 
 using Clock = std::chrono::steady_clock;
 
-/// Wall milliseconds from `t0` to now (steady clock).
-inline double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+/// Wall milliseconds from `a` to `b` (negative when `b` is earlier).
+inline double ms_between(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
 }
+/// Wall milliseconds from `t0` to now (steady clock).
+inline double ms_since(Clock::time_point t0) { return ms_between(t0, Clock::now()); }
 
 /// CPU milliseconds of the calling thread so far (CLOCK_THREAD_CPUTIME_ID): unlike wall time it
 /// does not count the time the thread waits for a core, which on a shared machine can dominate.
