@@ -1,40 +1,31 @@
 // `ridge bench queries`: nanoseconds per query on uniformly random points, medians over
-// repetitions (definitions in issue 2, "Speed to reach").
+// repetitions (docs/benchmarks.md).
 #include "bench_queries.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <glm/geometric.hpp>
 #include <random>
 #include <vector>
 
 #include "cli_util.h"
+#include "ridgeline/bench/clock.h"
+#include "ridgeline/bench/stats.h"
 
 namespace ridgeline::cli {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using bench::median;
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-// Wall and thread-CPU nanoseconds per item of one run of a timed loop.
+// Wall and thread-CPU nanoseconds per item of runs of a timed loop.
 struct Timing {
   std::vector<double> wall, cpu;
   template <class F>
   void run(std::size_t items, F&& body) {
-    const double c0 = thread_cpu_ns();
-    const auto t0 = Clock::now();
-    body();
-    const auto t1 = Clock::now();
-    const double c1 = thread_cpu_ns();
-    wall.push_back(std::chrono::duration<double, std::nano>(t1 - t0).count() / double(items));
-    cpu.push_back((c1 - c0) / double(items));
+    const bench::Timing t = bench::timed(body);
+    wall.push_back(t.wall_ms * 1e6 / double(items));
+    cpu.push_back(t.cpu_ms * 1e6 / double(items));
   }
 };
 

@@ -18,7 +18,7 @@ struct BenchQueriesOptions {
 
 /// Measures ns per height query (one call per point, and batched: one Terrain::heights call for
 /// all points), per height+normal, per vertical ray and per slanted ray crossing 256 cells (see
-/// issue 2 for the definitions) and returns {"height_ns":..,"batched_height_ns":..,
+/// docs/benchmarks.md for the definitions) and returns {"height_ns":..,"batched_height_ns":..,
 /// "height_normal_ns":..,"vertical_ray_ns":..,"slanted_ray_ns":..,
 ///  "bytes_per_sample":.., "points":.., "repetitions":.., ...} with medians.
 nlohmann::json bench_queries(const Terrain& terrain, const BenchQueriesOptions& options);

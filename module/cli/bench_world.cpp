@@ -27,6 +27,8 @@
 #include <vector>
 
 #include "ridgeline/edit.h"
+#include "ridgeline/bench/clock.h"
+#include "ridgeline/bench/stats.h"
 #include "ridgeline/landscape.h"
 #include "ridgeline/roam_view.h"
 #include "ridgeline/scenes.h"
@@ -34,13 +36,10 @@
 #include "ridgeline/world_file.h"
 
 using namespace ridgeline;
-using Clock = std::chrono::steady_clock;
+using bench::Clock;
+using bench::ms_between;
 
 namespace {
-
-double ms_between(Clock::time_point a, Clock::time_point b) {
-  return std::chrono::duration<double, std::milli>(b - a).count();
-}
 
 // The process's resident memory (VmRSS) and its peak since the last reset (VmHWM), bytes.
 std::size_t status_bytes(const char* key) {
@@ -62,13 +61,8 @@ std::string load_average() {
   return a + " " + b + " " + c;
 }
 
-// Quantile q of `v` (sorted copy): the nearest-rank definition, element ceil(q n) - 1.
-double quantile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const std::size_t k = std::size_t(std::ceil(q * double(v.size())));
-  return v[std::min(v.size() - 1, k == 0 ? 0 : k - 1)];
-}
+// The quantile of ridgeline/bench/stats.h (rank floor(q n)), 0 for an empty series.
+double quantile(const std::vector<double>& v, double q) { return bench::quantile_or(v, q, 0.0); }
 
 struct Options {
   std::string dir = "build/worlds";

@@ -1,16 +1,10 @@
 #include "cli_util.h"
 
-#if defined(__GLIBC__)
-#include <malloc.h>
-#endif
-
-#include <sys/resource.h>
 #include <unistd.h>
 
 #include <charconv>
 #include <cmath>
 #include <cstdio>
-#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -155,33 +149,6 @@ void install_log_sink() {
     std::fprintf(stderr, "ridge: %s: %.*s\n", tag, static_cast<int>(message.size()),
                  message.data());
   });
-}
-
-void keep_freed_memory() {
-#if defined(__GLIBC__)
-  (void)mallopt(M_MMAP_THRESHOLD, 1 << 30);
-  (void)mallopt(M_TRIM_THRESHOLD, 1 << 30);
-#endif
-}
-
-void OtherWork::touch() noexcept {
-  unsigned s = 0;
-  for (std::size_t k = 0; k < bytes_.size(); k += 64) s += bytes_[k]++;
-  // Kept, so the loop is not optimised away.
-  sink_ += s;
-  asm volatile("" : : "r"(sink_) : "memory");
-}
-
-double thread_cpu_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return double(ts.tv_sec) * 1e9 + double(ts.tv_nsec);
-}
-
-long thread_minor_faults() {
-  rusage u{};
-  getrusage(RUSAGE_THREAD, &u);
-  return u.ru_minflt;
 }
 
 }  // namespace ridgeline::cli

@@ -53,34 +53,6 @@ int report_usage(const std::string& message);
 /// current directory.
 Status check_output_folder(const std::string& path, const std::string& what);
 
-/// CPU time of the calling thread, nanoseconds (CLOCK_THREAD_CPUTIME_ID): unlike wall time it
-/// does not count the time the thread waits for a core, which on a shared machine can dominate.
-double thread_cpu_ns();
-/// Minor page faults of the calling thread so far (getrusage): a fresh page costs the first
-/// write to it ~11 us on this project's virtual machines, so a first update's time is mostly
-/// its faults (docs/benchmarks.md).
-long thread_minor_faults();
-/// For benchmarks that time one piece of work per frame and measure it between frames: keeps
-/// the memory the measurement frees inside the process (glibc: no unmapping, no trimming).
-/// Otherwise a measurement that frees a large buffer unmaps it, which flushes the TLB, and the
-/// next timed frame pays for refilling it (here ~0.5 ms for a 50k-triangle view): a cost of
-/// the benchmark, not of the work timed. Applies to every mode alike.
-void keep_freed_memory();
-
-/// The rest of a game's frame, for benchmarks that time one piece of work per frame: touch()
-/// reads and writes one byte in every cache line of `mib` MiB of other memory, so the next
-/// timed frame finds the caches holding that memory instead of the terrain's. Every mode of a
-/// benchmark calls it at the same place (0 MiB: nothing).
-class OtherWork {
- public:
-  explicit OtherWork(double mib) : bytes_(std::size_t(mib * 1048576.0), 1) {}
-  void touch() noexcept;
-
- private:
-  std::vector<unsigned char> bytes_;
-  unsigned sink_ = 0;
-};
-
 /// Installs a log sink that prints the library's info, warning and error messages to stderr.
 void install_log_sink();
 

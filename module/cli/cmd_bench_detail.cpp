@@ -1,7 +1,7 @@
 // `ridge bench detail`: detail tile generation time per level on one core, bytes per tile, and
 // the detail cache along a camera path (a PATH.json or a built-in straight flight): per frame,
 // the tiles the request rule asks for (detail_stream.h), resident bytes, pending tiles, lag and
-// generation rate. JSON; docs/cli.md and docs/benchmarks.md ("Detail streaming").
+// generation rate. JSON; docs/cli.md and docs/detail.md.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -11,6 +11,8 @@
 #include <thread>
 
 #include "cli_util.h"
+#include "ridgeline/bench/clock.h"
+#include "ridgeline/bench/stats.h"
 #include "commands.h"
 #include "ridgeline/camera_path.h"
 #include "ridgeline/detail_stream.h"
@@ -20,7 +22,7 @@ namespace ridgeline::cli {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using bench::Clock;
 
 struct BenchDetailArgs {
   TerrainArgs terrain;
@@ -33,13 +35,6 @@ struct BenchDetailArgs {
   std::string frames_every = "60";
   std::string json_path;
 };
-
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const std::size_t k = std::min(v.size() - 1, static_cast<std::size_t>(q * double(v.size())));
-  return v[k];
-}
 
 // Peak resident set of this process (VmHWM), bytes; 0 where /proc is not there.
 std::size_t peak_rss_bytes() {
@@ -70,7 +65,7 @@ nlohmann::ordered_json time_tiles(const DetailField& f, int reps, std::size_t* t
     for (int r = -3; r < reps; ++r) {  // three unreported warm-up runs
       const auto t0 = Clock::now();
       const auto tile = f.make_tile(key, parent.get());
-      const double t = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+      const double t = bench::ms_since(t0);
       sink = sink + tile->raw(64, 64);
       *tile_bytes = tile->memory_bytes();
       if (r >= 0) ms.push_back(t);
@@ -78,9 +73,9 @@ nlohmann::ordered_json time_tiles(const DetailField& f, int reps, std::size_t* t
     const double spacing = std::ldexp(std::max(f.spacing_x(), f.spacing_z()), -int(level));
     out.push_back({{"level", level},
                    {"spacing_m", spacing},
-                   {"median_ms", percentile(ms, 0.5)},
-                   {"p99_ms", percentile(ms, 0.99)},
-                   {"min_ms", percentile(ms, 0.0)},
+                   {"median_ms", bench::quantile_or(ms, 0.5, 0)},
+                   {"p99_ms", bench::quantile_or(ms, 0.99, 0)},
+                   {"min_ms", bench::quantile_or(ms, 0.0, 0)},
                    {"bytes", *tile_bytes}});
   }
   return out;
@@ -206,7 +201,7 @@ int run_bench_detail(const BenchDetailArgs& a) {
   const auto field_t0 = Clock::now();
   auto t = a.terrain.load_terrain();
   if (!t) return report_error(t.error().message);
-  const double load_ms = std::chrono::duration<double, std::milli>(Clock::now() - field_t0).count();
+  const double load_ms = bench::ms_since(field_t0);
   const std::shared_ptr<const Terrain> terrain = *t;
   const WorldInfo& hf = terrain->info();
   if (!terrain->surface().detail()) return report_error("the terrain has no detail field");
@@ -365,7 +360,7 @@ int run_bench_detail(const BenchDetailArgs& a) {
       {"max_working_set_bytes", max_requested * tile_bytes},
       {"max_requested_tiles", max_requested},
       {"max_needed_tiles", max_needed},
-      {"needed_resident_fraction_min", percentile(fraction, 0.0)},
+      {"needed_resident_fraction_min", bench::quantile_or(fraction, 0.0, 0)},
       {"needed_resident_fraction_mean",
        fraction.empty() ? 1.0 : [&] {
          double s = 0;
@@ -381,17 +376,17 @@ int run_bench_detail(const BenchDetailArgs& a) {
       {"max_pending", max_pending},
       {"generated", cs.generated},
       {"evicted", cs.evicted},
-      {"generated_per_second_median", percentile(gen_rate, 0.5)},
-      {"generated_per_second_max", percentile(gen_rate, 1.0)},
+      {"generated_per_second_median", bench::quantile_or(gen_rate, 0.5, 0)},
+      {"generated_per_second_max", bench::quantile_or(gen_rate, 1.0, 0)},
       {"generation_ms_per_tile",
        cs.generated ? 1000.0 * cs.generation_seconds / double(cs.generated) : 0.0},
-      {"frame_ms_median", percentile(frame_ms, 0.5)},
-      {"frame_ms_p99", percentile(frame_ms, 0.99)},
-      {"frame_ms_max", percentile(frame_ms, 1.0)},
-      {"request_ms_median", percentile(request_ms, 0.5)},
-      {"request_ms_p99", percentile(request_ms, 0.99)},
-      {"update_ms_median", percentile(update_ms, 0.5)},
-      {"update_ms_p99", percentile(update_ms, 0.99)},
+      {"frame_ms_median", bench::quantile_or(frame_ms, 0.5, 0)},
+      {"frame_ms_p99", bench::quantile_or(frame_ms, 0.99, 0)},
+      {"frame_ms_max", bench::quantile_or(frame_ms, 1.0, 0)},
+      {"request_ms_median", bench::quantile_or(request_ms, 0.5, 0)},
+      {"request_ms_p99", bench::quantile_or(request_ms, 0.99, 0)},
+      {"update_ms_median", bench::quantile_or(update_ms, 0.5, 0)},
+      {"update_ms_p99", bench::quantile_or(update_ms, 0.99, 0)},
       {"overrun_frames", overrun_frames},
       {"cache_frames", cs.frame - frame0},
       {"process_peak_rss_bytes", peak_rss_bytes()}};

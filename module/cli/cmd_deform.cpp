@@ -1,7 +1,6 @@
 // `ridge deform` (apply an edit list, save the state) and `ridge bench deform` (cost of one edit
 // and of the view update that follows it).
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <limits>
 #include <memory>
@@ -9,6 +8,8 @@
 #include <random>
 
 #include "cli_util.h"
+#include "ridgeline/bench/clock.h"
+#include "ridgeline/bench/stats.h"
 #include "commands.h"
 #include "ridgeline/edit.h"
 #include "ridgeline/edit_json.h"
@@ -47,7 +48,7 @@ int run_deform(const DeformArgs& a) {
   std::uint64_t samples = 0;
   Box total{glm::dvec3(std::numeric_limits<double>::infinity()),
             glm::dvec3(-std::numeric_limits<double>::infinity())};
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = bench::Clock::now();
   for (std::size_t k = 0; k < edits->size(); ++k) {
     auto r = t.apply_edit((*edits)[k]);
     if (!r) return report_error("edits[" + std::to_string(k) + "]: " + r.error().message);
@@ -62,8 +63,7 @@ int run_deform(const DeformArgs& a) {
     total.min = glm::min(total.min, r->changed.min);
     total.max = glm::max(total.max, r->changed.max);
   }
-  const double ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  const double ms = bench::ms_since(t0);
   if (!a.save.empty())
     if (auto s = save_edits(t, a.save); !s) return report_error(s.message());
   nlohmann::ordered_json j = {{"source", a.terrain.source()},
@@ -89,12 +89,6 @@ struct BenchDeformArgs {
   TerrainArgs terrain;
   std::string radii = "5,20,100", count = "200", patch_exponent = "6", seed = "1", json_path;
 };
-
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<std::size_t>(q * double(v.size() - 1) + 0.5))];
-}
 
 int run_bench_deform(const BenchDeformArgs& a) {
   auto radii = parse_finite_list(a.radii, "--radii", 1, 16);
@@ -136,34 +130,31 @@ int run_bench_deform(const BenchDeformArgs& a) {
       e.depth = (n & 1) ? -1.0 : 1.0;  // alternate craters and mounds: heights stay bounded
       // The edit, then the view's next update (which brings its mesh up to the edit): wall time
       // and this thread's CPU time (steadier on a shared machine).
-      const auto t0 = std::chrono::steady_clock::now();
-      const double c0 = thread_cpu_ns();
-      auto r = t.apply_edit(e);
-      const double c1 = thread_cpu_ns();
-      const auto t1 = std::chrono::steady_clock::now();
+      Result<EditResult> r = Error{""};
+      const bench::Timing edit = bench::timed([&] { r = t.apply_edit(e); });
       if (!r) return report_error(r.error().message);
-      if (auto u = (*view)->update(cam); !u) return report_error(u.error().message);
-      const double c2 = thread_cpu_ns();
-      const auto t2 = std::chrono::steady_clock::now();
-      ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
-      both_wall.push_back(std::chrono::duration<double, std::milli>(t2 - t0).count());
-      edit_cpu.push_back((c1 - c0) * 1e-6);
-      update_cpu.push_back((c2 - c1) * 1e-6);
-      both_cpu.push_back((c2 - c0) * 1e-6);
+      Result<RoamStats> u = Error{""};
+      const bench::Timing update = bench::timed([&] { u = (*view)->update(cam); });
+      if (!u) return report_error(u.error().message);
+      ms.push_back(edit.wall_ms);
+      both_wall.push_back(edit.wall_ms + update.wall_ms);
+      edit_cpu.push_back(edit.cpu_ms);
+      update_cpu.push_back(update.cpu_ms);
+      both_cpu.push_back(edit.cpu_ms + update.cpu_ms);
       samples.push_back(double(r->samples_changed));
     }
     rows.push_back({{"brush", "crater"},
                     {"radius_m", radius},
                     {"edits", *count},
-                    {"median_ms", percentile(ms, 0.5)},
-                    {"p90_ms", percentile(ms, 0.9)},
-                    {"max_ms", percentile(ms, 1.0)},
-                    {"median_edit_cpu_ms", percentile(edit_cpu, 0.5)},
-                    {"median_update_cpu_ms", percentile(update_cpu, 0.5)},
-                    {"median_edit_update_cpu_ms", percentile(both_cpu, 0.5)},
-                    {"p90_edit_update_cpu_ms", percentile(both_cpu, 0.9)},
-                    {"median_edit_update_ms", percentile(both_wall, 0.5)},
-                    {"median_samples_changed", percentile(samples, 0.5)}});
+                    {"median_ms", bench::quantile_or(ms, 0.5, 0)},
+                    {"p90_ms", bench::quantile_or(ms, 0.9, 0)},
+                    {"max_ms", bench::quantile_or(ms, 1.0, 0)},
+                    {"median_edit_cpu_ms", bench::quantile_or(edit_cpu, 0.5, 0)},
+                    {"median_update_cpu_ms", bench::quantile_or(update_cpu, 0.5, 0)},
+                    {"median_edit_update_cpu_ms", bench::quantile_or(both_cpu, 0.5, 0)},
+                    {"p90_edit_update_cpu_ms", bench::quantile_or(both_cpu, 0.9, 0)},
+                    {"median_edit_update_ms", bench::quantile_or(both_wall, 0.5, 0)},
+                    {"median_samples_changed", bench::quantile_or(samples, 0.5, 0)}});
   }
   nlohmann::ordered_json j = {
       {"benchmark", "deform"},

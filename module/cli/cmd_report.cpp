@@ -4,7 +4,6 @@
 // CDLOD-like quadtree, and writes per-setting medians as JSON and CSV (docs/report.md). This file
 // is the command-line glue; what it runs is in report/ (stats, modes, storm, inputs).
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -16,25 +15,21 @@
 #include "report/inputs.h"
 #include "report/noise_files.h"
 #include "report/storm.h"
+#include "ridgeline/bench/clock.h"
+#include "ridgeline/bench/stats.h"
 
 namespace ridgeline::cli {
 
 namespace {
 
+using bench::Clock;
+using bench::ms_since;
 using report::Json;
-using report::ModeResult;
 using report::NamedPath;
 using report::Options;
-using report::quantile;
+using report::Run;
 using report::Scene;
 using report::Setting;
-using Clock = std::chrono::steady_clock;
-
-constexpr double kMatchTolerance = 0.10;  // comparators' median triangles within 10 % of ROAM's
-
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 // One scene: every path (or the chosen ones) and every setting; appends CSV rows only when the
 // whole scene ran.
@@ -60,29 +55,33 @@ Result<Json> run_scene(Scene& sc, const Options& o, const std::vector<Setting>& 
   }
   j["error_stride"] = o.stride;
   Json paths = Json::array();
-  for (const NamedPath& p : report::make_paths(*sc.terrain, o.frames)) {
+  for (const NamedPath& p : bench::make_paths(*sc.terrain, o.frames)) {
     if (!o.paths.empty() && std::find(o.paths.begin(), o.paths.end(), p.name) == o.paths.end())
       continue;
     Json rows = Json::array();
     for (const Setting& st : settings) {
-      std::vector<ModeResult> modes;
+      std::vector<Run> modes;
       for (RoamMode mode : {RoamMode::kCoherent, RoamMode::kRebuild}) {
         auto r = report::run_roam(sc, p, st, mode, o);
         if (!r) return r.error();
         modes.push_back(std::move(*r));
       }
-      const double target = quantile(modes.front().tris, 0.5);
-      modes.push_back(report::run_uniform(sc, p, target, o));
-      modes.push_back(report::run_cdlod(sc, p, target, o));
-      if (o.soar) modes.push_back(report::run_soar(sc, p, st, o));
-      Json mj = Json::array();
+      const double target = bench::median(modes.front().triangles);
+      for (auto run : {&report::run_uniform, &report::run_cdlod}) {
+        auto r = run(sc, p, target, o);
+        if (!r) return r.error();
+        modes.push_back(std::move(*r));
+      }
+      if (o.soar) {
+        auto r = report::run_soar(sc, p, st, o);
+        if (!r) return r.error();
+        modes.push_back(std::move(*r));
+      }
       const std::string prefix =
           sc.name + "," + p.name + "," + st.kind + "," + csv_number(st.value);
-      for (const ModeResult& m : modes) {
-        mj.push_back(m.json());
-        csv += m.csv(prefix);
-      }
-      rows.push_back({{"kind", st.kind}, {"value", st.value}, {"modes", mj}});
+      rows.push_back({{"kind", st.kind},
+                      {"value", st.value},
+                      {"modes", report::modes_json(modes, prefix, csv)}});
       std::fprintf(stderr, "ridge report: %s %s %s %g done (%.1f s)\n", sc.name.c_str(),
                    p.name.c_str(), st.kind.c_str(), st.value, ms_since(t0) / 1000);
     }
@@ -220,7 +219,7 @@ Result<Json> run_hard_cases(const ReportArgs& a, const Options& o, std::string& 
 }
 
 int run_report(const ReportArgs& a) {
-  keep_freed_memory();
+  bench::keep_freed_memory();
   if (!a.write_noise.empty()) {  // only the input files
     if (auto s = report::write_noise_field(a.write_noise); !s) return report_error(s.message());
     return 0;
@@ -276,7 +275,7 @@ int run_report(const ReportArgs& a) {
                {"frames_per_path", o.frames},
                {"error_every", o.error_every},
                {"error_stride", o.stride},
-               {"match_tolerance", kMatchTolerance},
+               {"match_tolerance", report::kMatchTolerance},
                {"settings",
                 {{"thresholds_px", o.thresholds},
                  {"triangle_caps", o.triangle_caps},

@@ -1,14 +1,15 @@
 // `ridge mesh` (converge a ROAM mesh for one view and export it as .glb) and `ridge bench lod`
 // (run a camera path and report per-frame cost and error as JSON).
 #include <algorithm>
-#include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
-#include <numeric>
 
-#include "bench_soar.h"
 #include "cli_util.h"
 #include "commands.h"
+#include "ridgeline/bench/clock.h"
+#include "ridgeline/bench/summary.h"
+#include "ridgeline/bench/techniques.h"
 #include "ridgeline/camera_path.h"
 #include "ridgeline/gltf_export.h"
 #include "ridgeline/roam_view.h"
@@ -220,38 +221,59 @@ struct BenchLodArgs {
               flush_mb = "0";
 };
 
-// Leaves whose box (lattice extent, heights of the corners) meets the camera's frustum and that
-// are drawn (not padding): the triangles a renderer that culls per triangle would draw.
-std::uint64_t triangles_in_view(const RoamView& v, const Camera& c) {
-  const Frustum f(c);
-  const Surface& s = v.landscape().terrain().surface();
-  const SurfaceLattice& at = s.lattice();
-  const double off = at.height_offset;
-  std::uint64_t n = 0;
-  v.for_each_leaf([&](std::uint32_t, std::uint64_t, const LatticeTriangle& t) {
-    const Landscape::LatticeBox b = Landscape::box_of(t);
-    if (b.i0 >= at.vertices_x - 1 || b.j0 >= at.vertices_z - 1) return;  // padding, not drawn
-    const double ha = double(float(s.vertex_height(t.ax, t.az))),
-                 hl = double(float(s.vertex_height(t.lx, t.lz))),
-                 hr = double(float(s.vertex_height(t.rx, t.rz)));
-    const glm::dvec3 lo(at.origin_x + double(b.i0) * at.spacing_x, off + std::min({ha, hl, hr}),
-                        at.origin_z + double(b.j0) * at.spacing_z);
-    const glm::dvec3 hi(at.origin_x + double(b.i1) * at.spacing_x, off + std::max({ha, hl, hr}),
-                        at.origin_z + double(b.j1) * at.spacing_z);
-    n += f.classify_box(lo, hi) != Frustum::Cull::kOut;
-  });
-  return n;
-}
+// The technique of --mode soar: the stateless SOAR comparator over the finest lattice (its
+// preprocess reported as the bounds' build, like ROAM's), with the cap as the one kappa whose
+// median count over the path is closest to N (calibrated untimed, on every 60th part of the path);
+// with --threshold too, a frame uses the smaller of the two kappas.
+struct SoarMode {
+  std::unique_ptr<bench::Soar> soar;
+  std::unique_ptr<bench::SoarTechnique> technique;
+  double threshold = 0, preprocess_ms = 0;
+  std::uint64_t cap = 0;
+};
 
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const std::size_t k = std::min(v.size() - 1, static_cast<std::size_t>(q * double(v.size())));
-  return v[k];
+Result<SoarMode> soar_mode(const LodArgs& a, const std::vector<Camera>& cams,
+                           std::shared_ptr<const Terrain>* terrain) {
+  if (!a.budget_ms.empty())
+    return Error{"--budget-ms: the soar mode has no time budget (one full pass a frame)"};
+  if (a.threshold.empty() && a.triangles.empty())
+    return Error{"give --threshold PX and/or --triangles N"};
+  SoarMode m;
+  if (!a.threshold.empty()) {
+    auto th = parse_finite(a.threshold, "--threshold");
+    if (!th) return th.error();
+    if (*th < 0) return Error{"--threshold must be >= 0"};
+    m.threshold = *th;
+  }
+  if (!a.triangles.empty()) {
+    auto n = parse_count(a.triangles, "--triangles", 1, 0xffffffffu);
+    if (!n) return n.error();
+    m.cap = *n;
+  }
+  auto loaded = a.terrain.load_terrain();
+  if (!loaded) return loaded.error();
+  *terrain = *loaded;
+  const Terrain& t = **terrain;
+  const SurfaceLattice& at = t.surface().lattice();
+  if (std::max(at.vertices_x, at.vertices_z) > std::int64_t{bench::Soar::kMaxSide})
+    return Error{"--mode soar: the finest lattice is " + std::to_string(at.vertices_x) + " x " +
+                 std::to_string(at.vertices_z) + " vertices; the comparator takes at most " +
+                 std::to_string(bench::Soar::kMaxSide) + " per side"};
+  const auto t0 = bench::Clock::now();
+  auto fine = bench::finest_lattice(t);
+  if (!fine) return fine.error();
+  m.soar = std::make_unique<bench::Soar>(*fine);
+  m.preprocess_ms = bench::ms_since(t0);
+  double path_kappa = std::numeric_limits<double>::infinity();
+  if (m.cap > 0)
+    path_kappa =
+        m.soar->match(cams, double(m.cap), std::max<std::size_t>(1, cams.size() / 60)).kappa;
+  m.technique = std::make_unique<bench::SoarTechnique>(*m.soar, m.threshold, path_kappa);
+  return m;
 }
 
 int run_bench_lod(const BenchLodArgs& a) {
-  keep_freed_memory();
+  bench::keep_freed_memory();
   if (a.path.empty()) return report_error("give --path PATH.json");
   auto frames = io::load_camera_path(a.path);
   if (!frames) return report_error(frames.error().message);
@@ -266,147 +288,63 @@ int run_bench_lod(const BenchLodArgs& a) {
   auto flush_mb = parse_finite(a.flush_mb, "--flush-mb");
   if (!flush_mb) return report_error(flush_mb.error().message);
   if (*flush_mb < 0 || *flush_mb > 4096) return report_error("--flush-mb must be in 0..4096");
-  if (a.lod.mode == "soar")  // the stateless comparator (bench_soar.h)
-    return run_bench_lod_soar({&a.lod.terrain, &*frames, a.lod.threshold, a.lod.triangles,
-                               a.lod.budget_ms, *every, *stride, *warmup, *repeat, *flush_mb,
-                               a.lod.json_path});
-  double bounds_ms = 0;
-  std::size_t bound_bytes = 0;
-  auto view = a.lod.view(&bounds_ms, &bound_bytes);
-  if (!view) return report_error(view.error().message);
-  RoamView& v = **view;
-  OtherWork other(*flush_mb);
+  std::vector<Camera> cams;
+  for (const io::PathFrame& f : *frames) cams.push_back(f.camera);
 
-  // Warm-up frames (the first frames of the path, not reported), then the path `repeat` times.
-  for (std::uint64_t k = 0; k < *warmup; ++k) {
-    other.touch();
-    if (auto st = v.update((*frames)[k % frames->size()].camera); !st)
-      return report_error(st.error().message);
-    (void)v.take_dirty_patches();
+  // The technique: ROAM (coherent or rebuild) or SOAR, and the settings it runs at.
+  std::shared_ptr<const Terrain> terrain;
+  std::unique_ptr<bench::RoamTechnique> roam;
+  Result<SoarMode> soar = Error{""};
+  bench::Technique* technique = nullptr;
+  nlohmann::ordered_json summary;
+  double bounds_ms = 0, budget_ms = 0;
+  std::size_t bound_bytes = 0;
+  if (a.lod.mode == "soar") {
+    soar = soar_mode(a.lod, cams, &terrain);
+    if (!soar) return report_error(soar.error().message);
+    technique = soar->technique.get();
+    summary = {{"mode", "soar"},
+               {"threshold", soar->threshold},
+               {"max_triangles", soar->cap},
+               {"budget_ms", 0}};
+    bounds_ms = soar->preprocess_ms;
+    bound_bytes = soar->soar->memory_bytes();
+  } else {
+    auto view = a.lod.view(&bounds_ms, &bound_bytes);
+    if (!view) return report_error(view.error().message);
+    const RoamSettings s = (*view)->settings();
+    terrain = (*view)->landscape().terrain_ptr();
+    roam = std::make_unique<bench::RoamTechnique>(std::move(*view));
+    technique = roam.get();
+    budget_ms = s.budget_ms;
+    summary = {{"mode", s.mode == RoamMode::kCoherent ? "coherent" : "rebuild"},
+               {"threshold", s.threshold},
+               {"max_triangles", s.max_triangles},
+               {"budget_ms", s.budget_ms}};
   }
-  nlohmann::ordered_json out_frames = nlohmann::ordered_json::array();
-  std::vector<double> ms, cpu, out_ms, out_cpu, total_ms, total_cpu, tris, in_view, changes,
-      max_err, rms_err, px_err, mem, out_mem, upload;
-  std::uint32_t time_stops = 0, rebuilds = 0, compactions = 0;
-  for (std::uint64_t rep = 0; rep < *repeat; ++rep) {
-    for (std::size_t k = 0; k < frames->size(); ++k) {
-      const Camera& c = (*frames)[k].camera;
-      // CPU time of this thread as well as the wall time update() reports: on a shared machine
-      // the difference is time the update was preempted, which no budget can keep.
-      other.touch();
-      const long faults0 = thread_minor_faults();
-      const double cpu0 = thread_cpu_ns();
-      auto st = v.update(c);
-      const double cpu1 = thread_cpu_ns();
-      const long faults = thread_minor_faults() - faults0;
-      if (!st) return report_error(st.error().message);
-      // The output an engine uploads: the update keeps the patch buffers in step; what is left
-      // is taking the dirty patches and their ranges.
-      const auto w0 = std::chrono::steady_clock::now();
-      const std::vector<std::uint32_t> dirty = v.take_dirty_patches();
-      const double o_ms =
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - w0).count();
-      const double o_cpu = (thread_cpu_ns() - cpu1) * 1e-6;
-      const double cpu_ms = (cpu1 - cpu0) * 1e-6;
-      nlohmann::ordered_json f = {{"update_ms", st->update_ms},
-                                  {"update_cpu_ms", cpu_ms},
-                                  {"page_faults", faults},
-                                  {"output_ms", o_ms},
-                                  {"output_cpu_ms", o_cpu},
-                                  {"triangles", st->triangles},
-                                  {"splits", st->splits + st->forced_splits},
-                                  {"forced_splits", st->forced_splits},
-                                  {"merges", st->merges},
-                                  {"priority_updates", st->priority_updates},
-                                  {"front_size", st->front_size},
-                                  {"upload_bytes", st->upload_bytes},
-                                  {"dirty_patches", dirty.size()},
-                                  {"compacted_patches", st->compacted_patches},
-                                  {"rebuilt", st->rebuilt},
-                                  {"stopped_by", stop_reason_name(st->stop)},
-                                  {"morph_threshold", st->morph_threshold}};
-      // Measured on the frames whose error is measured, as the soar mode does: the walk over
-      // every leaf between two updates would change what the next update finds in the caches.
-      if (*every > 0 && k % *every == 0) {
-        const std::uint64_t visible = triangles_in_view(v, c);
-        f["triangles_in_view"] = visible;
-        in_view.push_back(double(visible));
-        const auto e = v.measure_error(c, static_cast<std::uint32_t>(*stride));
-        f["max_error"] = e.max_m;
-        f["rms_error"] = e.rms_m;
-        f["max_screen_error_px"] = e.max_px;
-        f["p99_screen_error_px"] = e.p99_px;
-        max_err.push_back(e.max_m);
-        rms_err.push_back(e.rms_m);
-        px_err.push_back(e.max_px);
-      }
-      f["max_remaining_error_px"] = st->max_remaining_error;
-      out_frames.push_back(f);
-      ms.push_back(st->update_ms);
-      cpu.push_back(cpu_ms);
-      out_ms.push_back(o_ms);
-      out_cpu.push_back(o_cpu);
-      total_ms.push_back(st->update_ms + o_ms);
-      total_cpu.push_back(cpu_ms + o_cpu);
-      tris.push_back(st->triangles);
-      changes.push_back(st->splits + st->forced_splits + st->merges);
-      mem.push_back(double(st->memory_bytes));
-      out_mem.push_back(double(st->output_bytes));
-      upload.push_back(double(st->upload_bytes));
-      time_stops += st->stop == StopReason::kTimeBudget;
-      compactions += st->compacted_patches;
-      rebuilds += st->rebuilt;
-    }
-  }
-  const RoamSettings s = v.settings();
-  const double tri_median = std::max(1.0, percentile(tris, 0.5));
-  nlohmann::ordered_json summary = {
-      {"frames", ms.size()},
-      {"mode", s.mode == RoamMode::kCoherent ? "coherent" : "rebuild"},
-      {"threshold", s.threshold},
-      {"max_triangles", s.max_triangles},
-      {"budget_ms", s.budget_ms},
-      {"update_ms_median", percentile(ms, 0.5)},
-      {"update_ms_p99", percentile(ms, 0.99)},
-      {"update_cpu_ms_median", percentile(cpu, 0.5)},
-      {"update_cpu_ms_p99", percentile(cpu, 0.99)},
-      {"update_ms_max", percentile(ms, 1.0)},
-      {"output_ms_median", percentile(out_ms, 0.5)},
-      {"output_cpu_ms_median", percentile(out_cpu, 0.5)},
-      {"update_plus_output_ms_median", percentile(total_ms, 0.5)},
-      {"update_plus_output_cpu_ms_median", percentile(total_cpu, 0.5)},
-      {"update_plus_output_cpu_ms_p99", percentile(total_cpu, 0.99)},
-      {"triangles_median", percentile(tris, 0.5)},
-      {"triangles_p99", percentile(tris, 0.99)},
-      {"triangles_in_view_median", percentile(in_view, 0.5)},
-      {"changes_per_frame_median", percentile(changes, 0.5)},
-      {"upload_bytes_median", percentile(upload, 0.5)},
-      {"upload_bytes_mean",
-       upload.empty() ? 0.0
-                      : std::accumulate(upload.begin(), upload.end(), 0.0) / double(upload.size())},
-      {"upload_bytes_p99", percentile(upload, 0.99)},
-      {"view_memory_bytes_median", percentile(mem, 0.5)},
-      {"view_bytes_per_triangle", percentile(mem, 0.5) / tri_median},
-      {"output_bytes_per_triangle", percentile(out_mem, 0.5) / tri_median},
-      {"max_error_median", percentile(max_err, 0.5)},
-      {"max_error_max", percentile(max_err, 1.0)},
-      {"rms_error_median", percentile(rms_err, 0.5)},
-      {"max_screen_error_px_median", percentile(px_err, 0.5)},
-      {"max_screen_error_px_max", percentile(px_err, 1.0)},
-      {"time_budget_stops", time_stops},
-      {"rebuilds", rebuilds},
-      {"compacted_patches", compactions},
-      {"bounds_build_ms", bounds_ms},
-      {"bounds_bytes", bound_bytes},
-      {"error_every", *every},
-      {"error_stride", *stride},
-      {"flush_mb", *flush_mb},
-  };
-  if (s.budget_ms > 0) {
-    summary["time_budget_met"] = percentile(ms, 0.99) <= 1.1 * s.budget_ms + 0.1;
-    summary["time_budget_met_cpu"] = percentile(cpu, 0.99) <= 1.1 * s.budget_ms + 0.1;
-  }
-  nlohmann::ordered_json j = {{"summary", summary}, {"frames", out_frames}};
+
+  // The frame loop: the warm-up (the path's first frames, not reported), the path `repeat`
+  // times, the mesh measured every K-th frame on every S-th lattice vertex.
+  bench::LoopOptions lo;
+  lo.warmup = *warmup;
+  lo.repeat = *repeat;
+  lo.error_every = static_cast<std::uint32_t>(*every);
+  lo.flush_mb = *flush_mb;
+  lo.keep_frames = true;
+  std::unique_ptr<MeshErrorMeter> meter;
+  if (*every > 0) meter = std::make_unique<MeshErrorMeter>(*terrain, static_cast<std::uint32_t>(*stride));
+  auto run = bench::run_path(*technique, cams, meter.get(), lo);
+  if (!run) return report_error(run.error().message);
+
+  bench::append(summary, bench::lod_figures(*run));
+  summary["bounds_build_ms"] = bounds_ms;
+  summary["bounds_bytes"] = bound_bytes;
+  summary["error_every"] = *every;
+  summary["error_stride"] = *stride;
+  summary["flush_mb"] = *flush_mb;
+  if (budget_ms > 0)
+    bench::append(summary, bench::time_budget_figures(*run, budget_ms));
+  nlohmann::ordered_json j = {{"summary", summary}, {"frames", run->frames}};
   if (auto st = write_json(j, a.lod.json_path); !st) return report_error(st.message());
   return 0;
 }

@@ -212,9 +212,15 @@ std::uint64_t MeshErrorMeter::triangles_in_view(const DrawnMesh& mesh, const Cam
   if (!validate_camera(camera)) return 0;
   const Frustum f(camera);
   std::uint64_t n = 0;
+  const double last_u = double(width_ - 1), last_v = double(height_ - 1);
   for (std::size_t t = 0; t + 2 < mesh.corners.size(); t += 3) {
-    const glm::dvec3 a = to_world(mesh.corners[t]), b = to_world(mesh.corners[t + 1]),
-                     c = to_world(mesh.corners[t + 2]);
+    const glm::dvec3 &p = mesh.corners[t], &q = mesh.corners[t + 1], &r = mesh.corners[t + 2];
+    // Not drawn: degenerate slots of a renderer's buffers (zero xz area), and triangles over
+    // the padding, wholly beyond the lattice's last row or column.
+    const double area2 = (q.x - p.x) * (r.z - p.z) - (q.z - p.z) * (r.x - p.x);
+    if (area2 == 0.0) continue;
+    if (std::min({p.x, q.x, r.x}) >= last_u || std::min({p.z, q.z, r.z}) >= last_v) continue;
+    const glm::dvec3 a = to_world(p), b = to_world(q), c = to_world(r);
     n += f.classify_box(glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c))) !=
          Frustum::Cull::kOut;
   }

@@ -4,7 +4,6 @@
 #include <btBulletDynamicsCommon.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -14,6 +13,7 @@
 #include "ridgeline/edit.h"
 #include "ridgeline/io.h"
 #include "ridgeline/world_file.h"
+#include "ridgeline/bench/clock.h"
 
 namespace game {
 
@@ -40,12 +40,6 @@ ridgeline::DetailParams default_world_detail() {
   d.seed = 17;
   return d;
 }
-
-namespace {
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-}  // namespace
 
 Game::~Game() {
   scripts_.reset();  // Lua first: its userdata refer to the game
@@ -263,7 +257,7 @@ void Game::step() {
         return 2;
       },
       args);
-  const auto t_physics = std::chrono::steady_clock::now();
+  const auto t_physics = ridgeline::bench::Clock::now();
   double waypoint_scripts_ms = 0;
   for (auto& [id, e] : vehicles_) {
     if (e.autopilot.drive(e.body)) {
@@ -271,7 +265,7 @@ void Game::step() {
         int id;
         std::size_t index;
       } arg{id, e.autopilot.next};
-      const auto t0 = std::chrono::steady_clock::now();
+      const auto t0 = ridgeline::bench::Clock::now();
       emit(
           "waypoint",
           [](lua_State* L, void* u) -> int {
@@ -281,7 +275,7 @@ void Game::step() {
             return 2;
           },
           &arg);
-      waypoint_scripts_ms += ms_since(t0);
+      waypoint_scripts_ms += ridgeline::bench::ms_since(t0);
     }
   }
   follow_terrain_edits();
@@ -301,7 +295,7 @@ void Game::step() {
   }
   count_touches();
   tidy_bodies();
-  step_times_.physics_ms += ms_since(t_physics) - waypoint_scripts_ms;
+  step_times_.physics_ms += ridgeline::bench::ms_since(t_physics) - waypoint_scripts_ms;
   // A body that started touching a vehicle: the "hit" event (after the physics, not inside it).
   for (const Hit& h : hits_) {
     emit(

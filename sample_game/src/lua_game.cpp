@@ -1,13 +1,13 @@
 // The `game` table of game scripts: spawning, events, cameras, the LOD budget, deformation, and
 // the game's terrain as a `ridgeline.terrain`. Documented in docs/game_scripting.md.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <lua.hpp>
 
 #include "lua_api.h"
 #include "materials.h"
+#include "ridgeline/bench/clock.h"
 #include "ridgeline/detail.h"
 #include "ridgeline/lua/check.h"
 #include "ridgeline/lua/module.h"
@@ -298,11 +298,9 @@ int g_set_budget(lua_State* L) {
 int g_burn_ms(lua_State* L) {
   const double ms = check_finite(L, 1);
   if (ms < 0 || ms > 100) luaL_argerror(L, 1, "0 .. 100 milliseconds expected");
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = ridgeline::bench::Clock::now();
   volatile double sink = 0;
-  while (std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() <
-         ms)
-    sink = sink + 1;
+  while (ridgeline::bench::ms_since(t0) < ms) sink = sink + 1;
   game_of(L).add_burn(ms);
   return 0;
 }

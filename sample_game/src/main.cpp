@@ -24,23 +24,14 @@
 #include "gl_context.h"
 #include "panel.h"
 #include "renderer.h"
+#include "ridgeline/bench/clock.h"
 #include "ridgeline/camera_path.h"
 #include "run_stats.h"
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
-
-// CPU time in milliseconds: of the whole process (every thread: llvmpipe's rasterisers, the
-// detail workers) and of the calling thread. On a shared machine these move less than wall time.
-double cpu_ms(clockid_t clock) {
-  timespec ts{};
-  clock_gettime(clock, &ts);
-  return double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6;
-}
+using ridgeline::bench::Clock;
+using ridgeline::bench::ms_since;
 
 struct Args {
   bool headless = false, offscreen = false, egl = false, no_panel = false, wireframe = false;
@@ -230,7 +221,10 @@ int run(const Args& a) {
   while (a.frames == 0 || frame < a.frames) {
     if (ctx && ctx->should_close()) break;
     const auto t0 = Clock::now();
-    const double cpu0 = cpu_ms(CLOCK_PROCESS_CPUTIME_ID), main0 = cpu_ms(CLOCK_THREAD_CPUTIME_ID);
+    // CPU time of the whole process (every thread: llvmpipe's rasterisers, the detail workers)
+    // and of this thread: on a shared machine these move less than wall time.
+    const double cpu0 = ridgeline::bench::process_cpu_ms(),
+                 main0 = ridgeline::bench::thread_cpu_ms();
     if (window) {
       GLFWwindow* w = ctx->window();
       read_window_input(w, g, !(panel && panel->wants_keyboard()), 1.0 / 60.0);
@@ -292,8 +286,8 @@ int run(const Args& a) {
     // 120 ms at 1280 x 720) is not part of the game's frame, so it is neither in the frame time
     // the controller sees nor in the statistics (the next frame starts after it).
     const double frame_ms = ms_since(t0);
-    const double frame_cpu_ms = cpu_ms(CLOCK_PROCESS_CPUTIME_ID) - cpu0;
-    const double frame_main_cpu_ms = cpu_ms(CLOCK_THREAD_CPUTIME_ID) - main0;
+    const double frame_cpu_ms = ridgeline::bench::process_cpu_ms() - cpu0;
+    const double frame_main_cpu_ms = ridgeline::bench::thread_cpu_ms() - main0;
     const auto tshot = Clock::now();
     if (renderer) {
       const bool last = a.frames > 0 && frame + 1 == a.frames;

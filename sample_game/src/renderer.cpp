@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <glm/gtc/matrix_transform.hpp>
@@ -19,6 +18,7 @@
 
 #include "geomorph_glsl.h"
 #include "materials.h"
+#include "ridgeline/bench/clock.h"
 
 namespace game {
 namespace {
@@ -219,10 +219,6 @@ int loc(unsigned p, const char* n) {
 
 const glm::vec3 kSun = glm::normalize(glm::vec3(0.45f, 0.6f, 0.35f));
 const glm::vec3 kFog(0.70f, 0.78f, 0.86f);
-
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // The MeshVertex attribute layout, in one place (locations as in kTerrainVs).
 void bind_mesh_vertex_layout() {
@@ -469,9 +465,9 @@ Renderer::MeshGpu Renderer::upload_model(const ModelMesh& mesh) {
 void Renderer::sync_patches(ridgeline::RoamView& view, std::vector<PatchGpu>& set,
                             bool& initialised, RenderStats& st) {
   const std::uint32_t np = view.landscape().patch_count();
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = ridgeline::bench::Clock::now();
   const std::vector<std::uint32_t> dirty = view.take_dirty_patches();
-  st.patch_mesh_ms += ms_since(t0);
+  st.patch_mesh_ms += ridgeline::bench::ms_since(t0);
   if (!initialised || set.size() != np) {
     // First use of this view: every patch, whole.
     set.assign(np, PatchGpu{});
@@ -587,10 +583,10 @@ RenderStats Renderer::draw(Game& game, const RenderSettings& settings) {
   RenderStats st;
   const int vi = static_cast<int>(game.rig().mode);
   std::vector<PatchGpu>& set = patches_[vi];
-  auto t0 = std::chrono::steady_clock::now();
+  auto t0 = ridgeline::bench::Clock::now();
   sync_patches(game.active_view(), set, patches_initialised_[vi], st);
-  st.upload_ms = ms_since(t0);
-  t0 = std::chrono::steady_clock::now();
+  st.upload_ms = ridgeline::bench::ms_since(t0);
+  t0 = ridgeline::bench::Clock::now();
 
   // Dynamic resolution: the scene renders into the lower-left scale x scale part of the scene
   // target and is upscaled; at scale 1 it renders into the output target directly.
@@ -743,7 +739,7 @@ RenderStats Renderer::draw(Game& game, const RenderSettings& settings) {
   }
   glBindFramebuffer(GL_FRAMEBUFFER, output_.fbo);
   glViewport(0, 0, width_, height_);
-  st.draw_ms = ms_since(t0);
+  st.draw_ms = ridgeline::bench::ms_since(t0);
   return st;
 }
 

@@ -9,6 +9,8 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "ridgeline/bench/stats.h"
+
 namespace game {
 
 void RunStats::record(const Game& game, FrameRecord r) {
@@ -17,14 +19,8 @@ void RunStats::record(const Game& game, FrameRecord r) {
 }
 
 namespace {
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const double k = p / 100.0 * double(v.size() - 1);
-  const auto i = static_cast<std::size_t>(k);
-  const double f = k - double(i);
-  return i + 1 < v.size() ? v[i] * (1 - f) + v[i + 1] * f : v[i];
-}
+// The q-quantile of ridgeline/bench/stats.h, 0 when there are no frames.
+double at(const std::vector<double>& v, double q) { return ridgeline::bench::quantile_or(v, q, 0.0); }
 }  // namespace
 
 ridgeline::Status RunStats::write(const std::string& path, const std::string& mode,
@@ -129,34 +125,32 @@ ridgeline::Status RunStats::write(const std::string& path, const std::string& mo
   for (const ScriptError& e : game.errors())
     errors.push_back({{"script", e.script}, {"frame", e.frame}, {"message", e.message}});
   auto pcts = [](const std::vector<double>& v) {
-    return json{{"p10", percentile(v, 10)},
-                {"p50", percentile(v, 50)},
-                {"p90", percentile(v, 90)},
-                {"p99", percentile(v, 99)},
+    return json{{"p10", at(v, 0.10)},
+                {"p50", at(v, 0.50)},
+                {"p90", at(v, 0.90)},
+                {"p99", at(v, 0.99)},
                 {"max", v.empty() ? 0.0 : *std::max_element(v.begin(), v.end())}};
   };
   auto mean = [](const std::vector<double>& v) {
-    double t = 0;
-    for (double x : v) t += x;
-    return v.empty() ? 0.0 : t / double(v.size());
+    return ridgeline::bench::or_value(ridgeline::bench::mean(v), 0.0);
   };
   json breakdown = json::object();
   for (const Part& p : parts)
-    breakdown[p.name] = {{"p50", percentile(p.v, 50)}, {"mean", mean(p.v)}};
-  breakdown["other"] = {{"p50", percentile(other, 50)}, {"mean", mean(other)}};
+    breakdown[p.name] = {{"p50", at(p.v, 0.50)}, {"mean", mean(p.v)}};
+  breakdown["other"] = {{"p50", at(other, 0.50)}, {"mean", mean(other)}};
   {
     std::vector<double> pm;
     for (const FrameRecord& f : frames_)
       if (f.frame >= skip_frames) pm.push_back(f.patch_mesh_ms);
-    breakdown["upload_patch_mesh_part"] = {{"p50", percentile(pm, 50)}, {"mean", mean(pm)}};
+    breakdown["upload_patch_mesh_part"] = {{"p50", at(pm, 0.50)}, {"mean", mean(pm)}};
   }
   json upload_bytes;
   {
     std::vector<double> b;
     for (const FrameRecord& f : frames_)
       if (f.frame >= skip_frames) b.push_back(double(f.bytes_uploaded));
-    upload_bytes = {{"p50", percentile(b, 50)},
-                    {"p99", percentile(b, 99)},
+    upload_bytes = {{"p50", at(b, 0.50)},
+                    {"p99", at(b, 0.99)},
                     {"mean", mean(b)},
                     {"max", b.empty() ? 0.0 : *std::max_element(b.begin(), b.end())}};
   }
@@ -168,15 +162,15 @@ ridgeline::Status RunStats::write(const std::string& path, const std::string& mo
       {"cpu_ms", pcts(cpu)},
       {"main_thread_cpu_ms", pcts(main_cpu)},
       {"threshold_px",
-       {{"p10", percentile(thr, 10)}, {"p50", percentile(thr, 50)}, {"p90", percentile(thr, 90)}}},
+       {{"p10", at(thr, 0.10)}, {"p50", at(thr, 0.50)}, {"p90", at(thr, 0.90)}}},
       {"render_scale",
-       {{"p10", percentile(scale, 10)},
-        {"p50", percentile(scale, 50)},
-        {"p90", percentile(scale, 90)},
+       {{"p10", at(scale, 0.10)},
+        {"p50", at(scale, 0.50)},
+        {"p90", at(scale, 0.90)},
         {"min", scale.empty() ? 1.0 : *std::min_element(scale.begin(), scale.end())}}},
       {"upload_bytes", upload_bytes},
       {"triangles",
-       {{"p50", percentile(tris, 50)},
+       {{"p50", at(tris, 0.50)},
         {"max", tris.empty() ? 0.0 : *std::max_element(tris.begin(), tris.end())}}},
       {"view_stop_fraction",
        {{"converged", double(converged) / n},

@@ -2,13 +2,13 @@
 // script in the registry so that a reload replaces exactly that script's handlers.
 #include "script_runner.h"
 
-#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <lua.hpp>
 #include <sstream>
 
 #include "lua_api.h"
+#include "ridgeline/bench/clock.h"
 
 namespace game {
 
@@ -21,10 +21,6 @@ namespace {
 
 char kHandlersKey;  // registry: {[script index] = {[event] = {fn, ...}}}
 char kContextKey;   // registry: the lua_api::Context userdata (owned by the state)
-
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // Runs in protected mode (host().call): builds the registry entries and the `game` table.
 int install(lua_State* L) {
@@ -152,9 +148,9 @@ Status ScriptRunner::run(int index) {
   lua_pop(L, 1);
   s.failed = false;
   current_ = index;
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = ridgeline::bench::Clock::now();
   Status st = host_->run(ss.str(), "@" + s.name);
-  script_ms_ += ms_since(t0);
+  script_ms_ += ridgeline::bench::ms_since(t0);
   current_ = -1;
   if (!st) {
     record_error(index, st.message());
@@ -189,7 +185,7 @@ bool ScriptRunner::add_handler(lua_State* L, int event, int fn) {
 void ScriptRunner::emit(const char* event, int (*push)(lua_State*, void*), void* user) {
   lua_State* L = host_->state();
   const int top0 = lua_gettop(L);
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = ridgeline::bench::Clock::now();
   for (std::size_t i = 0; i < scripts_.size(); ++i) {
     if (scripts_[i].failed) continue;
     lua_rawgetp(L, LUA_REGISTRYINDEX, &kHandlersKey);
@@ -211,7 +207,7 @@ void ScriptRunner::emit(const char* event, int (*push)(lua_State*, void*), void*
     }
     lua_settop(L, top0);
   }
-  script_ms_ += ms_since(t0);
+  script_ms_ += ridgeline::bench::ms_since(t0);
 }
 
 }  // namespace game

@@ -1,8 +1,9 @@
 // game_pop: the pop metric of `ridge report` (docs/report.md, "Pop") for a camera path the game
 // recorded (`ridgeline_game --record-path PATH.json`), on the game's own world: the default
 // terrain with the default world's procedural detail, the game's ROAM patches, a coherent
-// RoamView at a fixed threshold, geomorphs as the game's renderer draws them. Prints the
-// report's figures for the path as JSON (pop_geomorph_max_px is the one the renderer shows).
+// RoamView at a fixed threshold, geomorphs as the game's renderer draws them. A front end of
+// Ridgeline::bench's frame loop, as `ridge report` is; prints the report's figures for the path
+// as JSON (pop_geomorph_max_px is the one the renderer shows).
 // Usage: game_pop PATH.json [--threshold PX] [--every K] [--stride S] [--json FILE]
 #include <CLI/CLI.hpp>
 #include <cstdio>
@@ -12,7 +13,9 @@
 #include <string>
 
 #include "game.h"
-#include "report/modes.h"
+#include "ridgeline/bench/grid.h"
+#include "ridgeline/bench/summary.h"
+#include "ridgeline/bench/techniques.h"
 #include "ridgeline/camera_path.h"
 #include "ridgeline/heightfield.h"
 #include "ridgeline/landscape.h"
@@ -64,32 +67,34 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "game_pop: %s\n", land.error().message.c_str());
     return 1;
   }
-  auto fine = ridgeline::report::finest_lattice(**terrain);
+  // Measured on the finest lattice baked into a heightfield, as `ridge report` measures.
+  auto fine = ridgeline::bench::finest_lattice(**terrain);
   if (!fine) {
     std::fprintf(stderr, "game_pop: %s\n", fine.error().message.c_str());
     return 1;
   }
-  ridgeline::report::Scene scene;
-  scene.name = "game_world";
-  scene.terrain = *terrain;
-  scene.landscape = *land;
-  scene.fine = std::make_shared<const ridgeline::Heightfield>(std::move(*fine));
-  ridgeline::report::NamedPath path;
-  path.name = "recorded";
-  for (const ridgeline::io::PathFrame& f : *frames) path.frames.push_back(f.camera);
-  ridgeline::report::Options o;
-  o.frames = int(path.frames.size());
-  o.error_every = every;
-  o.stride = stride;
-  const ridgeline::report::Setting setting{"threshold", threshold};
-  auto r = ridgeline::report::run_roam(scene, path, setting, ridgeline::RoamMode::kCoherent, o);
+  const ridgeline::MeshErrorMeter meter(*fine, stride);
+  ridgeline::RoamSettings settings;
+  settings.threshold = threshold;
+  auto view = ridgeline::RoamView::create(*land, settings);
+  if (!view) {
+    std::fprintf(stderr, "game_pop: %s\n", view.error().message.c_str());
+    return 1;
+  }
+  ridgeline::bench::RoamTechnique roam(std::move(*view), /*converge_first=*/true);
+  std::vector<ridgeline::Camera> cams;
+  for (const ridgeline::io::PathFrame& f : *frames) cams.push_back(f.camera);
+  ridgeline::bench::LoopOptions o;
+  o.error_every = static_cast<std::uint32_t>(every);
+  o.pops = true;
+  auto r = ridgeline::bench::run_path(roam, cams, &meter, o);
   if (!r) {
     std::fprintf(stderr, "game_pop: %s\n", r.error().message.c_str());
     return 1;
   }
-  nlohmann::ordered_json out = r->json();
+  nlohmann::ordered_json out = ridgeline::bench::report_figures(*r);
   out["path"] = path_file;
-  out["frames"] = path.frames.size();
+  out["frames"] = cams.size();
   out["threshold_px"] = threshold;
   out["every"] = every;
   out["stride"] = stride;

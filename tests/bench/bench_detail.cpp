@@ -2,25 +2,19 @@
 // one core, and the direct evaluator per sample. Prints JSON; medians over repetitions.
 //   bench_detail [repetitions]
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <vector>
 
+#include "ridgeline/bench/clock.h"
+#include "ridgeline/bench/stats.h"
 #include "ridgeline/detail.h"
 #include "ridgeline/terrain.h"
 
 using namespace ridgeline;
-using Clock = std::chrono::steady_clock;
-
-namespace {
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
-}  // namespace
+using bench::Clock;
+using bench::median;
+using bench::ms_since;
 
 int main(int argc, char** argv) {
   const int reps = argc > 1 ? std::max(3, std::atoi(argv[1])) : 31;
@@ -52,7 +46,7 @@ int main(int argc, char** argv) {
         sink = sink + tile->raw(64, 64);
         bytes = tile->memory_bytes();
       }
-      ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count() / kBatch);
+      ms.push_back(ms_since(t0) / kBatch);
     }
     std::printf("    {\"level\": %u, \"median_ms\": %.4f, \"min_ms\": %.4f, \"bytes\": %zu}%s\n",
                 level, median(ms), *std::min_element(ms.begin(), ms.end()), bytes,
@@ -67,7 +61,7 @@ int main(int argc, char** argv) {
       for (int k = 0; k < kPoints; ++k)
         sink = sink + f.detail_raw(level, (std::int64_t{300} << level) + k * 37,
                                    (std::int64_t{500} << level) + k * 13);
-      us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - t0).count() / kPoints);
+      us.push_back(ms_since(t0) * 1e3 / kPoints);
     }
     std::printf("    {\"level\": %u, \"median_us_per_sample\": %.3f}%s\n", level, median(us),
                 level == shown[3] ? "" : ",");

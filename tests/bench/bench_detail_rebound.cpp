@@ -14,24 +14,21 @@
 // with the analytic bound and must be re-bounded when their tile arrives; then it holds the
 // final camera (waiting for the worker before each update) until it has converged.
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
 
+#include "ridgeline/bench/clock.h"
 #include "ridgeline/detail.h"
 #include "ridgeline/landscape.h"
 #include "ridgeline/roam_view.h"
 #include "ridgeline/terrain.h"
 
 using namespace ridgeline;
-using Clock = std::chrono::steady_clock;
+using ridgeline::bench::Clock;
+using ridgeline::bench::ms_since;
 
 namespace {
-
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 int usage(const char* why) {
   std::fprintf(stderr,

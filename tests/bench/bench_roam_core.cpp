@@ -1,31 +1,31 @@
-// ROAM against SOAR in one process, frame by frame (docs/benchmarks.md, "ROAM against SOAR, like
-// for like"): on the noise field and its circular flyover (ridgeline/scenes.h), each frame times
-// RoamView::update plus take_dirty_patches (update + output) and the stateless SOAR refinement
-// with the emission of its strip (refine + emit), in alternating order, with the same treatment
-// of the caches between frames for both. Core library only (no OpenImageIO), so that
-// valgrind's callgrind runs it too. Prints JSON.
+// ROAM against SOAR in one process, frame by frame (docs/benchmarks.md): on the noise field and
+// its circular flyover (ridgeline/scenes.h), the frame loop of Ridgeline::bench runs ROAM
+// (RoamView::update, then take_dirty_patches: update + output) and the stateless SOAR refinement
+// with the emission of its strip (refine + emit) in alternating order on every frame, with the
+// same treatment of the caches between frames for both. Core library only (no OpenImageIO), so
+// that valgrind's callgrind runs it too. Prints JSON.
 //
 // Usage: bench_roam_core [--triangles N] [--threshold PX] [--rounds R] [--flush-mb M]
-//                        [--only roam|soar] [--patch-exponent K] [--json FILE]
+//                        [--only roam|soar] [--patch-exponent K] [--cold N] [--json FILE]
 //   --triangles N   ROAM with a cap of N (threshold 0 unless given), SOAR with the one kappa
 //                   whose median count over the path is closest to N (as `ridge bench lod`)
 //   --threshold PX  both at PX pixels (without --triangles)
-//   --flush-mb M    between frames, read and write M MiB of other memory (the rest of an
+//   --flush-mb M    before each update, read and write M MiB of other memory (the rest of an
 //                   engine's frame evicting the terrain's data); 0 (default): caches stay warm
 //   --cold N        instead: N fresh views' first updates at the path's first camera (cold
 //                   start: the mesh built from the roots), their median (ROAM only)
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
+#include <limits>
 #include <string>
 #include <vector>
 
-#include "cli_util.h"
-#include "report/soar.h"
-#include "report/stats.h"
+#include "ridgeline/bench/clock.h"
+#include "ridgeline/bench/frame_loop.h"
+#include "ridgeline/bench/stats.h"
+#include "ridgeline/bench/techniques.h"
 #include "ridgeline/roam_view.h"
 #include "ridgeline/scenes.h"
 
@@ -37,27 +37,41 @@
 #endif
 
 using namespace ridgeline;
+using bench::median;
 
 namespace {
-
-double thread_cpu_ms() { return cli::thread_cpu_ns() * 1e-6; }
-
-// The median as `ridge bench lod` and the report take it (0 when there is nothing).
-double median(const std::vector<double>& v) {
-  return v.empty() ? 0.0 : report::quantile(v, 0.5);
-}
-
-struct Sample {
-  std::vector<double> wall, cpu, tris, changes;
-};
 
 int usage(const char* why) {
   std::fprintf(stderr,
                "bench_roam_core: %s\nusage: bench_roam_core [--triangles N] [--threshold PX] "
-               "[--rounds R] [--flush-mb M] [--only roam|soar] [--patch-exponent K] "
+               "[--rounds R] [--flush-mb M] [--only roam|soar] [--patch-exponent K] [--cold N] "
                "[--json FILE]\n",
                why);
   return 2;
+}
+
+// The --cold figures: the first update of `runs` fresh views at `first`, with their page faults.
+bench::Json cold_start(const std::shared_ptr<const Landscape>& landscape, const RoamSettings& s,
+                       const Camera& first, unsigned runs,
+                       const std::shared_ptr<RoamMemory>& memory) {
+  std::vector<double> ms, faults;
+  std::size_t tris = 0;
+  for (unsigned k = 0; k < runs; ++k) {
+    auto v = RoamView::create(landscape, s, memory).value();
+    Result<RoamStats> st = Error{""};
+    const bench::Timing t = bench::timed([&] { st = v->update(first); });
+    ms.push_back(t.wall_ms);
+    faults.push_back(double(t.faults));
+    tris = st ? st->triangles : 0;
+  }
+  // The first view of the process faults its memory in; later ones reuse what the previous one
+  // left in the RoamMemory. Both are reported.
+  return {{"cold_start_first_update_ms", ms[0]},
+          {"cold_start_first_page_faults", faults[0]},
+          {"cold_start_update_ms_median", median(ms)},
+          {"page_faults_median", median(faults)},
+          {"triangles", tris},
+          {"runs", runs}};
 }
 
 }  // namespace
@@ -107,134 +121,84 @@ int main(int argc, char** argv) {
   const std::vector<Camera> cams = scenes::noise_circle();
   const bool do_roam = only != "soar", do_soar = only != "roam";
 
-  std::unique_ptr<RoamView> view;
-  std::shared_ptr<const Landscape> landscape;
   // One memory for every view of the run, so that a view takes over the pages of the one before.
   const std::shared_ptr<RoamMemory> memory = RoamMemory::create();
+  std::vector<bench::Technique*> techniques;
+  std::unique_ptr<bench::RoamTechnique> roam;
   if (do_roam) {
     auto land = Landscape::create(terrain, {.patch_exponent = patch_exponent});
     if (!land) return usage(land.error().message.c_str());
-    landscape = *land;
     RoamSettings s;
     s.threshold = threshold;
     s.max_triangles = triangles;
+    if (cold > 0) {
+      const std::string text = cold_start(*land, s, cams[0], cold, memory).dump(1);
+      std::printf("%s\n", text.c_str());
+      return 0;
+    }
     auto v = RoamView::create(*land, s, memory);
     if (!v) return usage(v.error().message.c_str());
-    view = std::move(*v);
+    roam = std::make_unique<bench::RoamTechnique>(std::move(*v));
+    techniques.push_back(roam.get());
   }
-  if (cold > 0 && view) {
-    // The first view of the process faults its memory in; later ones reuse what the previous
-    // one left in the RoamMemory. Both are reported, with the page faults of each update.
-    std::vector<double> ms;
-    std::vector<long> faults;
-    std::size_t tris = 0;
-    const RoamSettings settings = view->settings();
-    view.reset();
-    for (unsigned k = 0; k < cold; ++k) {
-      auto v = RoamView::create(landscape, settings, memory).value();
-      const long f0 = cli::thread_minor_faults();
-      const auto w0 = std::chrono::steady_clock::now();
-      const auto st = v->update(cams[0]);
-      ms.push_back(
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - w0).count());
-      faults.push_back(cli::thread_minor_faults() - f0);
-      tris = st ? st->triangles : 0;
-    }
-    const double first = ms[0];
-    const long first_faults = faults[0];
-    std::printf(
-        "{\n \"cold_start_first_update_ms\": %.3f,\n \"cold_start_first_page_faults\": %ld,\n"
-        " \"cold_start_update_ms_median\": %.3f,\n \"page_faults_median\": %ld,\n"
-        " \"triangles\": %zu,\n \"runs\": %u\n}\n",
-        first, first_faults, median(ms), faults[faults.size() / 2], tris, cold);
-    return 0;
-  }
-  std::unique_ptr<report::Soar> soar;
-  double path_kappa = INFINITY;
+  std::unique_ptr<bench::Soar> soar;
+  std::unique_ptr<bench::SoarTechnique> soar_technique;
   if (do_soar) {
-    soar = std::make_unique<report::Soar>(terrain->surface().to_heightfield().value());
+    soar = std::make_unique<bench::Soar>(terrain->surface().to_heightfield().value());
+    double path_kappa = std::numeric_limits<double>::infinity();
     if (triangles > 0) path_kappa = soar->match(cams, triangles, cams.size() / 60).kappa;
+    soar_technique = std::make_unique<bench::SoarTechnique>(*soar, threshold, path_kappa);
+    techniques.push_back(soar_technique.get());
   }
-  auto kappa_of = [&](const Camera& c) {
-    return std::min(threshold > 0 ? report::Soar::kappa_for(c, threshold) : INFINITY, path_kappa);
-  };
 
-  std::vector<unsigned char> other(std::size_t(flush_mb * 1048576.0), 1);
-  volatile unsigned sink = 0;
-  auto flush = [&] {
-    unsigned s = 0;
-    for (std::size_t k = 0; k < other.size(); k += 64) s += other[k]++;
-    sink = sink + s;
-  };
-  std::vector<std::uint32_t> strip;
-  auto run_roam = [&](const Camera& c, Sample* out) {
-    flush();
-    const auto w0 = std::chrono::steady_clock::now();
-    const double c0 = thread_cpu_ms();
-    const auto st = view->update(c);
-    const auto dirty = view->take_dirty_patches();
-    const double c1 = thread_cpu_ms();
-    const auto w1 = std::chrono::steady_clock::now();
-    if (!st) std::exit(usage(st.error().message.c_str()));
-    if (out == nullptr) return;
-    out->wall.push_back(std::chrono::duration<double, std::milli>(w1 - w0).count());
-    out->cpu.push_back(c1 - c0);
-    out->tris.push_back(st->triangles);
-    out->changes.push_back(st->splits + st->forced_splits + st->merges);
-  };
-  auto run_soar = [&](const Camera& c, Sample* out) {
-    flush();
-    const double kappa = kappa_of(c);
-    const auto w0 = std::chrono::steady_clock::now();
-    const double c0 = thread_cpu_ms();
-    const auto f = soar->refine(c, kappa, strip);
-    const double c1 = thread_cpu_ms();
-    const auto w1 = std::chrono::steady_clock::now();
-    if (out == nullptr) return;
-    out->wall.push_back(std::chrono::duration<double, std::milli>(w1 - w0).count());
-    out->cpu.push_back(c1 - c0);
-    out->tris.push_back(double(f.triangles));
-  };
-
-  // Warm-up: the first 60 frames of the path (ROAM converges from its roots there).
-  for (std::size_t k = 0; k < 60; ++k) {
-    if (do_roam) run_roam(cams[k], nullptr);
-    if (do_soar) run_soar(cams[k], nullptr);
-  }
-  Sample roam, sr;
-  std::vector<double> ratio;
+  // Warm-up: the first 60 frames of the path (ROAM converges from its roots there); then the
+  // path `rounds` times, the two taking turns at going first.
+  bench::LoopOptions lo;
+  lo.warmup = 60;
+  lo.repeat = rounds;
+  lo.flush_mb = flush_mb;
+  lo.alternate = true;
   CALLGRIND_START_INSTRUMENTATION;
-  for (unsigned r = 0; r < rounds; ++r)
-    for (std::size_t k = 0; k < cams.size(); ++k) {
-      const bool roam_first = (k + r) % 2 == 0;
-      if (do_roam && roam_first) run_roam(cams[k], &roam);
-      if (do_soar) run_soar(cams[k], &sr);
-      if (do_roam && !roam_first) run_roam(cams[k], &roam);
-      if (do_roam && do_soar) ratio.push_back(sr.wall.back() / roam.wall.back());
-    }
+  auto runs = bench::run_path(techniques, cams, nullptr, lo);
   CALLGRIND_STOP_INSTRUMENTATION;
+  if (!runs) return usage(runs.error().message.c_str());
 
-  char buf[2048];
-  std::snprintf(
-      buf, sizeof buf,
-      "{\n \"command\": \"bench_roam_core%s%s%s%s\",\n \"frames\": %zu,\n \"flush_mb\": %g,\n"
-      " \"roam_update_plus_output_ms_median\": %.4f,\n \"roam_cpu_ms_median\": %.4f,\n"
-      " \"roam_triangles_median\": %.0f,\n \"roam_changes_median\": %.0f,\n"
-      " \"soar_refine_emit_ms_median\": %.4f,\n \"soar_cpu_ms_median\": %.4f,\n"
-      " \"soar_triangles_median\": %.0f,\n \"soar_over_roam_median_of_frame_ratios\": %.3f,\n"
-      " \"soar_over_roam_ratio_of_medians\": %.3f\n}\n",
-      triangles ? (" --triangles " + std::to_string(triangles)).c_str() : "",
-      threshold > 0 ? (" --threshold " + std::to_string(threshold)).c_str() : "",
-      flush_mb > 0 ? (" --flush-mb " + std::to_string(int(flush_mb))).c_str() : "",
-      rounds > 1 ? (" --rounds " + std::to_string(rounds)).c_str() : "",
-      std::max(roam.wall.size(), sr.wall.size()), flush_mb, median(roam.wall), median(roam.cpu),
-      median(roam.tris), median(roam.changes), median(sr.wall), median(sr.cpu), median(sr.tris),
-      median(ratio), median(roam.wall) > 0 ? median(sr.wall) / median(roam.wall) : 0.0);
+  static const bench::Run kNone;
+  const bench::Run& r = do_roam ? runs->front() : kNone;
+  const bench::Run& s = do_soar ? runs->back() : kNone;
+  std::vector<double> roam_ms(r.wall_ms), ratio;
+  for (std::size_t k = 0; k < roam_ms.size(); ++k) roam_ms[k] += r.output_ms[k];
+  std::vector<double> roam_cpu(r.cpu_ms);
+  for (std::size_t k = 0; k < roam_cpu.size(); ++k) roam_cpu[k] += r.output_cpu_ms[k];
+  if (do_roam && do_soar)
+    for (std::size_t k = 0; k < roam_ms.size(); ++k) ratio.push_back(s.wall_ms[k] / roam_ms[k]);
+  std::string command = "bench_roam_core";
+  if (triangles) command += " --triangles " + std::to_string(triangles);
+  if (threshold > 0) command += " --threshold " + std::to_string(threshold);
+  if (flush_mb > 0) command += " --flush-mb " + std::to_string(int(flush_mb));
+  if (rounds > 1) command += " --rounds " + std::to_string(rounds);
+  auto value = [](double x) { return bench::number(bench::or_value(x, 0.0)); };
+  const double roam_median = bench::or_value(median(roam_ms), 0.0);
+  const bench::Json j = {
+      {"command", command},
+      {"frames", std::max(r.wall_ms.size(), s.wall_ms.size())},
+      {"flush_mb", flush_mb},
+      {"roam_update_plus_output_ms_median", value(roam_median)},
+      {"roam_cpu_ms_median", value(median(roam_cpu))},
+      {"roam_triangles_median", value(median(r.triangles))},
+      {"roam_changes_median", value(median(r.changes))},
+      {"soar_refine_emit_ms_median", value(median(s.wall_ms))},
+      {"soar_cpu_ms_median", value(median(s.cpu_ms))},
+      {"soar_triangles_median", value(median(s.triangles))},
+      {"soar_over_roam_median_of_frame_ratios", value(median(ratio))},
+      {"soar_over_roam_ratio_of_medians",
+       value(roam_median > 0 ? median(s.wall_ms) / roam_median : 0.0)}};
+  const std::string text = j.dump(1) + "\n";
   if (json_path.empty()) {
-    std::fputs(buf, stdout);
+    std::fputs(text.c_str(), stdout);
   } else {
     FILE* f = std::fopen(json_path.c_str(), "w");
-    if (f == nullptr || std::fputs(buf, f) < 0 || std::fclose(f) != 0)
+    if (f == nullptr || std::fputs(text.c_str(), f) < 0 || std::fclose(f) != 0)
       return usage(("cannot write " + json_path).c_str());
   }
   return 0;

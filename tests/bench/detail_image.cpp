@@ -1,5 +1,5 @@
 // The streaming picture of docs/detail.md ("Streaming"): a top-down shaded relief around a
-// camera of the 100 km world flight (docs/benchmarks.md, "Detail streaming"), where every point
+// camera of the 100 km world flight (docs/detail.md), where every point
 // shows the surface at the finest level whose tile the request rule (detail_stream.h) asks for
 // there: fine near the camera, coarser with distance, the stored 32 m surface beyond the
 // coarsest radius. Three panels: the stored surface over 200 m around the camera, the streamed

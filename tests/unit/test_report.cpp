@@ -1,22 +1,31 @@
-// The comparators and the measurement of `ridge report` (module/cli/report/, mesh_error.h): the
-// uniform grid, the CDLOD quadtree and the SOAR refinement are crack-free and cover the terrain,
-// the error measurement agrees with a brute-force reference and with RoamView::measure_error,
-// triangle counts match, the jump and the pop measure what docs/report.md says.
+// The benchmark library (Ridgeline::bench, module/bench/) and the measurement it shares
+// (mesh_error.h): the uniform grid, the CDLOD quadtree and the SOAR refinement are crack-free and
+// cover the terrain, the error measurement agrees with a brute-force reference and with
+// RoamView::measure_error, triangle counts match, the jump and the pop measure what
+// docs/report.md says; the quantile is the one stats.h defines, and the frame loop times and
+// measures every technique alike.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <numeric>
 #include <random>
+#include <string>
 
-#include "report/meshes.h"
-#include "report/roam_drawn.h"
-#include "report/soar.h"
+#include "ridgeline/bench/frame_loop.h"
+#include "ridgeline/bench/meshes.h"
+#include "ridgeline/bench/roam_drawn.h"
+#include "ridgeline/bench/soar.h"
+#include "ridgeline/bench/stats.h"
+#include "ridgeline/bench/summary.h"
+#include "ridgeline/bench/techniques.h"
 #include "ridgeline/edit.h"
 #include "ridgeline/landscape.h"
 #include "ridgeline/mesh_error.h"
 #include "ridgeline/roam_view.h"
 #include "ridgeline/scenes.h"
 
-namespace ridgeline::report {
+namespace ridgeline::bench {
 namespace {
 
 std::shared_ptr<const Terrain> field(std::uint32_t w, std::uint32_t h, double sx = 1.0,
@@ -434,5 +443,195 @@ TEST(ReportSoar, MatchFindsTheKappaOfATriangleTarget) {
   }
 }
 
+
+// ---- Ridgeline::bench: statistics, the in-view count, the frame loop ----------------------
+
+TEST(BenchStats, QuantileIsTheElementOfRankFloorQN) {
+  const std::vector<double> six = {5, 1, 4, 2, 3, 6};  // sorted: 1 .. 6
+  EXPECT_EQ(quantile(six, 0.0), 1);
+  EXPECT_EQ(quantile(six, 0.5), 4);   // rank floor(3): the upper of the two middle values
+  EXPECT_EQ(quantile(six, 0.99), 6);  // rank floor(5.94)
+  EXPECT_EQ(quantile(six, 1.0), 6);
+  EXPECT_EQ(quantile(six, 2.0), 6);  // q clamped to [0, 1]
+  EXPECT_EQ(median({3, 1, 2}), 2);
+  std::vector<double> frames(360);
+  std::iota(frames.begin(), frames.end(), 1.0);
+  EXPECT_EQ(quantile(frames, 0.99), 357);  // the 357th smallest of 360
+  EXPECT_EQ(max_of(frames), 360);
+  EXPECT_EQ(mean({1, 2, 6}), 3);
+  // An empty series has no figure: NaN, null in JSON, or the fallback asked for.
+  EXPECT_TRUE(std::isnan(quantile({}, 0.5)));
+  EXPECT_TRUE(std::isnan(max_of({})));
+  EXPECT_EQ(quantile_or({}, 0.5, 0.0), 0.0);
+  EXPECT_TRUE(number(std::nan("")).is_null());
+  EXPECT_EQ(number(2.5), 2.5);
+}
+
+TEST(BenchInView, APatchBufferAndTheLeavesOfItsViewCountTheSameTriangles) {
+  // 100 x 70 samples: patches over the padding, and unused (0, 0, 0) slots in the buffers.
+  auto t = field(100, 70);
+  auto l = Landscape::create(t, {.patch_exponent = 4});
+  ASSERT_TRUE(l.ok());
+  auto v = RoamView::create(*l, {.threshold = 2.0});
+  ASSERT_TRUE(v.ok());
+  const MeshErrorMeter meter(*t);
+  const Camera near = look({-10, 60, -10}, {50, 20, 35}), far = look({150, 80, 120}, {50, 20, 35});
+  for (const Camera& c : {near, far, near}) {  // merges leave unused slots behind
+    ASSERT_TRUE((*v)->converge(c).ok());
+    const DrawnMesh buffers = RoamSnapshot::capture(**v).draw(meter, c, false);
+    const DrawnMesh leaves = leaves_mesh(**v);
+    EXPECT_GT(buffers.triangles(), (*v)->triangle_count() / 2);
+    const auto n = meter.triangles_in_view(leaves, c);
+    EXPECT_GT(n, 0u);
+    EXPECT_LT(n, (*v)->triangle_count());
+    EXPECT_EQ(meter.triangles_in_view(buffers, c), n);
+  }
+  // A degenerate triangle and one beyond the lattice are not drawn: not counted.
+  DrawnMesh odd;
+  odd.add({10, 30, 10}, {10, 30, 10}, {10, 30, 10});
+  odd.add({99, 30, 10}, {101, 30, 10}, {100, 30, 12});
+  EXPECT_EQ(meter.triangles_in_view(odd, far), 0u);
+}
+
+// A technique that logs its calls and draws a static 32 x 32 grid.
+class Logged final : public Technique {
+ public:
+  Logged(const Terrain& t, std::string name, std::vector<std::string>& log)
+      : grid_(t), name_(std::move(name)), log_(log) {}
+  std::string name() const override { return name_; }
+  Status start(const Camera&) override {
+    log_.push_back(name_ + ":start");
+    return {};
+  }
+  Status update(const Camera&) override {
+    log_.push_back(name_ + ":update");
+    ++updates_;
+    return {};
+  }
+  bool has_output() const override { return true; }
+  void output() override { log_.push_back(name_ + ":output"); }
+  FrameFigures figures() const override {
+    FrameFigures f;
+    f.triangles = double(g_.triangles());
+    f.extra = {{"updates", updates_}, {"label", "x"}};
+    return f;
+  }
+  Drawable capture(const MeshErrorMeter&) override {
+    log_.push_back(name_ + ":capture");
+    auto mesh = std::make_shared<const DrawnMesh>(g_.mesh(grid_));
+    return [mesh](const Camera&, bool) { return *mesh; };
+  }
+  Json summary() const override { return {{"label", name_}}; }
+
+ private:
+  Grid grid_;
+  UniformGrid g_{32, 32};
+  std::string name_;
+  std::vector<std::string>& log_;
+  int updates_ = 0;
+};
+
+TEST(BenchLoop, TimesEveryTechniqueAlikeAndMeasuresTheChosenFrames) {
+  auto t = field(33, 33);
+  const MeshErrorMeter meter(*t);
+  std::vector<Camera> path;
+  for (int k = 0; k < 12; ++k) path.push_back(look({-5.0 + k, 40, -5}, {16, 10, 16}));
+  std::vector<std::string> log;
+  Logged a(*t, "a", log), b(*t, "b", log);
+  LoopOptions o;
+  o.warmup = 2;
+  o.repeat = 2;
+  o.error_every = 4;
+  o.alternate = true;
+  o.keep_frames = true;
+  std::vector<std::size_t> before;
+  o.before_frame = [&](std::size_t k) {
+    before.push_back(k);
+    return Status{};
+  };
+  auto runs = run_path({&a, &b}, path, &meter, o);
+  ASSERT_TRUE(runs.ok()) << runs.error().message;
+  ASSERT_EQ(runs->size(), 2u);
+  // start(), two warm-up frames in order, then the laps with the first technique alternating.
+  EXPECT_EQ(log[0], "a:start");
+  EXPECT_EQ(log[1], "b:start");
+  EXPECT_EQ(log[2], "a:update");
+  EXPECT_EQ(log[4], "b:update");
+  const auto first = std::find(log.begin() + 10, log.end(), "b:update");
+  EXPECT_TRUE(std::find(log.begin() + 10, first, "a:update") != first);  // lap 1, frame 0: a first
+  EXPECT_EQ(before.size(), 24u);
+  for (const bench::Run& r : *runs) {
+    EXPECT_EQ(r.wall_ms.size(), 24u);
+    EXPECT_EQ(r.output_ms.size(), 24u);
+    EXPECT_EQ(r.frames.size(), 24u);
+    EXPECT_EQ(r.max_m.size(), 6u);  // frames 0, 4, 8 of each lap
+    EXPECT_EQ(r.in_view.size(), 6u);
+    EXPECT_EQ(r.uncovered, 0u);
+    EXPECT_TRUE(std::isfinite(max_of(r.max_m)));
+    EXPECT_EQ(r.named("updates").size(), 24u);  // numbers become series, strings do not
+    EXPECT_TRUE(r.named("label").empty());
+    EXPECT_TRUE(r.frames[0].contains("triangles_in_view"));
+    EXPECT_FALSE(r.frames[1].contains("triangles_in_view"));
+    EXPECT_EQ(r.summary["label"], r.technique);
+    const Json lod = lod_figures(r);
+    EXPECT_EQ(lod["frames"], 24);
+    EXPECT_TRUE(lod["changes_per_frame_median"].is_null());  // not reported by the technique
+    EXPECT_EQ(lod["triangles_median"], 2.0 * 32 * 32);
+    const Json rep = report_figures(r);
+    EXPECT_TRUE(rep["pop_max_px"].is_null());  // no pops asked for
+    EXPECT_EQ(rep["measured_frames"], 6);
+  }
+  // With pops: errors at K, 2K, ... and the mesh of K - 1, 2K - 1, ... captured; only those
+  // frames updated when asked.
+  log.clear();
+  LoopOptions p;
+  p.error_every = 4;
+  p.pops = true;
+  p.only_measured_frames = true;
+  auto r = run_path(a, path, &meter, p);
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r->wall_ms.size(), 5u);  // frames 3, 4, 7, 8, 11
+  EXPECT_EQ(r->max_m.size(), 2u);    // frames 4, 8
+  EXPECT_EQ(r->pop.size(), 2u);
+  EXPECT_EQ(max_of(r->pop), 0.0);  // the same mesh: no pop
+  // Measuring needs a meter.
+  EXPECT_FALSE(run_path(a, path, nullptr, p).ok());
+}
+
+TEST(BenchLoop, RoamAndSoarReportTheSameFiguresThroughOneLoop) {
+  auto t = field(129, 129);
+  auto l = Landscape::create(t, {.patch_exponent = 5});
+  ASSERT_TRUE(l.ok());
+  auto v = RoamView::create(*l, {.threshold = 2.0});
+  ASSERT_TRUE(v.ok());
+  std::vector<Camera> path;
+  for (int k = 0; k < 20; ++k) path.push_back(look({-10.0 + 2 * k, 70, -10}, {64, 20, 64}));
+  const Heightfield hf = t->surface().to_heightfield().value();
+  const MeshErrorMeter meter(hf);
+  const Soar soar(hf);
+  RoamTechnique roam(std::move(*v), true);
+  SoarTechnique stateless(soar, 2.0, std::numeric_limits<double>::infinity());
+  LoopOptions o;
+  o.error_every = 5;
+  o.pops = true;
+  auto runs = run_path({&roam, &stateless}, path, &meter, o);
+  ASSERT_TRUE(runs.ok()) << runs.error().message;
+  for (const bench::Run& r : *runs) {
+    const Json j = report_figures(r);
+    EXPECT_EQ(j["frames"], 20);
+    EXPECT_EQ(j["measured_frames"], 3);
+    EXPECT_EQ(j["uncovered_vertices"], 0);
+    EXPECT_GT(j["triangles_in_view_median"].get<double>(), 0);
+    EXPECT_LE(j["triangles_in_view_median"].get<double>(), j["triangles_median"].get<double>());
+    EXPECT_GT(j["memory_bytes"].get<double>(), 0);
+  }
+  EXPECT_EQ((*runs)[0].technique, "roam_coherent");
+  EXPECT_TRUE((*runs)[0].has_morph);
+  EXPECT_LE(max_of((*runs)[0].max_px), 2.0 + 1e-9);  // ROAM keeps its threshold, unmorphed
+  EXPECT_EQ((*runs)[1].technique, "soar");
+  EXPECT_EQ((*runs)[1].named("refine_only_ms").size(), 3u);
+  EXPECT_GT((*runs)[1].upload_bytes.front(), 4 * (*runs)[1].triangles.front());
+}
+
 }  // namespace
-}  // namespace ridgeline::report
+}  // namespace ridgeline::bench

@@ -23,7 +23,6 @@
 #include <btBulletDynamicsCommon.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -34,6 +33,8 @@
 #include <string>
 #include <vector>
 
+#include "ridgeline/bench/clock.h"
+#include "ridgeline/bench/stats.h"
 #include "ridgeline/bullet/terrain_shape.h"
 #include "ridgeline/bullet/terrain_sync.h"
 #include "ridgeline/detail.h"
@@ -42,12 +43,9 @@
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using ridgeline::bench::Clock;
+using ridgeline::bench::ms_since;
 using ridgeline::bullet::TerrainShape;
-
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 std::string load_average() {
   std::ifstream f("/proc/loadavg");
@@ -62,12 +60,6 @@ std::string cpu_model() {
   while (std::getline(f, line))
     if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
   return "unknown";
-}
-
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, std::size_t(p * double(v.size() - 1) + 0.5))];
 }
 
 // Bullet's heightfield with the size of its ray accelerator readable.
@@ -214,7 +206,8 @@ PhaseResult measure(World& w, int steps) {
     times.push_back(ms_since(t0));
     contacts += double(w.contact_points());
   }
-  return {percentile(times, 0.5), percentile(times, 0.9), contacts / steps};
+  return {ridgeline::bench::quantile_or(times, 0.5, 0), ridgeline::bench::quantile_or(times, 0.9, 0),
+          contacts / steps};
 }
 
 std::string json(const PhaseResult& r) {

@@ -2,11 +2,12 @@
 // terrain:heights, end to end from a Lua loop, on the default terrain. Prints JSON; medians of
 // 7 runs. The empty-loop cost (the same loop without the call) is reported alongside.
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <lua.hpp>
 #include <vector>
 
+#include "ridgeline/bench/clock.h"
+#include "ridgeline/bench/stats.h"
 #include "ridgeline/lua/host.h"
 
 namespace {
@@ -31,11 +32,6 @@ end
 function bench_heights(reps) for r = 1, reps do t:heights(xz, out) end end
 )";
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
 // Seconds for global `fn`(arg), median of 7.
 double time_call(ridgeline::lua::Host& host, const char* fn, double arg) {
   lua_State* L = host.state();
@@ -43,16 +39,16 @@ double time_call(ridgeline::lua::Host& host, const char* fn, double arg) {
   for (int r = 0; r < 7; ++r) {
     lua_getglobal(L, fn);
     lua_pushnumber(L, arg);
-    const auto t0 = std::chrono::steady_clock::now();
+    const auto t0 = ridgeline::bench::Clock::now();
     const auto s = host.call(1, 0);
-    const auto t1 = std::chrono::steady_clock::now();
+    const double ms = ridgeline::bench::ms_since(t0);
     if (!s) {
       std::fprintf(stderr, "%s\n", s.message().c_str());
       return -1;
     }
-    runs.push_back(std::chrono::duration<double>(t1 - t0).count());
+    runs.push_back(ms * 1e-3);
   }
-  return median(runs);
+  return ridgeline::bench::median(runs);
 }
 
 }  // namespace

@@ -153,7 +153,7 @@ Result<Scene> detail_scene(std::uint32_t size, std::uint32_t levels) {
   sc.landscape = first->second;
   sc.fresh = make;
   const auto t0 = std::chrono::steady_clock::now();
-  auto fine = finest_lattice(*sc.terrain);
+  auto fine = bench::finest_lattice(*sc.terrain);
   if (!fine) return fine.error();
   sc.fine = std::make_shared<const Heightfield>(std::move(*fine));
   sc.detail = {

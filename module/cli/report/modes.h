@@ -1,6 +1,6 @@
-// The modes `ridge report` runs along a camera path, and the one measurement loop they share
-// (docs/report.md, "Modes" and "What is measured"): ROAM coherent and rebuild, the uniform grid,
-// the CDLOD-like quadtree and the SOAR refinement.
+// The modes `ridge report` runs along a camera path (docs/report.md, "Modes"): ROAM coherent and
+// rebuild, the uniform grid, the CDLOD-like quadtree and the SOAR refinement, each a technique of
+// Ridgeline::bench run by its frame loop over a scene's lattice.
 #pragma once
 
 #include <functional>
@@ -9,15 +9,23 @@
 #include <string>
 #include <vector>
 
-#include "report/meshes.h"
-#include "report/paths.h"
-#include "report/soar.h"
 #include "report/stats.h"
+#include "ridgeline/bench/meshes.h"
+#include "ridgeline/bench/paths.h"
+#include "ridgeline/bench/soar.h"
 #include "ridgeline/landscape.h"
 #include "ridgeline/mesh_error.h"
 #include "ridgeline/terrain.h"
 
 namespace ridgeline::report {
+
+using bench::Cdlod;
+using bench::NamedPath;
+using bench::Run;
+using bench::Soar;
+
+/// The comparators' median triangle count is matched to ROAM's within this fraction.
+inline constexpr double kMatchTolerance = 0.10;
 
 /// A scene of the report: a terrain, its landscape, and what the comparators build from it once.
 struct Scene {
@@ -49,29 +57,11 @@ struct Scene {
   std::unique_ptr<MeshErrorMeter> meter_;
 };
 
-/// The finest lattice of `terrain` (base + detail + edits, Surface::vertex_height) baked into a
-/// heightfield (spacing / 2^L): what the comparators draw from.
-Result<Heightfield> finest_lattice(const Terrain& terrain);
-
-/// A mode's mesh as captured after one frame's update, drawable later for any camera (geomorphed
-/// or not): the pop compares the previous frame's mesh and the current one drawn for the
-/// current camera.
-using Drawable = std::function<DrawnMesh(const Camera& camera, bool morph)>;
-
-/// Runs one mode along `frames`: `update(k)` does frame k's work and records its cost into `r`;
-/// `capture()` returns the mesh as it stands. On the frames measured_frame() names, the loop
-/// measures with `meter`: the error of the mesh (and of the morphed mesh with r.has_morph), the
-/// per-vertex jump and the pop (docs/report.md). `after_update(k)`, if set, runs before the
-/// measurement of frame k (the storm refreshes the meter's surface there).
-void run_mode(const MeshErrorMeter& meter, const std::vector<Camera>& frames, const Options& o,
-              const std::function<void(std::size_t)>& update,
-              const std::function<Drawable()>& capture, ModeResult& r);
-
 /// ROAM (coherent or rebuild) on `scene` at `setting`, converged for the first frame first.
-Result<ModeResult> run_roam(Scene& scene, const NamedPath& path, const Setting& setting,
-                            RoamMode mode, const Options& o);
+Result<Run> run_roam(Scene& scene, const NamedPath& path, const Setting& setting, RoamMode mode,
+                     const Options& o);
 /// The static uniform grid closest to `target` triangles.
-ModeResult run_uniform(Scene& scene, const NamedPath& path, double target, const Options& o);
+Result<Run> run_uniform(Scene& scene, const NamedPath& path, double target, const Options& o);
 
 /// The CDLOD chunk grid and range that match `target` triangles over a path.
 struct CdlodChoice {
@@ -80,16 +70,17 @@ struct CdlodChoice {
 };
 CdlodChoice calibrate_cdlod(Scene& scene, const NamedPath& path, double target);
 /// CDLOD at the range matching `target` triangles (geomorphed and not).
-ModeResult run_cdlod(Scene& scene, const NamedPath& path, double target, const Options& o);
+Result<Run> run_cdlod(Scene& scene, const NamedPath& path, double target, const Options& o);
 /// SOAR at `setting`: a threshold in pixels as kappa = projection_scale / threshold per frame; a
 /// triangle cap as the one kappa whose median count over the path matches it; a time budget at
 /// its 1 px threshold (SOAR has no budget).
-ModeResult run_soar(Scene& scene, const NamedPath& path, const Setting& setting, const Options& o);
+Result<Run> run_soar(Scene& scene, const NamedPath& path, const Setting& setting,
+                     const Options& o);
 
-/// Thread CPU milliseconds and wall milliseconds of `work()`.
-struct Timing {
-  double wall_ms = 0, cpu_ms = 0;
-};
-Timing timed(const std::function<void()>& work);
+/// ROAM's loop options for a setting: a rebuild from the roots without a tile cache is updated
+/// only on the frames the measurement reads (its mesh depends on the current camera alone).
+bench::LoopOptions roam_loop(const Options& o, RoamMode mode, bool detail_cache);
+/// ROAM's time-budget fields for a "time_ms" setting (none otherwise), into run.summary.
+void add_time_budget(Run& run, const Setting& setting);
 
 }  // namespace ridgeline::report

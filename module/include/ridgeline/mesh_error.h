@@ -117,7 +117,9 @@ class MeshErrorMeter {
                  const Camera* before_camera = nullptr) const;
 
   /// Triangles of `mesh` whose world bounding box is not certainly outside `camera`'s frustum
-  /// (Frustum::classify_box): the triangles a renderer would not cull.
+  /// (Frustum::classify_box): the triangles a renderer would not cull. Triangles of zero xz
+  /// area (a renderer's unused slots) and triangles wholly beyond the lattice (over the
+  /// padding) are not drawn and not counted. The one in-view count of every benchmark.
   std::uint64_t triangles_in_view(const DrawnMesh& mesh, const Camera& camera) const;
 
  private:

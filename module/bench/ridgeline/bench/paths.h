@@ -1,4 +1,4 @@
-// The six camera paths of `ridge report`, generated for any terrain from its extent and heights
+// The six camera paths of `ridge report` and the benchmarks, generated for any terrain from its extent and heights
 // (the same kinds as tests/data/paths/make_paths.py writes for the default terrain).
 #pragma once
 
@@ -8,7 +8,7 @@
 #include "ridgeline/camera.h"
 #include "ridgeline/terrain.h"
 
-namespace ridgeline::report {
+namespace ridgeline::bench {
 
 struct NamedPath {
   std::string name;
@@ -24,4 +24,4 @@ struct NamedPath {
 /// 3), 1280 x 720, 60 Hz.
 std::vector<NamedPath> make_paths(const Terrain& terrain, int frames);
 
-}  // namespace ridgeline::report
+}  // namespace ridgeline::bench

@@ -13,7 +13,7 @@
 #include "ridgeline/mesh_error.h"
 #include "ridgeline/roam_view.h"
 
-namespace ridgeline::report {
+namespace ridgeline::bench {
 
 /// World height at which a renderer draws patch vertex `v` of a mesh whose origin is at height
 /// `origin_y`, for `camera` at the view's threshold `threshold_px` and the landscape's geomorph
@@ -48,4 +48,4 @@ class RoamSnapshot {
   Geomorph geomorph_;
 };
 
-}  // namespace ridgeline::report
+}  // namespace ridgeline::bench

@@ -1,14 +1,14 @@
 // Stateless SOAR refinement after Lindstrom & Pascucci 2001 (section 4: nested errors and
 // spheres, the refinement test, view culling, the strip built during the recursion) and 2002
 // (the division-free test). See soar.h.
-#include "report/soar.h"
+#include "ridgeline/bench/soar.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
 
-namespace ridgeline::report {
+namespace ridgeline::bench {
 
 namespace {
 constexpr std::uint32_t kAllInside = 0;  // no side plane left to test
@@ -232,4 +232,4 @@ DrawnMesh Soar::mesh(const std::vector<std::uint32_t>& strip) const {
   return out;
 }
 
-}  // namespace ridgeline::report
+}  // namespace ridgeline::bench

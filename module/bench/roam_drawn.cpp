@@ -1,9 +1,9 @@
 // ROAM's mesh as drawn (roam_drawn.h).
-#include "report/roam_drawn.h"
+#include "ridgeline/bench/roam_drawn.h"
 
 #include <glm/geometric.hpp>
 
-namespace ridgeline::report {
+namespace ridgeline::bench {
 
 double roam_drawn_y(const MeshVertex& v, const glm::dvec3& world, const Camera& camera,
                     double threshold_px, const Geomorph& geomorph, bool morph) {
@@ -43,4 +43,4 @@ DrawnMesh RoamSnapshot::draw(const MeshErrorMeter& meter, const Camera& camera, 
   return out;
 }
 
-}  // namespace ridgeline::report
+}  // namespace ridgeline::bench

@@ -1,12 +1,14 @@
-// The lattice the report's comparators read (report/meshes.h, report/soar.h).
+// The lattice the comparators read (meshes.h, soar.h), and a terrain's finest lattice baked into a
+// heightfield for them.
 #pragma once
 
 #include <cstdint>
 
 #include "ridgeline/heightfield.h"
+#include "ridgeline/result.h"
 #include "ridgeline/terrain.h"
 
-namespace ridgeline::report {
+namespace ridgeline::bench {
 
 /// The lattice the comparators read: a heightfield's samples, or a terrain's stored samples read
 /// through its surface (so that its edits show). Holds a pointer to either, which must outlive
@@ -50,4 +52,9 @@ class Grid {
   double sx_ = 1, sz_ = 1, ox_ = 0, oz_ = 0, offset_ = 0;
 };
 
-}  // namespace ridgeline::report
+/// The finest lattice of `terrain` (base + detail + edits, Surface::vertex_height) baked into a
+/// heightfield (spacing / 2^L with L detail levels): what the comparators draw from and what the
+/// error is measured against. Fails when the lattice exceeds 2^31 samples.
+Result<Heightfield> finest_lattice(const Terrain& terrain);
+
+}  // namespace ridgeline::bench

@@ -1,10 +1,10 @@
-// The comparators `ridge report` and `ridge bench lod` measure ROAM against: a uniform grid and a
+// Two of the comparators the benchmarks measure ROAM against (techniques.h): a uniform grid and a
 // CDLOD-like chunked quadtree (Strugar 2009), as drawn meshes (ridgeline/mesh_error.h), and a
 // watertightness check for any drawn mesh.
 //
-// These live with the tool, not in Ridgeline::terrain: they exist to be measured against, not to
-// be embedded. Everything here depends on the core library only (no image libraries), so the
-// tests link it without OpenImageIO.
+// These live in Ridgeline::bench, not in Ridgeline::terrain: they exist to be measured against,
+// not to be embedded. Everything here depends on the core library only (no image libraries), so
+// the tests link it without OpenImageIO.
 //
 // Threading: every object here is used by one thread at a time; const methods may run
 // concurrently.
@@ -17,10 +17,10 @@
 
 #include "ridgeline/camera.h"
 #include "ridgeline/mesh_error.h"
-#include "report/grid.h"
+#include "ridgeline/bench/grid.h"
 #include "ridgeline/terrain.h"
 
-namespace ridgeline::report {
+namespace ridgeline::bench {
 
 using ridgeline::DrawnMesh;
 
@@ -135,4 +135,4 @@ class Cdlod {
 /// Returns an empty string when they hold, else the first violation.
 std::string check_watertight(const Grid& hf, const DrawnMesh& mesh);
 
-}  // namespace ridgeline::report
+}  // namespace ridgeline::bench

@@ -11,7 +11,7 @@
 // Cafu's TerrainT): kappa = projection_scale(camera) / threshold_px, so a threshold in pixels means
 // what it means for ROAM (a world error e at distance d projects to e * projection_scale / d px).
 //
-// A yardstick, not a feature: it lives with the tool (docs/report.md, "SOAR").
+// A yardstick, not a feature: it lives in Ridgeline::bench (docs/report.md, "SOAR").
 #pragma once
 
 #include <cstdint>
@@ -19,10 +19,10 @@
 
 #include "ridgeline/camera.h"
 #include "ridgeline/heightfield.h"
-#include "report/grid.h"
+#include "ridgeline/bench/grid.h"
 #include "ridgeline/mesh_error.h"
 
-namespace ridgeline::report {
+namespace ridgeline::bench {
 
 class Soar {
  public:
@@ -33,7 +33,7 @@ class Soar {
   /// Builds the vertex data of `hf` (or of a terrain's finest lattice baked into one): a grid of
   /// (2^n + 1)^2 vertices covering it (the smallest such; samples beyond the heightfield repeat
   /// its edge samples, the padding rule), their heights, and the nested errors and radii.
-  /// Precondition: both sides of `hf` at most kMaxSide (callers check; see bench_soar.cpp).
+  /// Precondition: both sides of `hf` at most kMaxSide (callers check: SoarTechnique::create).
   explicit Soar(const Grid& hf);
 
   /// Result of one refinement.
@@ -81,4 +81,4 @@ class Soar {
   std::vector<Vertex> vertices_;
 };
 
-}  // namespace ridgeline::report
+}  // namespace ridgeline::bench

@@ -1,5 +1,5 @@
-// Comparator meshes and the measurement shared by every mode of `ridge report` (meshes.h).
-#include "report/meshes.h"
+// The uniform grid and the CDLOD-like quadtree the benchmarks measure ROAM against (meshes.h).
+#include "ridgeline/bench/meshes.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 #include <sstream>
 #include <tuple>
 
-namespace ridgeline::report {
+namespace ridgeline::bench {
 
 namespace {
 constexpr double kPi = 3.14159265358979323846;
@@ -385,4 +385,4 @@ std::string check_watertight(const Grid& hf, const DrawnMesh& mesh) {
   return {};
 }
 
-}  // namespace ridgeline::report
+}  // namespace ridgeline::bench

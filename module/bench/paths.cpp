@@ -1,10 +1,10 @@
-// Camera paths for `ridge report` (paths.h).
-#include "report/paths.h"
+// The six generated camera paths (paths.h).
+#include "ridgeline/bench/paths.h"
 
 #include <algorithm>
 #include <cmath>
 
-namespace ridgeline::report {
+namespace ridgeline::bench {
 
 std::vector<NamedPath> make_paths(const Terrain& terrain, int frames) {
   constexpr double kPi = 3.14159265358979323846;
@@ -79,4 +79,4 @@ std::vector<NamedPath> make_paths(const Terrain& terrain, int frames) {
   return out;
 }
 
-}  // namespace ridgeline::report
+}  // namespace ridgeline::bench
