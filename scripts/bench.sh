@@ -12,7 +12,7 @@ out=${1:-docs/benchmarks}
 work=build/bench
 mkdir -p "$out" "$work"
 ensure_packages "${RIDGELINE_PACKAGES[@]}" python3
-configure_and_build build/release -DCMAKE_BUILD_TYPE=Release > /dev/null
+build_release ridge bench_lua > /dev/null
 ridge=build/release/module/ridge
 
 # The peers' noise field and circle path, from the project's own definition (ridgeline/scenes.h).

@@ -81,8 +81,7 @@ FUZZ_TARGETS=(fuzz_raw fuzz_camera_path fuzz_image fuzz_edit_json fuzz_edit_stat
 fuzz() {
   local dir=build/asan t rc=0 secs=${FUZZ_SECONDS:-30}
   mkdir -p "$dir/crashes"
-  cmake -S "$RIDGELINE_ROOT" -B "$dir" -G Ninja "${ASAN_CMAKE_ARGS[@]}" > "$dir.configure.log" 2>&1 ||
-    { cat "$dir.configure.log"; return 1; }
+  configure "$dir" "${ASAN_CMAKE_ARGS[@]}" || return 1
   cmake --build "$dir" -j "$JOBS" --target "${FUZZ_TARGETS[@]}" || return 1
   local sym=/usr/lib/llvm-14/bin/llvm-symbolizer
   [ -x "$sym" ] && export ASAN_SYMBOLIZER_PATH=$sym
