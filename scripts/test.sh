@@ -1,16 +1,17 @@
 #!/usr/bin/env bash
-# Builds and runs every test: the normal build and its tests, then an AddressSanitizer +
-# UndefinedBehaviorSanitizer build of the tests, then the fuzz targets (libFuzzer, bounded time).
+# Builds and runs every test: the normal build and its tests, the core and its unit tests on the
+# portable fallbacks (RIDGELINE_PORTABLE=ON), an AddressSanitizer + UndefinedBehaviorSanitizer
+# build of the tests, then the fuzz targets (libFuzzer, bounded time).
 # Installs missing Debian packages first.
 # Usage: scripts/test.sh            (all stages)
-#        STAGES="release" scripts/test.sh   (a subset: release asan fuzz)
+#        STAGES="release" scripts/test.sh   (a subset: release portable asan fuzz)
 #        FUZZ_SECONDS=600 FUZZ_SEED=$RANDOM STAGES=fuzz scripts/test.sh   (a longer, fresh fuzz run;
 #        default 30 s a target with the fixed seed 1, so that CI explores the same inputs each run)
 set -uo pipefail
 source "$(dirname "$0")/lib/common.sh"
 cd "$RIDGELINE_ROOT"
 
-STAGES=${STAGES:-"release asan fuzz"}
+STAGES=${STAGES:-"release portable asan fuzz"}
 JOBS=$(nproc)
 total0=$SECONDS
 
@@ -42,11 +43,14 @@ check_skips() {
   [ ${#unexpected[@]} -eq 0 ]
 }
 
-# run_ctest STAGE DIR [ctest args...]: ctest in DIR with its output kept in DIR/ctest.log, then
-# the skip check.
+# run_ctest STAGE DIR [PREFIX...] [-- CTEST_ARGS...]: ctest in DIR (run under the PREFIX command,
+# e.g. with_display) with its output kept in DIR/ctest.log, then the skip check.
 run_ctest() {
-  local stage=$1 dir=$2 rc; shift 2
-  (cd "$dir" && "$@" ctest --output-on-failure -j "$JOBS") 2>&1 | tee "$dir/ctest.log"
+  local stage=$1 dir=$2 rc prefix=() args=(); shift 2
+  while [ $# -gt 0 ] && [ "$1" != -- ]; do prefix+=("$1"); shift; done
+  [ $# -gt 0 ] && { shift; args=("$@"); }
+  (cd "$dir" && "${prefix[@]}" ctest --output-on-failure -j "$JOBS" "${args[@]}") 2>&1 |
+    tee "$dir/ctest.log"
   rc=${PIPESTATUS[0]}
   check_skips "$stage" "$dir/ctest.log" || rc=1
   return $rc
@@ -57,6 +61,20 @@ release() {
   # Under Xvfb when there is no display: the game's OpenGL tests need an X server for GLFW
   # (they skip with exit 77 where no context can be made; EGL needs none).
   LP_NUM_THREADS=2 run_ctest release build/release with_display
+}
+
+# The core on its portable fallbacks (docs/architecture.md, "Portability"): Ridgeline::terrain,
+# Ridgeline::io and the unit tests (ctest label `unit`: tests/unit, the source layers and the
+# symbols the core calls), built with RIDGELINE_PORTABLE=ON; no tool, Lua, Bullet, game,
+# benchmark or fuzz target. A few minutes on two cores.
+PORTABLE_CMAKE_ARGS=(-DCMAKE_BUILD_TYPE=Release -DRIDGELINE_PORTABLE=ON -DRIDGELINE_BUILD_TESTS=ON
+  -DRIDGELINE_BUILD_TOOLS=OFF -DRIDGELINE_BUILD_LUA=OFF -DRIDGELINE_BUILD_BULLET=OFF
+  -DRIDGELINE_BUILD_GAME=OFF -DRIDGELINE_BUILD_BENCHMARKS=OFF)
+
+portable() {
+  configure build/portable "${PORTABLE_CMAKE_ARGS[@]}" || return 1
+  cmake --build build/portable -j "$JOBS" --target unit_tests || return 1
+  run_ctest portable build/portable -- -L unit
 }
 
 # One clang build with ASan, UBSan and libFuzzer instrumentation serves the sanitizer tests and

@@ -11,6 +11,7 @@
 #include "cli_util.h"
 #include "commands.h"
 #include "ridgeline/edit.h"
+#include "ridgeline/edit_file.h"
 #include "ridgeline/edit_json.h"
 #include "ridgeline/landscape.h"
 #include "ridgeline/roam_view.h"
@@ -65,7 +66,7 @@ int run_deform(const DeformArgs& a) {
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   if (!a.save.empty())
-    if (auto s = save_edits(t, a.save); !s) return report_error(s.message());
+    if (auto s = io::save_edits(t, a.save); !s) return report_error(s.message());
   nlohmann::ordered_json j = {{"source", a.terrain.source()},
                               {"edits", edits->size()},
                               {"edits_changed", changed},
