@@ -35,5 +35,7 @@ Command add_bench_deform_command(CLI::App& bench);
 Command add_bench_detail_command(CLI::App& bench);
 /// `ridge bench queries`: query speed (JSON), measured by bench_queries.h.
 Command add_bench_queries_command(CLI::App& bench);
+/// `ridge bench world`: baked worlds measured by ridge-bench-world (JSON; cmd_bench_world.cpp).
+Command add_bench_world_command(CLI::App& bench);
 
 }  // namespace ridgeline::cli

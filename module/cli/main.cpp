@@ -74,6 +74,7 @@ int main(int argc, char** argv) {
   commands.push_back(add_bench_lod_command(*bench));
   commands.push_back(add_bench_deform_command(*bench));
   commands.push_back(add_bench_detail_command(*bench));
+  commands.push_back(add_bench_world_command(*bench));
 
   if (const std::string unknown = unknown_subcommand(app, argc, argv); !unknown.empty()) {
     std::fprintf(stderr, "ridge: error: %s\n", unknown.c_str());

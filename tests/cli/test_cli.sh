@@ -172,7 +172,7 @@ run info --heightmap "$RGB"; expect "rgb refused" 1 "3 channels (R, G, B)"
 run info --heightmap "$RGB" --channel 1; expect "rgb channel 1" 0
 near "rgb green max = 12" "$(json_num height_max)" 12 0
 run info --heightmap "$RGB" --channel 3; expect "rgb channel 3" 1 "channel 3 requested"
-run info --heightmap "$PNG" --max-samples 19; expect "size cap" 1 "exceeds the limit of 19 samples"
+run info --heightmap "$PNG" --max-samples 19; expect "size cap" 1 "exceeds the limit of 19 samples (HeightfieldDesc::max_samples); raise it with --max-samples N"
 run info --heightmap "$PNG" --max-samples 20; expect "size cap exact" 0
 run info --default-terrain --max-samples 1000; expect "default terrain cap" 1 "exceeds the limit"
 run info --heightmap "$PNG" --materials "$RGB"; expect "material size" 1 "material image"

@@ -93,7 +93,7 @@ struct BakedRecords {
 
 /// One page as a PageSource delivers it.
 struct PageData {
-  /// kPageEntries heights, row-major (entry (a, b) at (a + 2) + (b + 2) * kPageStride): u16 for
+  /// kPageEntries heights, row-major (entry (a, b) at (a + 6) + (b + 6) * kPageStride): u16 for
   /// SampleFormat::kU16, f32 for kF32 (the other stays empty).
   std::vector<std::uint16_t> u16;
   std::vector<float> f32;

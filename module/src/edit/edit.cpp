@@ -140,7 +140,7 @@ void Terrain::commit(const SampleChanges& c, EditResult& r) {
   world::PageStore& store = *surface_.store_;
   for (int slot = 0; slot < int(world::kRecordSlots); ++slot)
     if (const world::RecordMaker* m = store.maker(slot))
-      store.set_records(slot, m->remake(store, c.i0, c.j0, c.i1, c.j1));
+      store.set_records(slot, m->remake(store, c.i0, c.j0, c.i1, c.j1), true);
   TerrainChange ch = describe_change(surface_, c);
   ch.version = ++edit_version_;
   log_->record(ch);

@@ -20,7 +20,9 @@ static_assert(std::endian::native == std::endian::little,
 namespace {
 
 constexpr char kMagic[8] = {'R', 'I', 'D', 'G', 'E', 'E', 'D', 'T'};
-constexpr std::uint32_t kVersion = 1;
+// 2: the terrain hash a file records is the page-wise content hash (version 1 recorded an older
+// hash of the same samples, which no build computes any more).
+constexpr std::uint32_t kVersion = 2;
 constexpr std::size_t kHeaderBytes = 64;
 constexpr std::size_t kChunkValues = std::size_t{EditLayer::kChunk} * EditLayer::kChunk;
 constexpr std::size_t kChunkBytes = 8 + 4 * kChunkValues;
@@ -124,6 +126,10 @@ static Status check_edit_header(const Terrain& terrain, std::string_view in) {
   if (std::memcmp(in.data(), kMagic, 8) != 0)
     return Error{what + ": not a Ridgeline edit file (bad magic)"};
   const auto version = get<std::uint32_t>(in, 8);
+  if (version == 1)
+    return Error{what + ": version 1, written by an older build: it names its terrain by a hash "
+                        "this build no longer computes; load it with that build and apply the "
+                        "edits again, or re-create them"};
   if (version != kVersion)
     return Error{
         fmt("%s: version %u; this build reads version %u", what.c_str(), version, kVersion)};

@@ -28,7 +28,7 @@
 namespace ridgeline::io::world_file {
 
 inline constexpr char kMagic[8] = {'R', 'I', 'D', 'G', 'E', 'W', 'L', 'D'};
-inline constexpr std::uint32_t kVersion = 1;
+inline constexpr std::uint32_t kVersion = 3;  // 2: six-entry aprons; 3: 4-byte bounds
 /// Bytes 16 .. 79 of the file: the locator.
 inline constexpr std::size_t kLocatorAt = 16;
 inline constexpr std::size_t kLocatorBytes = 64;

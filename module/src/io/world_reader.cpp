@@ -239,15 +239,15 @@ Status WorldSource::load(const PageKey& key, PageData& out) const {
   p += e.materials;
   out.records.clear();
   if (e.records > 0) {
-    // Inflated to at most the largest block (its size is checked by the tessellator).
-    std::vector<std::uint8_t> rec(8 + kPageEntries * 3 * 2);
-    thread_local std::vector<std::uint8_t> scratch;
+    // Inflated to its stated size, at most that of the largest block (the tessellator checks
+    // the exact size): allocated exactly, as the page keeps it.
+    constexpr std::size_t kMaxRecordBytes = 8 + kPageEntries * 4;
     std::uint32_t raw = 0;
     // The record part starts with its raw size (4 bytes), then the Deflate stream.
     if (e.records < 4) return bad("tessellator bounds");
     std::memcpy(&raw, p, 4);
-    if (raw > rec.size()) return bad("tessellator bounds");
-    rec.resize(raw);
+    if (raw > kMaxRecordBytes) return bad("tessellator bounds");
+    std::vector<std::uint8_t> rec(raw);
     if (!inflate({p + 4, e.records - 4}, rec)) return bad("tessellator bounds");
     out.records = std::move(rec);
   }

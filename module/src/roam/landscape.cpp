@@ -61,7 +61,7 @@ class Maker final : public world::RecordMaker {
   std::shared_ptr<const RecordBlock> make(const world::Page& page) const override {
     if (page.key.level > 0) {
       if (!page.baked) return nullptr;
-      auto b = RecordBlock::decode(page.key.level, *page.baked);
+      auto b = RecordBlock::decode(page.key.level, page.baked);
       if (!b)
         log_message(LogLevel::kError,
             fmt("%s: page (%u, %d, %d): its tessellator bounds are damaged",
@@ -491,6 +491,18 @@ Result<std::shared_ptr<const Landscape>> Landscape::create(std::shared_ptr<const
         }
       }
       store.set_records(m.slot, level);
+    }
+    // The baked bounds predate the terrain's edits: remade around every edited page (its cells;
+    // remake() reaches the coarser diamonds over them).
+    const std::shared_ptr<const world::PageTable> table = store.snapshot();
+    for (std::size_t n = 0; n < table->size(); ++n) {
+      const world::Page& pg = table->page(n);
+      if (pg.key.level != 0 || !pg.edited) continue;
+      const std::int64_t i0 = std::int64_t(pg.key.px) << 8, j0 = std::int64_t(pg.key.pz) << 8;
+      store.set_records(m.slot,
+                        maker->remake(store, i0, j0, std::min(i0 + kPageCells, store.grid().last_i),
+                                      std::min(j0 + kPageCells, store.grid().last_j)),
+                        true);
     }
   }
   store.set_records(m.slot, blocks);

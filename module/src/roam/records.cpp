@@ -316,26 +316,40 @@ DiamondBound edge_bound(const RecordConfig& c, const Heights& h, std::int64_t i,
 // ---- encoding -----------------------------------------------------------------------------------
 
 std::vector<std::uint8_t> RecordBlock::encode() const {
-  std::vector<std::uint8_t> out(8 + values.size() * 2);
+  const std::size_t n =
+      values.empty() && encoded ? (encoded->size() - kHeaderBytes) / 4 : values.size();
+  std::vector<std::uint8_t> out(kHeaderBytes + n * 4);
   out[0] = 'R', out[1] = 'B', out[2] = std::uint8_t(level), out[3] = edges ? 1 : 0;
-  const std::uint32_t n = std::uint32_t(values.size());
-  std::memcpy(out.data() + 4, &n, 4);
-  std::memcpy(out.data() + 8, values.data(), values.size() * 2);
+  const std::uint32_t n32 = std::uint32_t(n);
+  std::memcpy(out.data() + 4, &n32, 4);
+  if (!values.empty())
+    std::memcpy(out.data() + kHeaderBytes, values.data(), n * 4);
+  else if (n > 0)
+    std::memcpy(out.data() + kHeaderBytes, encoded->data() + kHeaderBytes, n * 4);
   return out;
 }
 
 std::shared_ptr<RecordBlock> RecordBlock::decode(std::uint32_t level,
-                                                 const std::vector<std::uint8_t>& in) {
-  if (in.size() < 8 || in[0] != 'R' || in[1] != 'B' || in[2] != level) return nullptr;
+                                                 std::shared_ptr<const std::vector<std::uint8_t>> in) {
+  if (!in || in->size() < kHeaderBytes || (*in)[0] != 'R' || (*in)[1] != 'B' || (*in)[2] != level)
+    return nullptr;
   auto b = std::make_shared<RecordBlock>();
   b->level = level;
-  b->edges = in[3] != 0;
+  b->edges = (*in)[3] != 0;
   std::uint32_t n;
-  std::memcpy(&n, in.data() + 4, 4);
-  if (n != 3 * slots(level, b->edges) || in.size() != 8 + std::size_t(n) * 2) return nullptr;
-  b->values.resize(n);
-  std::memcpy(b->values.data(), in.data() + 8, std::size_t(n) * 2);
+  std::memcpy(&n, in->data() + 4, 4);
+  if (n == 0 || n != slots(level, b->edges) || in->size() != kHeaderBytes + std::size_t(n) * 4)
+    return nullptr;
+  b->encoded = std::move(in);
   return b;
+}
+
+void RecordBlock::own() {
+  if (!encoded) return;
+  const std::size_t n = (encoded->size() - kHeaderBytes) / 4;
+  values.resize(n);
+  std::memcpy(values.data(), encoded->data() + kHeaderBytes, n * 4);
+  encoded.reset();
 }
 
 // ---- level 0, from the page alone ---------------------------------------------------------------
@@ -393,7 +407,7 @@ std::shared_ptr<RecordBlock> level0_block(const RecordConfig& c, const world::Pa
   auto block = std::make_shared<RecordBlock>();
   block->level = 0;
   block->edges = c.L > 0;
-  block->values.assign(3 * RecordBlock::slots(0, block->edges), 0);
+  block->values.assign(RecordBlock::slots(0, block->edges), 0);
   // Every t <= 1 diamond of the page and its apron whose descendants lie on the entries. The
   // apron (kPageApron = 6) is the reach of a t = 1 square diamond, so every diamond of the
   // page's own cells is among them.
@@ -424,11 +438,11 @@ namespace {
 struct StrideGrid {
   int shift = 0;  // log2 stride
   std::int64_t nx = 0, nz = 0, off = 0;
-  std::vector<std::uint16_t> v;  // 3 per position
+  std::vector<std::uint32_t> v;  // one packed bound per position
   void init(int s, std::int64_t pad_i, std::int64_t pad_j, std::int64_t offset) {
     shift = s, off = offset;
     nx = ((pad_i - off) >> s) + 1, nz = ((pad_j - off) >> s) + 1;
-    v.assign(std::size_t(nx) * std::size_t(nz) * 3, 0);
+    v.assign(std::size_t(nx) * std::size_t(nz), 0);
   }
   bool has(std::int64_t i, std::int64_t j) const noexcept {
     if (i < off || j < off) return false;
@@ -438,12 +452,12 @@ struct StrideGrid {
   }
   DiamondBound get(std::int64_t i, std::int64_t j) const noexcept {
     if (!has(i, j)) return {};
-    const std::size_t k = 3 * (std::size_t((i - off) >> shift) + std::size_t((j - off) >> shift) * std::size_t(nx));
-    return {dequantize(v[k]), dequantize(v[k + 1]), dequantize(v[k + 2])};
+    const std::size_t k = std::size_t((i - off) >> shift) + std::size_t((j - off) >> shift) * std::size_t(nx);
+    return packed::unpack(v[k]);
   }
   void set(std::int64_t i, std::int64_t j, const DiamondBound& b) noexcept {
-    const std::size_t k = 3 * (std::size_t((i - off) >> shift) + std::size_t((j - off) >> shift) * std::size_t(nx));
-    v[k] = quantize_up(b.error), v[k + 1] = quantize_up(b.morph), v[k + 2] = quantize_up(b.radius);
+    const std::size_t k = std::size_t((i - off) >> shift) + std::size_t((j - off) >> shift) * std::size_t(nx);
+    v[k] = packed::pack(b);
   }
 };
 
@@ -527,18 +541,18 @@ void level_bounds(const RecordConfig& c, const H& h, int k, StrideGrid& grid,
   }
 }
 
-// The block of level-k page `key` (k >= 1) from the grids (apron included): the diamonds whose
+// The block of level-k page `key` (k >= 1) from the grids (entries 0 .. 256): the diamonds whose
 // record level (record_level()) is k, each from its own level's grid.
 std::shared_ptr<RecordBlock> slice(const RecordConfig& c, const std::vector<StrideGrid>& grids,
                                    std::uint32_t levels, const PageKey& key) {
   auto block = std::make_shared<RecordBlock>();
   block->level = key.level;
-  block->values.assign(3 * kPageEntries, 0);
+  block->values.assign(RecordBlock::kCoarse, 0);
   const int ls = world::level_shift(key.level);
   const std::int64_t i0 = std::int64_t(key.px) << world::page_shift(key.level);
   const std::int64_t j0 = std::int64_t(key.pz) << world::page_shift(key.level);
-  for (std::int32_t b = -kPageApron; b <= kPageCells + kPageApron; ++b)
-    for (std::int32_t a = -kPageApron; a <= kPageCells + kPageApron; ++a) {
+  for (std::int32_t b = 0; b <= kPageCells; ++b)
+    for (std::int32_t a = 0; a <= kPageCells; ++a) {
       const std::int64_t i = i0 + (std::int64_t(a) << ls), j = j0 + (std::int64_t(b) << ls);
       if (i < 0 || j < 0 || i > c.pad_i || j > c.pad_j) continue;
       const Diamond d = diamond_at(i, j, c.K);
@@ -627,14 +641,17 @@ std::vector<std::pair<PageKey, std::shared_ptr<const RecordBlock>>> remake(
     const RecordBlock* bl = block(key);
     return bl ? bl->get(a, b) : DiamondBound{};
   };
+  // Into every block holding it: its page's and, on a page edge, its neighbours' (entries 0 ..
+  // 256 of each).
   auto store_everywhere = [&](std::int64_t i, std::int64_t j, std::uint32_t k, const DiamondBound& v) {
     const int ls = world::level_shift(k);
     const std::int64_t x = i >> ls, z = j >> ls;
-    for (std::int64_t pz = std::max<std::int64_t>(0, floor_div(z - kPageCells - kPageApron + kPageCells - 1, kPageCells));
-         pz <= std::min<std::int64_t>(grid.pz[k] - 1, floor_div(z + kPageApron, kPageCells)); ++pz)
-      for (std::int64_t px = std::max<std::int64_t>(0, floor_div(x - kPageCells - kPageApron + kPageCells - 1, kPageCells));
-           px <= std::min<std::int64_t>(grid.px[k] - 1, floor_div(x + kPageApron, kPageCells)); ++px) {
+    for (std::int64_t pz = std::max<std::int64_t>(0, floor_div(z - 1, kPageCells));
+         pz <= std::min<std::int64_t>(grid.pz[k] - 1, floor_div(z, kPageCells)); ++pz)
+      for (std::int64_t px = std::max<std::int64_t>(0, floor_div(x - 1, kPageCells));
+           px <= std::min<std::int64_t>(grid.px[k] - 1, floor_div(x, kPageCells)); ++px) {
         const std::int32_t a = std::int32_t(x - (px << 8)), b = std::int32_t(z - (pz << 8));
+        if (!RecordBlock::holds(a, b)) continue;
         if (RecordBlock* bl = writable({k, std::int32_t(px), std::int32_t(pz)})) bl->set(a, b, v);
       }
   };

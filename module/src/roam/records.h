@@ -5,8 +5,8 @@
 // nested error bound, a nested morph bound and a nested bounding sphere (landscape.h's
 // DiamondBound). A diamond of size 2^t lives in the pages of level k = t / 2 (whose stride 4^k
 // holds its centre; the coarsest level of the world's pyramid holds every coarser diamond too),
-// as three bfloat16 values rounded up (6 bytes): conservative, and nested
-// because every bound is computed from its children's quantised values.
+// packed in 4 bytes rounded up (packed::pack): conservative, and nested because every bound is
+// computed from its children's packed values.
 //
 // - Levels >= 1 (t >= 2): the exact nested bounds, computed once from every sample under them
 //   (in memory at Landscape::create, or by the bake, which stores them in the world).
@@ -25,7 +25,9 @@
 #include <bit>
 #include <cmath>
 #include <cfloat>
+#include <array>
 #include <cstdint>
+#include <cstring>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -41,21 +43,65 @@ class DetailField;
 
 namespace ridgeline::roam {
 
-/// A bound quantised to 16 bits (bfloat16) rounded towards +infinity (0 stays 0; FLT_MAX and
-/// infinity become infinity).
-inline std::uint16_t quantize_up(float v) noexcept {
+/// A bound packed in 32 bits, every part rounded towards +infinity (so conservative, and nested
+/// because every bound is computed from its children's packed values):
+/// - bits 0-11, the error, and bits 12-23, the radius: 12-bit unsigned floats (6-bit exponent
+///   covering 2^-37 .. 2^26 m, 6-bit mantissa: at most 1/64 above the value); 0 stays 0, values
+///   past the range (FLT_MAX: over the data's border) become infinity;
+/// - bits 24-31, the morph bound over the packed error, 2^(c/64) for c = 0 .. 255 (1 .. 15.8);
+///   a larger ratio raises the packed error instead (still a bound).
+namespace packed {
+inline constexpr int kBias = 38;
+inline constexpr std::uint32_t kInfinity = 0xfff;
+inline std::uint32_t up12(float v) noexcept {
   if (!(v > 0.0f)) return 0;
-  const std::uint32_t b = std::bit_cast<std::uint32_t>(v);
-  if (b >= 0x7f7f0000u) return 0x7f80;  // at or near FLT_MAX: infinity
-  return std::uint16_t((b + 0xffffu) >> 16);
+  if (!(v < 1.0e30f)) return kInfinity;
+  const std::uint32_t bits = std::bit_cast<std::uint32_t>(v);
+  std::int32_t e = std::int32_t(bits >> 23) - 127 + kBias;
+  std::uint32_t m = (bits & 0x7fffffu) >> 17;
+  if ((bits & 0x1ffffu) != 0) ++m;
+  if (m == 64) m = 0, ++e;
+  if (e < 1) return 1u << 6;  // the smallest positive value
+  const std::uint32_t c = (std::uint32_t(e) << 6) | m;
+  return e > 63 || c >= kInfinity ? kInfinity : c;
 }
-inline float dequantize(std::uint16_t q) noexcept {
-  return std::bit_cast<float>(std::uint32_t(q) << 16);
+inline float down12(std::uint32_t c) noexcept {
+  if (c == 0) return 0.0f;
+  if (c >= kInfinity) return std::numeric_limits<float>::infinity();
+  return std::bit_cast<float>(((((c >> 6) & 63u) + 127u - kBias) << 23) | ((c & 63u) << 17));
 }
-/// A bound as the records hold it (each value rounded up to bfloat16).
+inline const std::array<float, 256> kRatio = [] {
+  std::array<float, 256> r{};
+  for (int c = 0; c < 256; ++c) r[std::size_t(c)] = float(std::exp2(double(c) / 64.0));
+  return r;
+}();
+inline DiamondBound unpack(std::uint32_t v) noexcept {
+  const float e = down12(v & 0xfffu);
+  return {e, e * kRatio[v >> 24], down12((v >> 12) & 0xfffu)};
+}
+inline std::uint32_t pack(const DiamondBound& b) noexcept {
+  const float morph = std::max(b.morph, b.error);
+  std::uint32_t ce = up12(b.error);
+  float e = down12(ce);
+  std::uint32_t cm = 0;
+  if (morph > e) {
+    if (!(morph < 1.0e30f)) {
+      ce = kInfinity, e = down12(ce);
+    } else {
+      if (!(e * kRatio[255] >= morph)) ce = up12(morph / kRatio[255] * (1.0f + 0x1p-12f)), e = down12(ce);
+      int c = std::clamp(int(std::ceil(64.0 * std::log2(double(morph) / double(e)))), 0, 255);
+      while (c > 0 && e * kRatio[std::size_t(c - 1)] >= morph) --c;
+      while (c < 255 && e * kRatio[std::size_t(c)] < morph) ++c;
+      cm = std::uint32_t(c);
+    }
+  }
+  return ce | (up12(b.radius) << 12) | (cm << 24);
+}
+}  // namespace packed
+
+/// A bound as the records hold it (packed::pack, then unpacked).
 inline DiamondBound quantized(const DiamondBound& b) noexcept {
-  return {dequantize(quantize_up(b.error)), dequantize(quantize_up(b.morph)),
-          dequantize(quantize_up(b.radius))};
+  return packed::unpack(packed::pack(b));
 }
 
 /// The level of the pages holding the bounds of a stored diamond of size 2^t in a pyramid of
@@ -70,20 +116,30 @@ struct RecordBlock {
   /// Level 0 with detail: the size-1 edge diamonds are stored too (their children are detail
   /// diamonds, so three heights do not give their bound).
   bool edges = false;
-  /// Three values (error, morph, radius) per slot (slot()).
-  std::vector<std::uint16_t> values;
+  /// One packed bound (packed::pack) per slot (slot()), held here (blocks made in memory) or,
+  /// when empty, read in place from `encoded` (a baked payload the page holds anyway: decode()
+  /// copies nothing).
+  std::vector<std::uint32_t> values;
+  std::shared_ptr<const std::vector<std::uint8_t>> encoded;
+  static constexpr std::size_t kHeaderBytes = 8;
 
   /// Slots of a level-0 block: both coordinates odd (128 x 128), both even (129 x 129), then,
-  /// with `edges`, odd x (128 x 129) and odd z (129 x 128). Levels >= 1: every entry (269 x 269,
-  /// apron included).
+  /// with `edges`, odd x (128 x 129) and odd z (129 x 128). Levels >= 1: every entry of the
+  /// page's cells and far edges (257 x 257; the apron's diamonds belong to the neighbours).
   static constexpr std::size_t kOdd = 128 * 128, kEven = 129 * 129, kEdge = 128 * 129;
+  static constexpr std::int32_t kSide = kPageCells + 1;
+  static constexpr std::size_t kCoarse = std::size_t(kSide) * kSide;
   static std::size_t slots(std::uint32_t level, bool edges) noexcept {
-    return level > 0 ? kPageEntries : kOdd + kEven + (edges ? 2 * kEdge : 0);
+    return level > 0 ? kCoarse : kOdd + kEven + (edges ? 2 * kEdge : 0);
   }
-  /// Slot of entry (a, b): level 0 for a, b in 0 .. 256 (never a size-1 edge diamond without
-  /// `edges`), levels >= 1 for a, b in -6 .. 262.
+  /// Whether entry (a, b) has a slot (a, b in 0 .. 256).
+  static bool holds(std::int32_t a, std::int32_t b) noexcept {
+    return a >= 0 && b >= 0 && a <= kPageCells && b <= kPageCells;
+  }
+  /// Slot of entry (a, b), a, b in 0 .. 256 (holds()); at level 0 never a size-1 edge diamond
+  /// without `edges`.
   std::size_t slot(std::int32_t a, std::int32_t b) const noexcept {
-    if (level > 0) return world::entry_index(a, b);
+    if (level > 0) return std::size_t(a) + std::size_t(b) * std::size_t(kSide);
     const bool oa = (a & 1) != 0, ob = (b & 1) != 0;
     if (oa && ob) return std::size_t(a >> 1) + std::size_t(b >> 1) * 128;
     if (!oa && !ob) return kOdd + std::size_t(a >> 1) + std::size_t(b >> 1) * 129;
@@ -91,18 +147,27 @@ struct RecordBlock {
     return kOdd + kEven + kEdge + std::size_t(a >> 1) + std::size_t(b >> 1) * 129;
   }
   DiamondBound get(std::int32_t a, std::int32_t b) const noexcept {
-    const std::uint16_t* v = values.data() + 3 * slot(a, b);
-    return {dequantize(v[0]), dequantize(v[1]), dequantize(v[2])};
+    std::uint32_t v;
+    if (!values.empty())
+      v = values[slot(a, b)];
+    else
+      std::memcpy(&v, encoded->data() + kHeaderBytes + sizeof v * slot(a, b), sizeof v);
+    return packed::unpack(v);
   }
-  void set(std::int32_t a, std::int32_t b, const DiamondBound& d) noexcept {
-    std::uint16_t* v = values.data() + 3 * slot(a, b);
-    v[0] = quantize_up(d.error), v[1] = quantize_up(d.morph), v[2] = quantize_up(d.radius);
+  /// Sets one slot (a block read in place is copied into `values` first).
+  void set(std::int32_t a, std::int32_t b, const DiamondBound& d) {
+    if (values.empty() && encoded) own();
+    values[slot(a, b)] = packed::pack(d);
   }
-  std::size_t bytes() const noexcept { return sizeof(*this) + values.capacity() * 2; }
+  /// Bytes this block holds itself (a block read in place holds none of its payload).
+  std::size_t bytes() const noexcept { return sizeof(*this) + values.capacity() * 4; }
   /// The block as bytes (the bake's payload) and back (checked: size and level; null when they
   /// do not fit).
   std::vector<std::uint8_t> encode() const;
-  static std::shared_ptr<RecordBlock> decode(std::uint32_t level, const std::vector<std::uint8_t>& b);
+  static std::shared_ptr<RecordBlock> decode(std::uint32_t level,
+                                             std::shared_ptr<const std::vector<std::uint8_t>> b);
+  /// Copies an in-place payload into `values`.
+  void own();
 };
 
 /// What the bounds depend on besides the heights (a Landscape's configuration).

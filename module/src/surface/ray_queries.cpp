@@ -268,23 +268,6 @@ bool RayQueries::walk_leaf(const Lattice& g, double touch_, const Ray& stored, s
   }
 }
 
-std::optional<RayHit> RayQueries::raycast(const Surface& s, const glm::dvec3& origin,
-                                          const glm::dvec3& direction,
-                                          double max_distance) noexcept {
-  return detail::with_lattice(s, [&](const auto& g) -> std::optional<RayHit> {
-    auto hit = raycast_impl(g, s, s.detail_bound(), origin, direction, max_distance);
-    if (g.missing || stored_of(g).missing) return std::nullopt;  // a page could not be loaded
-    return hit;
-  });
-}
-
-std::size_t RayQueries::triangles_in_box(const Surface& s, const Box& box,
-                                         std::vector<SurfaceTriangle>& out,
-                                         std::size_t max_triangles) {
-  return detail::with_lattice(
-      s, [&](const auto& g) { return boxes_impl(g, s.detail_bound(), box, out, max_triangles); });
-}
-
 // `widen`: the detail bound, metres, by which the pyramid's stored maxima are raised.
 template <class Lattice>
 std::optional<RayHit> RayQueries::raycast_impl(const Lattice& g, const Surface& s, double widen,
@@ -501,6 +484,23 @@ std::size_t RayQueries::boxes_impl(const Lattice& g, double widen, const Box& bo
     }
   }
   return added;
+}
+
+std::optional<RayHit> RayQueries::raycast(const Surface& s, const glm::dvec3& origin,
+                                          const glm::dvec3& direction,
+                                          double max_distance) noexcept {
+  return detail::with_lattice(s, [&](const auto& g) -> std::optional<RayHit> {
+    auto hit = raycast_impl(g, s, s.detail_bound(), origin, direction, max_distance);
+    if (g.missing || stored_of(g).missing) return std::nullopt;  // a page could not be loaded
+    return hit;
+  });
+}
+
+std::size_t RayQueries::triangles_in_box(const Surface& s, const Box& box,
+                                         std::vector<SurfaceTriangle>& out,
+                                         std::size_t max_triangles) {
+  return detail::with_lattice(
+      s, [&](const auto& g) { return boxes_impl(g, s.detail_bound(), box, out, max_triangles); });
 }
 
 }  // namespace ridgeline

@@ -569,7 +569,8 @@ const RecordMaker* PageStore::maker(int slot) const noexcept {
 
 void PageStore::set_records(
     int slot,
-    const std::vector<std::pair<PageKey, std::shared_ptr<const roam::RecordBlock>>>& blocks) {
+    const std::vector<std::pair<PageKey, std::shared_ptr<const roam::RecordBlock>>>& blocks,
+    bool edited) {
   std::vector<std::shared_ptr<const Page>> changed;
   {
     std::lock_guard lock(cache_->mu);
@@ -578,6 +579,7 @@ void PageStore::set_records(
       if (it == cache_->resident.end()) continue;
       auto p = it->second.page->copy();
       p->records[std::size_t(slot)] = block;
+      p->edited |= edited;
       std::shared_ptr<const Page> cp = std::move(p);
       cache_->insert(cp, *this, it->second.forever);
       changed.push_back(std::move(cp));

@@ -112,10 +112,13 @@ class PageStore {
   /// Frees a slot: its bounds are dropped from the pages published next.
   void remove_slot(int slot);
   /// Replaces pages with versions carrying `blocks` in `slot` (bounds computed in bulk, or after
-  /// an edit), and publishes. Exclusive access or the store's own callers only.
+  /// an edit), and publishes. `edited`: the blocks follow an edit, so the pages now differ from
+  /// their source and are never evicted (Page::edited). Exclusive access or the store's own
+  /// callers only.
   void set_records(int slot,
                    const std::vector<std::pair<PageKey, std::shared_ptr<const roam::RecordBlock>>>&
-                       blocks);
+                       blocks,
+                   bool edited = false);
   const RecordMaker* maker(int slot) const noexcept;
 
   // ---- summaries and the ray pyramid above pages ---------------------------------------------
