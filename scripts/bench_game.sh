@@ -14,7 +14,8 @@
 # it; CPU times (process and game thread) are recorded per frame too.
 # Writes docs/benchmarks/game.json and the plots docs/images/game_budget_{busy,spike}.png; the
 # per-frame files stay in out/bench_game/.
-# Usage: scripts/bench_game.sh [BUILD_DIR]   (default build/release; builds ridgeline_game there)
+# Usage: scripts/bench_game.sh [BUILD_DIR]   (default build/release, configured and built as every
+#        script does; another, already configured folder is only built)
 #        BENCH_GAME_ONLY="steady busy" scripts/bench_game.sh   (a subset; the others are kept
 #        from the previous docs/benchmarks/game.json)
 #        BENCH_GAME_QUIET=1.5 scripts/bench_game.sh   (before each run, wait up to 20 minutes for
@@ -23,9 +24,12 @@ set -euo pipefail
 source "$(dirname "$0")/lib/common.sh"
 cd "$RIDGELINE_ROOT"
 ensure_packages "${RIDGELINE_PACKAGES[@]}" "${RIDGELINE_REPORT_PACKAGES[@]}"
-build=${1:-build/release}
-[ -f "$build/build.ninja" ] || cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release > /dev/null
-cmake --build "$build" --target ridgeline_game > /dev/null
+build=${1:-$RIDGELINE_RELEASE_DIR}
+if [ "$build" = "$RIDGELINE_RELEASE_DIR" ]; then
+  build_release ridgeline_game > /dev/null
+else  # a build folder the caller configured
+  cmake --build "$build" --target ridgeline_game > /dev/null
+fi
 game=$build/sample_game/ridgeline_game
 out=out/bench_game
 mkdir -p "$out" docs/images

@@ -23,7 +23,7 @@ rounds=${ROUNDS:-3}
 work=build/bench
 mkdir -p "$work" "$(dirname "$out")"
 ensure_packages "${RIDGELINE_PACKAGES[@]}" python3
-configure_and_build build/release -DCMAKE_BUILD_TYPE=Release > /dev/null
+build_release ridge bench_roam_core > /dev/null
 ridge=build/release/module/ridge
 [ -f "$work/noise1025.png" ] && [ -f "$work/noise1025_circle.json" ] ||
   "$ridge" report --write-noise-field "$work"

@@ -14,11 +14,8 @@ mkdir -p "$out" "$data"
 ensure_packages "${RIDGELINE_PACKAGES[@]}" "${RIDGELINE_REPORT_PACKAGES[@]}"
 ridge=${RIDGE:-}
 if [ -z "$ridge" ]; then  # the report needs only `ridge`: build that target, not the whole tree
-  mkdir -p build/release
-  cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release > build/release.configure.log 2>&1 ||
-    { cat build/release.configure.log; exit 1; }
-  cmake --build build/release -j "$(nproc)" --target ridge > /dev/null
-  ridge=build/release/module/ridge
+  build_release ridge > /dev/null
+  ridge=$RIDGELINE_RELEASE_DIR/module/ridge
 fi
 build_s=$SECONDS
 

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Builds and runs every test: the normal build and its tests, then an AddressSanitizer +
-# UndefinedBehaviorSanitizer build of the tests, then the fuzz targets (libFuzzer, bounded time).
+# Builds and runs every test: the normal build and its tests, the core and its unit tests on the
+# portable fallbacks (RIDGELINE_PORTABLE=ON), an AddressSanitizer + UndefinedBehaviorSanitizer
+# build of the tests, then the fuzz targets (libFuzzer, bounded time).
 # Installs missing Debian packages first.
 # Usage: scripts/test.sh            (all stages)
 #        STAGES="release" scripts/test.sh   (a subset: release portable asan fuzz)
@@ -42,11 +43,14 @@ check_skips() {
   [ ${#unexpected[@]} -eq 0 ]
 }
 
-# run_ctest STAGE DIR [ctest args...]: ctest in DIR with its output kept in DIR/ctest.log, then
-# the skip check.
+# run_ctest STAGE DIR [PREFIX...] [-- CTEST_ARGS...]: ctest in DIR (run under the PREFIX command,
+# e.g. with_display) with its output kept in DIR/ctest.log, then the skip check.
 run_ctest() {
-  local stage=$1 dir=$2 rc; shift 2
-  (cd "$dir" && "$@" ctest --output-on-failure -j "$JOBS") 2>&1 | tee "$dir/ctest.log"
+  local stage=$1 dir=$2 rc prefix=() args=(); shift 2
+  while [ $# -gt 0 ] && [ "$1" != -- ]; do prefix+=("$1"); shift; done
+  [ $# -gt 0 ] && { shift; args=("$@"); }
+  (cd "$dir" && "${prefix[@]}" ctest --output-on-failure -j "$JOBS" "${args[@]}") 2>&1 |
+    tee "$dir/ctest.log"
   rc=${PIPESTATUS[0]}
   check_skips "$stage" "$dir/ctest.log" || rc=1
   return $rc
@@ -59,14 +63,18 @@ release() {
   LP_NUM_THREADS=2 run_ctest release build/release with_display
 }
 
-# The core and its tests from standard C++ alone (RIDGELINE_PORTABLE: plain allocations instead
-# of reserved address space, no SIMD dispatch, no prefetch hints), without the optional targets:
-# what an engine on another platform builds.
+# The core on its portable fallbacks (docs/architecture.md, "Portability"): Ridgeline::terrain,
+# Ridgeline::io and the unit tests (ctest label `unit`: tests/unit, the source layers and the
+# symbols the core calls), built with RIDGELINE_PORTABLE=ON; no tool, Lua, Bullet, game,
+# benchmark or fuzz target. A few minutes on two cores.
+PORTABLE_CMAKE_ARGS=(-DCMAKE_BUILD_TYPE=Release -DRIDGELINE_PORTABLE=ON -DRIDGELINE_BUILD_TESTS=ON
+  -DRIDGELINE_BUILD_TOOLS=OFF -DRIDGELINE_BUILD_LUA=OFF -DRIDGELINE_BUILD_BULLET=OFF
+  -DRIDGELINE_BUILD_GAME=OFF -DRIDGELINE_BUILD_BENCHMARKS=OFF)
+
 portable() {
-  configure_and_build build/portable -DCMAKE_BUILD_TYPE=Release -DRIDGELINE_PORTABLE=ON \
-    -DRIDGELINE_BUILD_IO=OFF -DRIDGELINE_BUILD_BENCHMARKS=OFF -DRIDGELINE_BUILD_BULLET=OFF ||
-    return 1
-  run_ctest portable build/portable
+  configure build/portable "${PORTABLE_CMAKE_ARGS[@]}" || return 1
+  cmake --build build/portable -j "$JOBS" --target unit_tests || return 1
+  run_ctest portable build/portable -- -L unit
 }
 
 # One clang build with ASan, UBSan and libFuzzer instrumentation serves the sanitizer tests and
@@ -93,8 +101,7 @@ FUZZ_TARGETS=(fuzz_raw fuzz_camera_path fuzz_image fuzz_edit_json fuzz_edit_stat
 fuzz() {
   local dir=build/asan t rc=0 secs=${FUZZ_SECONDS:-30}
   mkdir -p "$dir/crashes"
-  cmake -S "$RIDGELINE_ROOT" -B "$dir" -G Ninja "${ASAN_CMAKE_ARGS[@]}" > "$dir.configure.log" 2>&1 ||
-    { cat "$dir.configure.log"; return 1; }
+  configure "$dir" "${ASAN_CMAKE_ARGS[@]}" || return 1
   cmake --build "$dir" -j "$JOBS" --target "${FUZZ_TARGETS[@]}" || return 1
   local sym=/usr/lib/llvm-14/bin/llvm-symbolizer
   [ -x "$sym" ] && export ASAN_SYMBOLIZER_PATH=$sym

@@ -12,6 +12,7 @@
 #include "ridgeline/bench/stats.h"
 #include "commands.h"
 #include "ridgeline/edit.h"
+#include "ridgeline/edit_file.h"
 #include "ridgeline/edit_json.h"
 #include "ridgeline/landscape.h"
 #include "ridgeline/roam_view.h"
@@ -65,7 +66,7 @@ int run_deform(const DeformArgs& a) {
   }
   const double ms = bench::ms_since(t0);
   if (!a.save.empty())
-    if (auto s = save_edits(t, a.save); !s) return report_error(s.message());
+    if (auto s = io::save_edits(t, a.save); !s) return report_error(s.message());
   nlohmann::ordered_json j = {{"source", a.terrain.source()},
                               {"edits", edits->size()},
                               {"edits_changed", changed},

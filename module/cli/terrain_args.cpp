@@ -8,6 +8,7 @@
 #include "cli_util.h"
 #include "ridgeline/detail.h"
 #include "ridgeline/edit.h"
+#include "ridgeline/edit_file.h"
 #include "ridgeline/io.h"
 #include "ridgeline/log.h"
 #include "ridgeline/world_file.h"
@@ -451,7 +452,7 @@ Result<std::shared_ptr<Terrain>> TerrainArgs::load_terrain(io::LoadReport* repor
     if (report != nullptr) report->pixel_type = (*t)->info().format == SampleFormat::kU16 ? "uint16 (baked)" : "float (baked)";
     std::shared_ptr<Terrain> terrain = std::move(*t);
     if (given("--load")) {
-      auto r = load_edits(*terrain, load_);
+      auto r = io::load_edits(*terrain, load_);
       if (!r) return Error{"--load: " + r.error().message};
     }
     return terrain;
@@ -469,7 +470,7 @@ Result<std::shared_ptr<Terrain>> TerrainArgs::load_terrain(io::LoadReport* repor
   if (!created) return Error{created.error().message};
   std::shared_ptr<Terrain> terrain = std::move(*created);
   if (given("--load")) {
-    auto r = load_edits(*terrain, load_);
+    auto r = io::load_edits(*terrain, load_);
     if (!r) return Error{"--load: " + r.error().message};
   }
   return terrain;

@@ -1,5 +1,6 @@
 // Measured error and popping of drawn meshes over a fixed sample of lattice vertices
-// (mesh_error.h; definitions in docs/report.md).
+// (mesh_error.h; definitions in docs/report.md). Any drawn mesh: nothing here knows the
+// tessellator (a view's leaves become a DrawnMesh in leaves_mesh.cpp).
 #include "ridgeline/mesh_error.h"
 
 #include <algorithm>
@@ -7,8 +8,6 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 #include <limits>
-
-#include "ridgeline/roam_view.h"
 
 namespace ridgeline {
 
@@ -19,21 +18,6 @@ std::uint32_t sampled(std::int64_t lattice, std::uint32_t stride) {
   return lattice > 0 ? static_cast<std::uint32_t>((lattice - 1) / stride + 1) : 0;
 }
 }  // namespace
-
-DrawnMesh leaves_mesh(const RoamView& view) {
-  const Landscape& l = view.landscape();
-  DrawnMesh out;
-  out.corners.reserve(std::size_t(view.triangle_count()) * 3);
-  const Surface& s = l.terrain().surface();
-  const double offset = l.terrain().info().height_offset;
-  auto corner = [&](std::int64_t i, std::int64_t j) {
-    return glm::dvec3(double(i), offset + double(float(s.vertex_height(i, j))), double(j));
-  };
-  view.for_each_leaf([&](std::uint32_t, std::uint64_t, const LatticeTriangle& t) {
-    out.add(corner(t.ax, t.az), corner(t.lx, t.lz), corner(t.rx, t.rz));
-  });
-  return out;
-}
 
 MeshErrorMeter::MeshErrorMeter(const Terrain& terrain, std::uint32_t stride)
     : terrain_(&terrain), stride_(std::max<std::uint32_t>(stride, 1)) {

@@ -7,10 +7,10 @@
 #include <algorithm>
 #include <cmath>
 
-#include "edit/edit_layer.h"
-#include "edit/edit_log.h"
+#include "change_log.h"
 #include "format.h"
 #include "ridgeline/detail.h"
+#include "surface/edit_layer.h"
 #include "surface/ray_queries.h"
 #include "world/page_store.h"
 
@@ -26,7 +26,8 @@ Terrain::Terrain(const Terrain& o, Surface::CloneTag tag)
     : surface_(o.surface_, tag),
       log_(std::make_unique<ChangeLog>(*o.log_)),
       base_hash_(o.base_hash_),
-      edit_version_(o.edit_version_) {}
+      edit_version_(o.edit_version_),
+      edit_limits_(o.edit_limits_) {}
 
 Terrain::~Terrain() = default;
 

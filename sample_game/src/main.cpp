@@ -443,11 +443,19 @@ int main(int argc, char** argv) {
   app.add_option("--render-scale", a.render_scale,
                  "with --threshold: fixed render scale (fraction of the resolution per axis)")
       ->check(CLI::Range(0.25, 1.0));
+  // The defaults quoted from the world's own (docs/game.md states them; ctest docs_facts compares).
+  const ridgeline::DetailParams world_detail = game::default_world_detail();
   app.add_option("--detail-levels", a.detail_levels,
-                 "procedural detail levels of the world (0: none; default 2)")
+                 "procedural detail levels of the world (0: none; default " +
+                     std::to_string(world_detail.levels) + ")")
       ->check(CLI::Range(0, 6));
   app.add_option("--detail-amplitude", a.detail_amplitude,
-                 "first detail octave, metres (default 0.2)")
+                 [&] {
+                   char text[64];
+                   std::snprintf(text, sizeof text, "first detail octave, metres (default %g)",
+                                 world_detail.amplitude);
+                   return std::string(text);
+                 }())
       ->check(CLI::Range(0.0, 10.0));
   app.add_option("--patch-exponent", a.patch_exponent, "ROAM patches of 2^k stored cells per side")
       ->check(CLI::Range(3, 8))

@@ -11,6 +11,7 @@
 
 #include "game.h"
 #include "ridgeline/edit.h"
+#include "ridgeline/edit_file.h"
 
 using game::Game;
 using game::GameOptions;
@@ -99,12 +100,12 @@ TEST(GameEdits, LoadingAnEditStateThatRaisesTheGroundLeavesTheTruckResting) {
   const int id = park_truck(*g, resting);
   const std::string raised = kTmp + "/game_raised.bin", flat = kTmp + "/game_flat.bin";
   std::filesystem::create_directories(kTmp);
-  ASSERT_TRUE(ridgeline::save_edits(g->terrain(), flat));
+  ASSERT_TRUE(ridgeline::io::save_edits(g->terrain(), flat));
   // A raise elsewhere, saved, then undone: the state holds ground 5 m higher under the truck
   // once it is moved there.
   ASSERT_TRUE(g->terrain_ptr()->apply_edit(
       {.brush = ridgeline::Brush::kRaise, .x = 1000, .z = 1000, .radius = 12, .depth = 5}));
-  ASSERT_TRUE(ridgeline::save_edits(g->terrain(), raised));
+  ASSERT_TRUE(ridgeline::io::save_edits(g->terrain(), raised));
   auto st = g->host().run("assert(ridgeline.load_edits(game.terrain, 'game_flat.bin'))", "undo");
   ASSERT_TRUE(st.ok()) << st.message();
   for (int f = 0; f < 180; ++f) g->step();  // lifted, then lowered back: settles again

@@ -56,30 +56,36 @@ fetch_test_data() {
   echo "r-cran-terra's example rasters: fetched into $dir/terra"
 }
 
-# configure_and_build BUILD_DIR [cmake args...]
-configure_and_build() {
+# configure BUILD_DIR [cmake args...]: configures BUILD_DIR with Ninja (the log in
+# BUILD_DIR.configure.log, printed when configuring fails).
+configure() {
   local dir=$1; shift
   mkdir -p "$dir"
   cmake -S "$RIDGELINE_ROOT" -B "$dir" -G Ninja "$@" > "$dir.configure.log" 2>&1 || {
     cat "$dir.configure.log"; return 1; }
-  cmake --build "$dir" -j "$(nproc)"
+}
+
+# configure_and_build BUILD_DIR [cmake args...]: configures, then builds every target.
+configure_and_build() {
+  local dir=$1; shift
+  configure "$dir" "$@" && cmake --build "$dir" -j "$(nproc)"
 }
 
 # The one Release build every script and the README's commands share: build/release, configured
-# with the defaults (everything on), so that no script's options undo another's.
+# with the defaults (everything on), so that no script's options undo another's. Every script
+# builds it through build_release and nothing else (tests/cli/check_scripts.sh, ctest
+# `scripts_one_release_layout`, fails on a script that configures it any other way).
 RIDGELINE_RELEASE_DIR=build/release
 RIDGELINE_RELEASE_ARGS=(-DCMAKE_BUILD_TYPE=Release -DRIDGELINE_BUILD_TESTS=ON
   -DRIDGELINE_BUILD_BENCHMARKS=ON -DRIDGELINE_BUILD_TOOLS=ON -DRIDGELINE_BUILD_LUA=ON
-  -DRIDGELINE_BUILD_BULLET=ON -DRIDGELINE_BUILD_GAME=ON)
+  -DRIDGELINE_BUILD_BULLET=ON -DRIDGELINE_BUILD_GAME=ON -DRIDGELINE_PORTABLE=OFF)
 
 # build_release [TARGET...]: configures build/release and builds the given targets (all when
 # none is given).
 build_release() {
   local dir=$RIDGELINE_ROOT/$RIDGELINE_RELEASE_DIR targets=()
   [ $# -gt 0 ] && targets=(--target "$@")
-  mkdir -p "$dir"
-  cmake -S "$RIDGELINE_ROOT" -B "$dir" -G Ninja "${RIDGELINE_RELEASE_ARGS[@]}" \
-    > "$dir.configure.log" 2>&1 || { cat "$dir.configure.log"; return 1; }
+  configure "$dir" "${RIDGELINE_RELEASE_ARGS[@]}" || return 1
   cmake --build "$dir" -j "$(nproc)" "${targets[@]}"
 }
 

@@ -263,6 +263,17 @@ near "query far corner is on the terrain" "$(sed -n 3p "$T/stdout" | cut -d, -f3
 fields=$(sed -n 1p "$T/stdout" | awk -F, '{ print NF }')
 [ "$fields" = 6 ] && ok || bad "query lines have 6 fields"
 run query --default-terrain --points - < "$T/points.csv"; expect "query from stdin" 0
+# A placement flag changes only what it names: --origin moves the default terrain and keeps its
+# 2 m spacing, so a point 2,000 m in from the new origin is still on it (with 1 m it was off).
+printf '%s\n' "2100,1200" "2148,1248" "2148,1249" > "$T/moved.csv"
+run query --default-terrain --origin 100,-800 --points "$T/moved.csv"; expect "query --origin" 0
+[ "$(sed -n 1p "$T/stdout" | cut -d, -f3)" != "" ] && ok ||
+  bad "--origin keeps the default terrain's 2 m spacing (2,000 m in is on it)" "$out"
+[ "$(sed -n 2p "$T/stdout" | cut -d, -f3)" != "" ] && ok || bad "--origin: far corner" "$out"
+[ "$(sed -n 3p "$T/stdout")" = "2148,1249,,,," ] && ok || bad "--origin: past the far edge" "$out"
+run info --default-terrain --origin 100,-800; expect "info --origin" 0
+[[ "$(tr -d ' \n' <<< "$out")" == *'"extent":[2048.0,2048.0]'* ]] && ok ||
+  bad "--origin keeps the 2,048 m extent" "$out"
 
 for line in "1;2" "1,2,3" "nan,1" "1,inf" "1," ",1" "x,y" "1e999,0"; do
   printf '0,0\n1,1\n%s\n' "$line" > "$T/bad.csv"

@@ -249,13 +249,12 @@ TEST(DetailSurface, EditsAndSaveFilesWithDetail) {
   ASSERT_EQ(v->check_invariants(), "");
   ASSERT_EQ(check_crack_free(*v), "");
   EXPECT_LE(v->measure_error(cam, 1).max_m, 0.3 + 1e-4);
-  const std::string f = std::string(RIDGELINE_TEST_TMP) + "/detail_edits.bin";
-  ASSERT_TRUE(save_edits(*t, f));
+  const std::string saved = save_edits_to_memory(*t);
   auto same = detail_terrain(65, 2);
-  ASSERT_TRUE(load_edits(*same, f));
+  ASSERT_TRUE(load_edits_from_memory(*same, saved));
   EXPECT_EQ(*same->height(100, 80), *t->height(100, 80));
   auto other_seed = detail_terrain(65, 2, 0, /*seed=*/6);
-  auto r = load_edits(*other_seed, f);
+  auto r = load_edits_from_memory(*other_seed, saved);
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().message.find("detail"), std::string::npos) << r.error().message;
 }

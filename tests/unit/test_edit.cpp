@@ -1,13 +1,12 @@
 // Deformation: brush shapes against their analytic profiles, the incremental bounds against a
 // rebuild, views crack-free and honest after edits on seams and corners, queries (rays included)
-// on the new surface, limits, and the edit file (round trip, undo, refusals that change nothing).
+// on the new surface, limits, and the edit file's bytes in memory and through streams (round trip,
+// undo, refusals that change nothing). Edit files on disk: test_edit_file.cpp (Ridgeline::io).
 #include <gtest/gtest.h>
-#include <sys/stat.h>
 
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <glm/common.hpp>
 #include <random>
 #include <thread>
@@ -36,10 +35,6 @@ std::shared_ptr<Terrain> flat_terrain(std::uint32_t n, double spacing = 1.0, dou
 std::shared_ptr<Terrain> noise_terrain(std::uint32_t n, std::uint32_t seed = 7) {
   return Terrain::create(
       std::move(make_default_heightfield({.size = n, .spacing = 2.0, .seed = seed})).value()).value();
-}
-
-std::string tmp_path(const std::string& name) {
-  return std::string(RIDGELINE_TEST_TMP) + "/" + name;
 }
 
 // Every bound of `l` (refreshed by the edits themselves) equals the one a fresh Landscape over
@@ -238,34 +233,34 @@ TEST(Transaction, TenThousandRandomEditsWhileTheCameraMoves) {
 TEST(EditFile, RoundTripUndoAndRefusals) {
   auto t = noise_terrain(129);
   auto l = Landscape::create(t, {.patch_exponent = 4}).value();
-  const std::string a = tmp_path("edits_a.bin"), b = tmp_path("edits_b.bin");
   const auto h0 = t->surface().heights_hash();
-  ASSERT_TRUE(save_edits(*t, a));  // empty layer
+  const std::string a = save_edits_to_memory(*t);  // empty layer
+  EXPECT_EQ(a.size(), 72u) << "header and checksum only";
   ASSERT_TRUE(t->apply_edit({.x = 40, .z = 60, .radius = 12, .depth = 4}));
   ASSERT_TRUE(
       t->apply_edit({.brush = Brush::kFlatten, .x = 200, .z = 250, .radius = 20, .height = 50}));
   const auto h1 = t->surface().heights_hash();
   ASSERT_NE(h0, h1);
-  ASSERT_TRUE(save_edits(*t, b));
+  const std::string b = save_edits_to_memory(*t);
   ASSERT_TRUE(t->apply_edit({.x = 100, .z = 100, .radius = 30, .depth = 9}));
   // Undo by loading the earlier saves; bounds follow.
-  auto r = load_edits(*t, b);
+  auto r = load_edits_from_memory(*t, b);
   ASSERT_TRUE(r) << r.error().message;
   EXPECT_EQ(t->surface().heights_hash(), h1);
   expect_bounds_equal_rebuild(*l);
-  ASSERT_TRUE(load_edits(*t, a));
+  ASSERT_TRUE(load_edits_from_memory(*t, a));
   EXPECT_EQ(t->surface().heights_hash(), h0);
   EXPECT_EQ(t->surface().edited_chunks(), 0u);
-  ASSERT_TRUE(load_edits(*t, b));
+  ASSERT_TRUE(load_edits_from_memory(*t, b));
   EXPECT_EQ(t->surface().heights_hash(), h1);
+  EXPECT_EQ(save_edits_to_memory(*t), b) << "loading and saving again gives the same bytes";
   // A fresh terrain with the same base loads it to the same hash.
   auto t2 = noise_terrain(129);
-  ASSERT_TRUE(load_edits(*t2, b));
+  ASSERT_TRUE(load_edits_from_memory(*t2, b));
   EXPECT_EQ(t2->surface().heights_hash(), h1);
 
   // Refusals change nothing.
-  std::ifstream in(b, std::ios::binary);
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string& bytes = b;
   ASSERT_TRUE(t->apply_edit({.x = 10, .z = 10, .radius = 5}));
   const auto h2 = t->surface().heights_hash();
   for (std::size_t cut : {std::size_t{0}, std::size_t{10}, std::size_t{63}, std::size_t{72},
@@ -281,33 +276,113 @@ TEST(EditFile, RoundTripUndoAndRefusals) {
     EXPECT_FALSE(load_edits_from_memory(*t, c)) << "corrupted at " << at;
   }
   auto other = noise_terrain(129, 8);  // another base
-  auto foreign = load_edits(*other, b);
+  auto foreign = load_edits_from_memory(*other, b);
   ASSERT_FALSE(foreign);
   EXPECT_NE(foreign.error().message.find("another terrain"), std::string::npos);
-  EXPECT_FALSE(load_edits(*t, tmp_path("missing.bin")));
   EXPECT_EQ(t->surface().heights_hash(), h2);
   expect_bounds_equal_rebuild(*l);
 }
 
-TEST(EditFile, FailedSaveKeepsThePreviousFile) {
-  auto t = flat_terrain(65);
-  const std::string dir = tmp_path("ro_dir");
-  ::mkdir(dir.c_str(), 0755);
-  const std::string f = dir + "/state.bin";
-  ASSERT_TRUE(save_edits(*t, f));
-  ASSERT_TRUE(t->apply_edit({.x = 32, .z = 32, .radius = 5}));
-  ::chmod(dir.c_str(), 0555);          // the temporary file cannot be created
-  const bool root = ::geteuid() == 0;  // root ignores the mode: nothing to prove then
-  auto s = save_edits(*t, f);
-  ::chmod(dir.c_str(), 0755);
-  if (!root) {
-    ASSERT_FALSE(s);
-    EXPECT_NE(s.message().find("previous file"), std::string::npos) << s.message();
-    auto fresh = flat_terrain(65);
-    ASSERT_TRUE(load_edits(*fresh, f));  // the old (empty) state is intact
-    EXPECT_EQ(fresh->surface().edited_chunks(), 0u);
+namespace {
+
+// A sink that keeps what it gets, one write() at a time, and fails the write numbered `fail_at`.
+struct RecordingSink final : EditSink {
+  std::vector<std::string> writes;
+  std::size_t fail_at = SIZE_MAX;
+  Status write(std::string_view bytes) override {
+    if (writes.size() == fail_at) return Error{"sink full"};
+    writes.emplace_back(bytes);
+    return {};
   }
-  EXPECT_FALSE(save_edits(*t, tmp_path("no/such/dir/state.bin")));
+  std::string all() const {
+    std::string out;
+    for (const std::string& w : writes) out += w;
+    return out;
+  }
+};
+
+// A source over `bytes` that hands out at most `step` bytes a read and fails after `fail_after`
+// bytes; counts what it handed out.
+struct ChunkedSource final : EditSource {
+  std::string bytes;
+  std::size_t step = 1, fail_after = SIZE_MAX, at = 0;
+  Result<std::size_t> read(std::span<char> buffer) override {
+    if (at >= fail_after) return Error{"source broke"};
+    const std::size_t n = std::min({buffer.size(), step, bytes.size() - at});
+    std::memcpy(buffer.data(), bytes.data() + at, n);
+    at += n;
+    return n;
+  }
+};
+
+}  // namespace
+
+TEST(EditFile, StreamsGiveTheBytesOfMemoryInBoundedWrites) {
+  auto t = noise_terrain(257);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0, 512);
+  for (int k = 0; k < 80; ++k)  // most of its 9 x 9 chunks: several 64 KiB writes
+    ASSERT_TRUE(t->apply_edit({.x = u(rng), .z = u(rng), .radius = 20, .depth = 2}));
+  const std::string bytes = save_edits_to_memory(*t);
+  ASSERT_GT(bytes.size(), std::size_t{3} << 16);
+  RecordingSink sink;
+  ASSERT_TRUE(save_edits(*t, sink));
+  EXPECT_EQ(sink.all(), bytes);
+  EXPECT_GT(sink.writes.size(), 3u);
+  for (const std::string& w : sink.writes) EXPECT_LE(w.size(), std::size_t{1} << 16);
+  // A sink error stops the save and comes back unchanged.
+  RecordingSink failing;
+  failing.fail_at = 2;
+  const Status s = save_edits(*t, failing);
+  ASSERT_FALSE(s);
+  EXPECT_EQ(s.message(), "sink full");
+  EXPECT_EQ(failing.writes.size(), 2u) << "nothing written after the error";
+  // Loaded through a source that gives a byte, or 7, or 64 KiB at a time: the same terrain.
+  for (const std::size_t step : {std::size_t{1}, std::size_t{7}, std::size_t{1} << 16}) {
+    auto fresh = noise_terrain(257);
+    ChunkedSource src;
+    src.bytes = bytes;
+    src.step = step;
+    auto r = load_edits(*fresh, src);
+    ASSERT_TRUE(r) << "step " << step << ": " << r.error().message;
+    EXPECT_EQ(fresh->surface().heights_hash(), t->surface().heights_hash()) << "step " << step;
+  }
+}
+
+TEST(EditFile, ASourceErrorOrAnOversizedStreamChangesNothing) {
+  auto t = noise_terrain(129);
+  ASSERT_TRUE(t->apply_edit({.x = 40, .z = 60, .radius = 12, .depth = 4}));
+  const std::string bytes = save_edits_to_memory(*t);
+  auto target = noise_terrain(129);
+  const auto h0 = target->surface().heights_hash();
+  // The source fails half way: its error, unchanged; nothing applied.
+  ChunkedSource broken;
+  broken.bytes = bytes;
+  broken.step = 100;
+  broken.fail_after = bytes.size() / 2;
+  auto r = load_edits(*target, broken);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().message, "source broke");
+  EXPECT_EQ(target->surface().heights_hash(), h0);
+  EXPECT_EQ(target->edit_version(), 0u);
+  // A stream longer than any edit file of this terrain (5 x 5 chunks): refused after reading one
+  // chunk past that size, not to its end.
+  const std::size_t chunk = 8 + 4 * 32 * 32, largest = 64 + 25 * chunk + 8;
+  ChunkedSource endless;
+  endless.bytes = bytes + std::string(std::size_t{64} << 20, '\0');
+  endless.step = std::size_t{1} << 16;
+  r = load_edits(*target, endless);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("larger than any edit file of this terrain"), std::string::npos)
+      << r.error().message;
+  EXPECT_EQ(endless.at, largest + chunk + 1) << "read no further than needed";
+  // The same length with a foreign header names the header's problem instead.
+  endless.bytes[0] = 'X';
+  endless.at = 0;
+  r = load_edits(*target, endless);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("bad magic"), std::string::npos) << r.error().message;
+  EXPECT_EQ(target->surface().heights_hash(), h0);
 }
 
 TEST(Transaction, CloneIsASnapshot) {
@@ -389,8 +464,7 @@ std::size_t expect_change_describes(const Terrain& t, const TerrainChange& c,
 
 TEST(ChangeLog, EveryBrushAndEveryLoadIsRecordedUnderTheVersionItProduced) {
   auto t = noise_terrain(129);
-  const std::string empty = tmp_path("log_empty.bin"), saved = tmp_path("log_saved.bin");
-  ASSERT_TRUE(save_edits(*t, empty));
+  const std::string empty = save_edits_to_memory(*t);
   EXPECT_EQ(t->edit_version(), 0u);
   EXPECT_TRUE(t->changes_since(0).empty());
   EXPECT_FALSE(t->changes_since(0).trimmed);
@@ -420,18 +494,18 @@ TEST(ChangeLog, EveryBrushAndEveryLoadIsRecordedUnderTheVersionItProduced) {
         << brush_name(e.brush);
     v = c.version;
   }
-  ASSERT_TRUE(save_edits(*t, saved));
+  const std::string saved = save_edits_to_memory(*t);
   // A load that changes heights is one change too: back to the empty state, then forward.
-  for (const std::string& file : {empty, saved}) {
+  for (const std::string* file : {&empty, &saved}) {
     const auto before = lattice_heights(*t);
-    auto r = load_edits(*t, file);
+    auto r = load_edits_from_memory(*t, *file);
     ASSERT_TRUE(r) << r.error().message;
     const auto after = lattice_heights(*t);
     const TerrainChanges c = t->changes_since(v);
-    ASSERT_EQ(c.changes.size(), 1u) << file;
+    ASSERT_EQ(c.changes.size(), 1u) << (file == &empty ? "empty" : "saved");
     EXPECT_EQ(c.version, v + 1);
     EXPECT_GT(expect_change_describes(*t, c.changes[0], before, after), 0u);
-    EXPECT_EQ(t->check_invariants(), "") << "the ray pyramid after loading " << file;
+    EXPECT_EQ(t->check_invariants(), "") << "the ray pyramid after a load";
     v = c.version;
   }
   // The whole history, in order; nothing after the current version.
@@ -442,7 +516,7 @@ TEST(ChangeLog, EveryBrushAndEveryLoadIsRecordedUnderTheVersionItProduced) {
   EXPECT_EQ(t->changes_since(v).version, v);
   // Loading the state already in place, a brush outside, a zero-strength brush: no change, no
   // version, no entry.
-  ASSERT_TRUE(load_edits(*t, saved));
+  ASSERT_TRUE(load_edits_from_memory(*t, saved));
   ASSERT_TRUE(t->apply_edit({.x = 5000, .z = 5000, .radius = 10}));
   ASSERT_TRUE(
       t->apply_edit({.brush = Brush::kRaise, .x = 50, .z = 50, .radius = 10, .strength = 0}));
@@ -581,10 +655,7 @@ TEST(EditFile, EveryRegionOfTheHeaderAndBodyIsGuarded) {
   auto t = noise_terrain(129);
   ASSERT_TRUE(t->apply_edit({.x = 40, .z = 60, .radius = 12, .depth = 4}));
   ASSERT_TRUE(t->apply_edit({.brush = Brush::kRaise, .x = 200, .z = 230, .radius = 9, .depth = 3}));
-  const std::string file = tmp_path("edits_guarded.bin");
-  ASSERT_TRUE(save_edits(*t, file));
-  std::ifstream in(file, std::ios::binary);
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string bytes = save_edits_to_memory(*t);
   const std::size_t chunk = 8 + 4 * 32 * 32;
   ASSERT_GE(t->surface().edited_chunks(), 2u);
   ASSERT_EQ(bytes.size(), 64 + t->surface().edited_chunks() * chunk + 8);

@@ -21,7 +21,9 @@
 
 #include "file_limit_child.h"
 #include "ridgeline/detail.h"
+#include "io/durable_file.h"
 #include "ridgeline/edit.h"
+#include "ridgeline/edit_file.h"
 #include "ridgeline/heightfield.h"
 #include "ridgeline/io.h"
 #include "ridgeline/terrain.h"
@@ -201,8 +203,8 @@ TEST(Faults, KilledMidSaveLeavesThePreviousFileIntact) {
   }
   apply_random_edits(*b, 400, rng, 2048, 90);
   const fs::path pa = dir / "a.bin", pb = dir / "b.bin", target = dir / "state.bin";
-  ASSERT_TRUE(save_edits(*a, pa.string()).ok());
-  ASSERT_TRUE(save_edits(*b, pb.string()).ok());
+  ASSERT_TRUE(io::save_edits(*a, pa.string()).ok());
+  ASSERT_TRUE(io::save_edits(*b, pb.string()).ok());
   const std::string bytes_a = read_bytes(pa), bytes_b = read_bytes(pb);
   ASSERT_NE(bytes_a, bytes_b);
   const std::hash<std::string> hash;
@@ -213,7 +215,7 @@ TEST(Faults, KilledMidSaveLeavesThePreviousFileIntact) {
     const pid_t child = fork();
     ASSERT_GE(child, 0);
     if (child == 0) {
-      for (;;) (void)save_edits(*b, target.string());  // until killed
+      for (;;) (void)io::save_edits(*b, target.string());  // until killed
     }
     usleep(static_cast<useconds_t>(delay_us(rng)));
     kill(child, SIGKILL);
@@ -228,7 +230,7 @@ TEST(Faults, KilledMidSaveLeavesThePreviousFileIntact) {
     saw_a += is_a, saw_b += is_b;
     // And it loads: onto a fresh copy of the same base terrain.
     auto fresh = make_terrain(513);
-    auto loaded = load_edits(*fresh, target.string());
+    auto loaded = io::load_edits(*fresh, target.string());
     ASSERT_TRUE(loaded.ok()) << loaded.error().message;
   }
   RecordProperty("killed_before_rename", saw_a);
@@ -254,10 +256,10 @@ TEST(Faults, DiskFullDuringSaveKeepsThePreviousFileAndCleansUp) {
   one.x = 500, one.z = 500, one.radius = 30;
   ASSERT_TRUE(a->apply_edit(one).ok());
   const fs::path previous = dir / "previous.bin", target = dir / "state.bin";
-  ASSERT_TRUE(save_edits(*a, previous.string()).ok());
+  ASSERT_TRUE(io::save_edits(*a, previous.string()).ok());
   const std::string bytes_a = read_bytes(previous);
   // The size of the new state's file, measured by saving it without a limit.
-  ASSERT_TRUE(save_edits(*b, (dir / "new.bin").string()).ok());
+  ASSERT_TRUE(io::save_edits(*b, (dir / "new.bin").string()).ok());
   const std::size_t new_size = fs::file_size(dir / "new.bin");
   ASSERT_GT(new_size, bytes_a.size());
   ASSERT_GT(new_size, std::size_t{4096});
@@ -269,7 +271,7 @@ TEST(Faults, DiskFullDuringSaveKeepsThePreviousFileAndCleansUp) {
     SCOPED_TRACE("file size limit " + std::to_string(limit));
     fs::copy_file(previous, target, fs::copy_options::overwrite_existing);
     const std::string msg = test::in_child_with_file_limit(limit, [&] {
-      const Status s = save_edits(*b, target.string());
+      const Status s = io::save_edits(*b, target.string());
       return s ? std::string("ok") : s.message();
     });
     EXPECT_NE(msg.find("save edits '" + target.string() + "'"), std::string::npos) << msg;
@@ -279,7 +281,7 @@ TEST(Faults, DiskFullDuringSaveKeepsThePreviousFileAndCleansUp) {
     EXPECT_EQ(files_starting_with(dir, "state.bin.tmp"), std::vector<std::string>{})
         << "temporary file left behind";
     auto fresh = make_terrain(257);
-    auto loaded = load_edits(*fresh, target.string());
+    auto loaded = io::load_edits(*fresh, target.string());
     ASSERT_TRUE(loaded.ok()) << loaded.error().message;
     EXPECT_DOUBLE_EQ(*fresh->height(500, 500), *a->height(500, 500));
   }
@@ -287,7 +289,7 @@ TEST(Faults, DiskFullDuringSaveKeepsThePreviousFileAndCleansUp) {
   // came from the limit, not from the child.
   fs::copy_file(previous, target, fs::copy_options::overwrite_existing);
   const std::string ok = test::in_child_with_file_limit(new_size, [&] {
-    const Status s = save_edits(*b, target.string());
+    const Status s = io::save_edits(*b, target.string());
     return s ? std::string("ok") : s.message();
   });
   EXPECT_EQ(ok, "ok");
@@ -296,8 +298,8 @@ TEST(Faults, DiskFullDuringSaveKeepsThePreviousFileAndCleansUp) {
 }
 
 TEST(Faults, NoSpaceLeftOnDeviceDuringSaveIsReported) {
-  // A real ENOSPC from the kernel: the save's temporary file (NAME.tmp.PID, created without
-  // O_EXCL) is made a link to /dev/full, whose every write fails with ENOSPC.
+  // A real ENOSPC from the kernel: the save's temporary file (io::durable::temp_path_of, opened
+  // without O_EXCL) is made a link to /dev/full, whose every write fails with ENOSPC.
   if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
   const fs::path dir = fresh_dir("faults_enospc");
   auto a = make_terrain(129), b = make_terrain(129);
@@ -307,11 +309,11 @@ TEST(Faults, NoSpaceLeftOnDeviceDuringSaveIsReported) {
   e.x = 300;
   ASSERT_TRUE(b->apply_edit(e).ok());
   const fs::path target = dir / "state.bin";
-  ASSERT_TRUE(save_edits(*a, target.string()).ok());
+  ASSERT_TRUE(io::save_edits(*a, target.string()).ok());
   const std::string bytes_a = read_bytes(target);
-  const fs::path tmp = dir / ("state.bin.tmp." + std::to_string(getpid()));
+  const fs::path tmp = io::durable::temp_path_of(target.string());
   fs::create_symlink("/dev/full", tmp);
-  const Status s = save_edits(*b, target.string());
+  const Status s = io::save_edits(*b, target.string());
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find(std::strerror(ENOSPC)), std::string::npos) << s.message();
   EXPECT_NE(s.message().find("state.bin"), std::string::npos) << s.message();
@@ -319,7 +321,7 @@ TEST(Faults, NoSpaceLeftOnDeviceDuringSaveIsReported) {
   EXPECT_FALSE(fs::exists(fs::symlink_status(tmp))) << "temporary name left behind";
   EXPECT_TRUE(fs::exists("/dev/full"));
   auto fresh = make_terrain(129);
-  ASSERT_TRUE(load_edits(*fresh, target.string()).ok());
+  ASSERT_TRUE(io::load_edits(*fresh, target.string()).ok());
 }
 
 TEST(Faults, RenameFailingDuringSaveCleansUp) {
@@ -328,7 +330,7 @@ TEST(Faults, RenameFailingDuringSaveCleansUp) {
   fs::create_directories(dir / "state.bin");
   std::ofstream(dir / "state.bin" / "keep") << "kept";
   auto t = make_terrain(129);
-  const Status s = save_edits(*t, (dir / "state.bin").string());
+  const Status s = io::save_edits(*t, (dir / "state.bin").string());
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find("rename failed"), std::string::npos) << s.message();
   EXPECT_EQ(read_bytes(dir / "state.bin" / "keep"), "kept");

@@ -7,6 +7,7 @@
 
 #include "lua_util.h"
 #include "ridgeline/edit.h"
+#include "ridgeline/edit_file.h"
 
 namespace ridgeline::lua::detail {
 namespace {
@@ -126,13 +127,13 @@ bool do_file(bool confine, const char* root, Terrain& t, const char* name, FileO
     char path[4096];
     if (!resolve_path(confine, root, name, path, sizeof path, err)) return false;
     if (op == FileOp::kSave) {
-      if (auto s = save_edits(t, path); !s) {
+      if (auto s = io::save_edits(t, path); !s) {
         copy_error(err, s.message().c_str());
         return false;
       }
       return true;
     }
-    return take_result(load_edits(t, path), out, err);
+    return take_result(io::load_edits(t, path), out, err);
   } catch (const std::exception& ex) {
     copy_error(err, ex.what());
     return false;

@@ -1,5 +1,6 @@
 // Runtime deformation (docs/deformation.md): brushes, the edit transaction's result and limits,
-// and saving / loading the edit layer.
+// and saving / loading the edit layer in memory or through a stream (files: edit_file.h, in
+// Ridgeline::io).
 //
 // The transaction itself is Terrain::apply_edit() (terrain.h): it changes the heights, refreshes
 // the ray pyramid, bumps the terrain's edit_version() and records the changed region in its
@@ -8,10 +9,13 @@
 #pragma once
 
 #include <cstdint>
+#include <cstddef>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 
+#include "ridgeline/edit_limits.h"
 #include "ridgeline/result.h"
 #include "ridgeline/terrain.h"
 
@@ -52,18 +56,6 @@ struct Edit {
 /// and the value, e.g. "edit: radius is -3; need a finite value > 0".
 Status validate_edit(const Edit& edit);
 
-/// Limits that give every edit a defined answer. Plain data; Terrain::set_edit_limits().
-struct EditLimits {
-  /// Largest area one edit may cover, square metres (pi x reach^2, reach being the brush's outer
-  /// radius). A larger edit is clipped to this area (its radius shrunk, EditResult::clipped) or,
-  /// with refuse_oversize, refused. Default 1e6 m^2 (a crater of ~560 m reach).
-  double max_area_m2 = 1e6;
-  bool refuse_oversize = false;
-  /// World heights an edit may produce; samples driven past them are clamped and the result says
-  /// so (EditResult::clamped). Defaults: -1e5 .. 1e5 m relative to the heightfield's offset.
-  double min_height_rel = -1e5, max_height_rel = 1e5;
-};
-
 /// What an edit did.
 struct EditResult {
   /// The region whose surface (heights or normals) changed: every cell touching a changed
@@ -80,21 +72,52 @@ struct EditResult {
   bool empty() const noexcept { return samples_changed == 0; }
 };
 
-/// Writes the terrain's edit layer to `path`: a versioned binary file (docs/deformation.md) with
-/// a checksum and the hashes of the base data and detail parameters it belongs to. Written to a
-/// temporary file in the same folder, flushed to disk and renamed over `path`, so a crash or a
-/// full disk during the save leaves the previous file intact. Errors name the path and the cause.
-Status save_edits(const Terrain& terrain, const std::string& path);
+// ---- the edit layer saved and loaded (docs/deformation.md, "The edit file") -------------------
+// The core writes and reads the edit file's bytes; where they go is the caller's: memory (an
+// engine's own save game), a stream of its own (EditSink, EditSource), or a file through
+// Ridgeline::io (io::save_edits / io::load_edits in edit_file.h: written to a temporary name and
+// renamed). The core touches no file system.
 
-/// Replaces the terrain's edit layer with the one saved in `path` (edits made since are undone),
-/// as one transaction: the heights, bounds and views update as for apply_edit(). The whole file
-/// is read and checked first (magic, version, size, checksum, the base and detail hashes, every
-/// chunk index and value); a truncated, corrupted or foreign file is refused with a clear error
-/// and changes nothing. Exclusive access as for apply_edit().
-Result<EditResult> load_edits(Terrain& terrain, const std::string& path);
+/// Where save_edits() writes an edit file's bytes: an engine's save game, a network buffer, a
+/// file. Implemented by the caller; used by one save at a time.
+class EditSink {
+ public:
+  virtual ~EditSink() = default;
+  /// Appends `bytes` (at most 64 KiB a call, in file order). An error stops the save, and
+  /// save_edits() returns it unchanged.
+  virtual Status write(std::string_view bytes) = 0;
+};
 
-/// The same from bytes already in memory (what load_edits() does after reading the file; the
-/// fuzz target's entry point).
+/// Where load_edits() reads an edit file's bytes from. Implemented by the caller.
+class EditSource {
+ public:
+  virtual ~EditSource() = default;
+  /// Reads up to `buffer.size()` bytes into `buffer` and returns how many it read: 0 only at the
+  /// end of the data. An error stops the load (nothing changes), and load_edits() returns it
+  /// unchanged.
+  virtual Result<std::size_t> read(std::span<char> buffer) = 0;
+};
+
+/// Writes the terrain's edit layer to `out` as an edit file: versioned, with a checksum and the
+/// hashes of the base data and detail parameters it belongs to (docs/deformation.md), 72 bytes
+/// plus 4,104 per edited 32 x 32 chunk, in a few write() calls. Returns the sink's first error
+/// (the sink then holds part of a file: a caller that replaces an earlier save keeps it until the
+/// save succeeded, as io::save_edits does). Const: may run while other threads query.
+Status save_edits(const Terrain& terrain, EditSink& out);
+
+/// The same into memory: the bytes of the edit file (what an engine stores in its save game).
+std::string save_edits_to_memory(const Terrain& terrain);
+
+/// Replaces the terrain's edit layer with the one read from `in` (edits made since are undone),
+/// as one transaction: the heights, bounds and views update as for apply_edit(). Everything is
+/// read and checked first (magic, version, size, checksum, the base and detail hashes, every
+/// chunk index and value); a truncated, corrupted or foreign file, or a source error, is refused
+/// with an error naming the problem ("edit file: ...") and changes nothing. Reads at most one
+/// chunk more than the largest edit file of this terrain can hold: a longer stream is refused
+/// without reading it all. Exclusive access as for apply_edit().
+Result<EditResult> load_edits(Terrain& terrain, EditSource& in);
+
+/// The same from the bytes of an edit file in memory (the fuzz target's entry point).
 Result<EditResult> load_edits_from_memory(Terrain& terrain, std::string_view bytes);
 
 }  // namespace ridgeline

@@ -13,12 +13,11 @@
 
 namespace ridgeline {
 
-class RoamView;
-
 /// A triangle mesh as drawn, in the lattice frame of the surface it is measured against: each
 /// corner is (u, y, v), with u and v in lattice units of that surface (world x = origin_x + u *
 /// spacing_x, z likewise; for a terrain with procedural detail, its finest lattice) and y the
-/// drawn world height in metres. Any winding; triangles of zero xz area are ignored.
+/// drawn world height in metres. Any winding; triangles of zero xz area are ignored. A ROAM view's
+/// leaves as a DrawnMesh: leaves_mesh() (roam_view.h).
 struct DrawnMesh {
   std::vector<glm::dvec3> corners;  ///< three per triangle
   std::size_t triangles() const noexcept { return corners.size() / 3; }
@@ -28,12 +27,6 @@ struct DrawnMesh {
     corners.push_back(c);
   }
 };
-
-/// The leaves of a ROAM view as drawn without geomorphs, straight from the bintree
-/// (RoamView::for_each_leaf), in finest-lattice units of the view's terrain, each corner at its
-/// lattice height (Surface::vertex_height as a float: base + detail + edits; the padding repeats
-/// the edge samples). Needs no patch meshes. Not during the view's update().
-DrawnMesh leaves_mesh(const RoamView& view);
 
 /// Measured error over the sampled lattice vertices (docs/report.md).
 struct MeshError {

@@ -247,4 +247,13 @@ class RoamView {
   std::unique_ptr<Impl> impl_;
 };
 
+struct DrawnMesh;  // mesh_error.h
+
+/// The leaves of a ROAM view as drawn without geomorphs, straight from the bintree
+/// (RoamView::for_each_leaf), in finest-lattice units of the view's terrain, each corner at its
+/// lattice height (Surface::vertex_height as a float: base + detail + edits; the padding repeats
+/// the edge samples): what a MeshErrorMeter measures (mesh_error.h). Needs no patch meshes. Not
+/// during the view's update().
+DrawnMesh leaves_mesh(const RoamView& view);
+
 }  // namespace ridgeline

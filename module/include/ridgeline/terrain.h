@@ -15,6 +15,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "ridgeline/edit_limits.h"
 #include "ridgeline/heightfield.h"
 #include "ridgeline/result.h"
 #include "ridgeline/surface.h"
@@ -28,8 +29,8 @@ class DetailCache;
 struct DetailParams;
 struct DetailCacheDesc;
 struct Edit;
-struct EditLimits;
 struct EditResult;
+class EditSink;
 class ChangeLog;
 struct SampleChanges;
 namespace detail {
@@ -261,7 +262,7 @@ class Terrain {
   Result<EditResult> apply_edit(const Edit& edit);
   /// Limits for later edits (validated: finite, area > 0, min < max; else an error and no change).
   Status set_edit_limits(const EditLimits& limits);
-  const EditLimits& edit_limits() const noexcept;
+  const EditLimits& edit_limits() const noexcept { return edit_limits_; }
   /// Hash of the stored samples as created, before any edit (info().content_hash: what save
   /// files record; a baked world and the map it was baked from have the same one).
   std::uint64_t base_hash() const noexcept { return base_hash_; }
@@ -313,11 +314,12 @@ class Terrain {
   std::unique_ptr<ChangeLog> log_;
   std::uint64_t base_hash_ = 0;
   std::uint64_t edit_version_ = 0;
+  EditLimits edit_limits_;
 
   // The edit file's reader and writer (edit/edit_file.cpp) reach the edit layer and the
   // transaction.
   friend Result<EditResult> load_edits_from_memory(Terrain&, std::string_view);
-  friend Status save_edits(const Terrain&, const std::string&);
+  friend Status save_edits(const Terrain&, EditSink&);
 };
 
 }  // namespace ridgeline

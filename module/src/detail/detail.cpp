@@ -9,8 +9,8 @@
 #include <cmath>
 
 #include "format.h"
+#include "ridgeline/lattice_cell.h"
 #include "ridgeline/log.h"
-#include "ridgeline/surface.h"
 
 namespace ridgeline {
 

@@ -1,6 +1,6 @@
 // Deformation (docs/deformation.md): brushes and the edit transaction that applies them to a
-// terrain's surface, ray hierarchy and change log. The edit layer is in edit_layer.cpp, its file
-// in edit_file.cpp.
+// terrain's surface, ray hierarchy and change log. The edit layer is the surface's
+// (surface/edit_layer.cpp), the change log the terrain's (change_log.h), the file edit_file.cpp.
 #include "ridgeline/edit.h"
 
 #include <algorithm>
@@ -11,9 +11,10 @@
 #include <cstring>
 #include <numbers>
 
-#include "edit/edit_layer.h"
-#include "edit/edit_log.h"
+#include "change_log.h"
+#include "edit/sample_changes.h"
 #include "format.h"
+#include "surface/edit_layer.h"
 #include "surface/lattice.h"
 #include "world/page_store.h"
 #include "ridgeline/detail.h"
@@ -181,7 +182,7 @@ Result<EditResult> Terrain::apply_edit(const Edit& e) {
   if (e.radius > extent)
     return Error{"edit: radius " + num(e.radius) + " m is larger than the terrain (" +
                  num(extent) + " m)"};
-  const EditLimits& lim = layer.limits;
+  const EditLimits& lim = edit_limits_;
   EditResult r;
   double radius = e.radius;
   const double area = std::numbers::pi * std::pow(radius * reach_factor(e.brush), 2);
@@ -267,10 +268,8 @@ Status Terrain::set_edit_limits(const EditLimits& l) {
       !(l.min_height_rel < l.max_height_rel))
     return Error{"edit limits: height range " + num(l.min_height_rel) + " .. " +
                  num(l.max_height_rel) + "; need finite values with min < max"};
-  edit_layer().limits = l;
+  edit_limits_ = l;
   return {};
 }
-
-const EditLimits& Terrain::edit_limits() const noexcept { return edit_layer().limits; }
 
 }  // namespace ridgeline

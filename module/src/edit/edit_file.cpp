@@ -1,19 +1,16 @@
 // The edit layer's file (docs/deformation.md, "The edit file"): a versioned, checksummed binary
-// image of every edited chunk, written atomically and read back as one transaction.
-#include <fcntl.h>
-#include <unistd.h>
-
+// image of every edited chunk, written to a sink and read back from a source as one
+// transaction. No file system here: Ridgeline::io (io/edit_file.cpp) gives files.
 #include <algorithm>
 #include <bit>
-#include <cerrno>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 
-#include "edit/edit_layer.h"
-#include "surface/lattice.h"
+#include "edit/sample_changes.h"
 #include "format.h"
 #include "ridgeline/edit.h"
+#include "surface/edit_layer.h"
+#include "surface/lattice.h"
 
 namespace ridgeline {
 
@@ -30,8 +27,9 @@ constexpr std::size_t kHeaderBytes = 64;
 constexpr std::size_t kChunkValues = std::size_t{EditLayer::kChunk} * EditLayer::kChunk;
 constexpr std::size_t kChunkBytes = 8 + 4 * kChunkValues;
 
-std::uint64_t fnv1a(const char* p, std::size_t n) {
-  std::uint64_t h = 1469598103934665603ull;
+constexpr std::uint64_t kFnvBasis = 1469598103934665603ull;
+
+std::uint64_t fnv1a(const char* p, std::size_t n, std::uint64_t h = kFnvBasis) {
   for (std::size_t k = 0; k < n; ++k) {
     h ^= static_cast<unsigned char>(p[k]);
     h *= 1099511628211ull;
@@ -50,15 +48,33 @@ T get(std::string_view in, std::size_t at) {
   return v;
 }
 
+// The largest edit file of a terrain of width x height samples (every chunk edited).
+std::size_t max_file_bytes(const WorldInfo& hf) {
+  const std::size_t chunks = std::size_t((hf.width + EditLayer::kChunk - 1) / EditLayer::kChunk) *
+                             ((hf.height + EditLayer::kChunk - 1) / EditLayer::kChunk);
+  return kHeaderBytes + chunks * kChunkBytes + 8;
+}
+
+// Bytes handed to the sink at a time: at most 64 KiB (edit.h).
+constexpr std::size_t kSinkBytes = std::size_t{64} << 10;
+
 }  // namespace
 
-Status save_edits(const Terrain& terrain, const std::string& path) {
+Status save_edits(const Terrain& terrain, EditSink& sink) {
   const WorldInfo& hf = terrain.info();
   const detail::StoredLattice g = detail::stored_lattice(terrain.surface());
   const EditLayer& layer = terrain.edit_layer();
   const std::vector<std::uint64_t> keys = layer.sorted_keys();
+  // The checksum runs over everything before it: hashed as each block goes out.
+  std::uint64_t sum = kFnvBasis;
   std::string out;
-  out.reserve(kHeaderBytes + keys.size() * kChunkBytes + 8);
+  out.reserve(std::min(kSinkBytes, kHeaderBytes + keys.size() * kChunkBytes + 8));
+  auto flush = [&]() -> Status {
+    sum = fnv1a(out.data(), out.size(), sum);
+    Status s = sink.write(out);
+    out.clear();
+    return s;
+  };
   out.append(kMagic, 8);
   put(out, kVersion);
   put(out, EditLayer::kChunk);
@@ -70,6 +86,8 @@ Status save_edits(const Terrain& terrain, const std::string& path) {
   put(out, std::uint64_t{0});
   put(out, std::uint64_t{0});
   for (std::uint64_t k : keys) {
+    if (out.size() + kChunkBytes > kSinkBytes)
+      if (Status s = flush(); !s) return s;
     const std::uint32_t cx = std::uint32_t(k), cz = std::uint32_t(k >> 32);
     put(out, cx);
     put(out, cz);
@@ -80,49 +98,24 @@ Status save_edits(const Terrain& terrain, const std::string& path) {
         put(out, in ? g.local(i0 + di, j0 + dj) : 0.0f);
       }
   }
-  put(out, fnv1a(out.data(), out.size()));
+  if (out.size() + 8 > kSinkBytes)
+    if (Status s = flush(); !s) return s;
+  put(out, fnv1a(out.data(), out.size(), sum));
+  return sink.write(out);
+}
 
-  // Temporary file in the same folder, fsync, rename over the target, fsync the folder.
-  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0)
-    return Error{"save edits '" + path + "': cannot create '" + tmp + "': " + std::strerror(errno)};
-  std::size_t done = 0;
-  while (done < out.size()) {
-    const ssize_t n = ::write(fd, out.data() + done, out.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      const int err = n < 0 ? errno : ENOSPC;
-      ::close(fd);
-      ::unlink(tmp.c_str());
-      return Error{"save edits '" + path + "': writing failed (" + std::strerror(err) +
-                   "); the previous file is unchanged"};
+std::string save_edits_to_memory(const Terrain& terrain) {
+  struct Memory final : EditSink {
+    std::string bytes;
+    Status write(std::string_view b) override {
+      bytes.append(b);
+      return {};
     }
-    done += std::size_t(n);
-  }
-  // A full disk may show only here (delayed allocation, network file systems). The descriptor
-  // is closed whatever fsync answered.
-  int err = ::fsync(fd) != 0 ? errno : 0;
-  if (::close(fd) != 0 && err == 0) err = errno;
-  if (err != 0) {
-    ::unlink(tmp.c_str());
-    return Error{"save edits '" + path + "': flushing failed (" + std::strerror(err) +
-                 "); the previous file is unchanged"};
-  }
-  if (::rename(tmp.c_str(), path.c_str()) != 0) {
-    err = errno;
-    ::unlink(tmp.c_str());
-    return Error{"save edits '" + path + "': rename failed (" + std::strerror(err) +
-                 "); the previous file is unchanged"};
-  }
-  const std::size_t slash = path.find_last_of('/');
-  const std::string dir =
-      slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
-  if (const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC); dfd >= 0) {
-    ::fsync(dfd);
-    ::close(dfd);
-  }
-  return {};
+  } memory;
+  memory.bytes.reserve(kHeaderBytes + terrain.surface().edited_chunks() * kChunkBytes + 8);
+  const Status s = save_edits(terrain, memory);
+  RIDGELINE_ASSERT(s.ok());  // memory never refuses
+  return std::move(memory.bytes);
 }
 
 // The header fields that tie a file to a terrain (base hash, detail hash, size); `in` holds at
@@ -183,7 +176,7 @@ Result<EditResult> load_edits_from_memory(Terrain& terrain, std::string_view in)
     return Error{what +
                  ": reserved header bytes 48..63 are not zero (written by a newer version, "
                  "or corrupted)"};
-  const EditLimits& lim = terrain.edit_layer().limits;
+  const EditLimits& lim = terrain.edit_limits();
   std::uint64_t prev_key = 0;
   for (std::uint64_t c = 0; c < count; ++c) {
     const std::size_t at = kHeaderBytes + c * kChunkBytes;
@@ -257,34 +250,27 @@ Result<EditResult> load_edits_from_memory(Terrain& terrain, std::string_view in)
   return r;
 }
 
-Result<EditResult> load_edits(Terrain& terrain, const std::string& path) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) return Error{"load edits '" + path + "': " + std::strerror(errno)};
+Result<EditResult> load_edits(Terrain& terrain, EditSource& in) {
+  // Read whole (a load is one transaction, checked before anything changes), but never more than
+  // one chunk past the largest file this terrain can have: a longer stream is not its edit file.
+  const std::size_t cap = max_file_bytes(terrain.info()) + kChunkBytes;
   std::string bytes;
   char buf[1 << 16];
-  // Cap: the largest valid file for this terrain plus one chunk.
-  const WorldInfo& hf = terrain.info();
-  const std::size_t cap =
-      kHeaderBytes + 8 +
-      (std::size_t((hf.width + 31) / 32) * ((hf.height + 31) / 32) + 1) * kChunkBytes;
   for (;;) {
-    const std::size_t n = std::fread(buf, 1, sizeof buf, f);
-    bytes.append(buf, n);
+    const std::size_t want = std::min(sizeof buf, cap + 1 - bytes.size());
+    auto n = in.read(std::span<char>(buf, want));
+    if (!n) return n.error();
+    if (*n == 0) break;
+    bytes.append(buf, std::min(*n, want));
     if (bytes.size() > cap) {
-      std::fclose(f);
-      Status why = check_edit_header(terrain, bytes);  // a foreign file says so
-      return Error{
-          "load edits '" + path +
-          "': " + (why ? std::string("larger than any edit file of this terrain") : why.message())};
+      if (Status why = check_edit_header(terrain, bytes); !why)  // a foreign file says so
+        return Error{why.message()};
+      return Error{fmt("edit file: larger than any edit file of this terrain (more than %zu "
+                       "bytes; at most %zu)",
+                       cap, cap - kChunkBytes)};
     }
-    if (n < sizeof buf) break;
   }
-  const bool failed = std::ferror(f) != 0;
-  std::fclose(f);
-  if (failed) return Error{"load edits '" + path + "': read error"};
-  auto r = load_edits_from_memory(terrain, bytes);
-  if (!r) return Error{"load edits '" + path + "': " + r.error().message};
-  return r;
+  return load_edits_from_memory(terrain, bytes);
 }
 
 }  // namespace ridgeline

@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "format.h"
+#include "io/durable_file.h"
 #include "io/world_format.h"
 #include "ridgeline/world_file.h"
 #include "roam/records.h"
@@ -68,23 +69,15 @@ class Output {
     return {};
   }
   Status commit() {
-    int err = ::fsync(fd_) != 0 ? errno : 0;
-    if (::close(fd_) != 0 && err == 0) err = errno;
+    // Closed here; flushed, renamed and the folder flushed by io/durable_file.h.
+    const int err = ::close(fd_) != 0 ? errno : 0;
     fd_ = -1;
-    if (err != 0)
-      return Error{fmt("bake '%s': flushing failed (%s); nothing was written to '%s'",
-                       path_.c_str(), std::strerror(err), path_.c_str())};
-    if (::rename(tmp_.c_str(), path_.c_str()) != 0)
-      return Error{fmt("bake '%s': rename failed (%s); nothing was written", path_.c_str(),
-                       std::strerror(errno))};
+    Status s = err != 0 ? Status{Error{fmt("flushing failed (%s)", std::strerror(err))}}
+                        : durable::put_in_place(tmp_, path_);
+    if (!s)
+      return Error{fmt("bake '%s': %s; nothing was written to '%s'", path_.c_str(),
+                       s.message().c_str(), path_.c_str())};
     committed_ = true;
-    const std::size_t slash = path_.find_last_of('/');
-    const std::string dir =
-        slash == std::string::npos ? "." : (slash == 0 ? "/" : path_.substr(0, slash));
-    if (const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC); dfd >= 0) {
-      ::fsync(dfd);
-      ::close(dfd);
-    }
     return {};
   }
 

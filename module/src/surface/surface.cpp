@@ -6,9 +6,9 @@
 #include <bit>
 #include <cmath>
 
-#include "edit/edit_layer.h"
 #include "ridgeline/detail.h"
 #include "ridgeline/log.h"
+#include "surface/edit_layer.h"
 #include "surface/lattice.h"
 #include "world/page_store.h"
 

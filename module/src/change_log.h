@@ -1,5 +1,6 @@
 // Private: a Terrain's change log (terrain.h's changes_since): the last kChangeLogCapacity
-// changes one by one, and everything older merged into one summary entry.
+// changes one by one, and everything older merged into one summary entry. The terrain's own
+// record (terrain.cpp makes and copies it); the edit transaction (module/src/edit/) appends to it.
 #pragma once
 
 #include <algorithm>

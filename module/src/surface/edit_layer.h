@@ -1,44 +1,24 @@
-// Private: the sparse edit layer of a terrain's Surface (docs/deformation.md), and the record of
-// what one edit transaction changed. The surface's stored samples are edited in their pages
-// (copies of the pages they lie in, so queries cost the same edited or not); the layer keeps,
-// for every 32 x 32 chunk an edit touched, the chunk's original heights, so that the edits can
-// be saved (the current values of the touched chunks) and undone (load_edits restores the
-// originals first).
+// Private: the sparse edit layer of a terrain's Surface (docs/deformation.md). The surface's
+// stored samples are edited in their pages (copies of the pages they lie in, so queries cost the
+// same edited or not); the layer keeps, for every 32 x 32 chunk an edit touched, the chunk's
+// original heights, so that the edits can be saved (the current values of the touched chunks)
+// and undone (load_edits restores the originals first). Part of the surface: it knows pages, not
+// brushes, transactions or limits (module/src/edit/ writes through it).
 #pragma once
 
-#include <algorithm>
-#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <unordered_map>
 #include <vector>
 
-#include "ridgeline/edit.h"
-#include "ridgeline/heightfield.h"
 #include "world/page_store.h"
 
 namespace ridgeline {
-
-/// Bookkeeping of one transaction (Terrain::commit): which stored samples changed, and the range
-/// of their heights before and after.
-struct SampleChanges {
-  std::uint32_t i0 = ~0u, j0 = ~0u, i1 = 0, j1 = 0;
-  float lo = INFINITY, hi = -INFINITY;
-  std::size_t samples = 0;
-  void add(std::uint32_t i, std::uint32_t j, float before, float after) {
-    i0 = std::min(i0, i), j0 = std::min(j0, j), i1 = std::max(i1, i), j1 = std::max(j1, j);
-    lo = std::min({lo, before, after});
-    hi = std::max({hi, before, after});
-    ++samples;
-  }
-};
 
 class EditLayer {
  public:
   static constexpr std::uint32_t kChunkShift = 5;
   static constexpr std::uint32_t kChunk = 1u << kChunkShift;  ///< samples per chunk side
-
-  EditLimits limits;
 
   /// Records the original heights of the chunk holding sample (i, j) if not yet recorded,
   /// reading them through `edit` (before it writes them) from a field of width x height samples.

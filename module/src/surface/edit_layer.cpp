@@ -1,5 +1,5 @@
 // The sparse edit layer (edit_layer.h): the original heights of every chunk an edit touched.
-#include "edit/edit_layer.h"
+#include "surface/edit_layer.h"
 
 #include <algorithm>
 
