@@ -130,3 +130,29 @@ T.case("keep_detail = false: refused over procedural detail, the same edit witho
                       keep_detail = false})
   T.near(plain:height(800, 800), 5, 1e-4, "without detail there is nothing to keep")
 end)
+
+T.case("heights over a rectangle: get, set, errors", function()
+  local r = ridgeline.default_terrain()
+  local before = assert(r:get_heights{i0 = 100, j0 = 200, width = 3, height = 2})
+  T.eq(#before, 6, "3 x 2 heights")
+  T.near(before[1], r:height(200, 400), 1e-3, "sample (100, 200) at x 200, z 400 (2 m spacing)")
+  local v = r:edit_version()
+  local res = assert(r:set_heights{i0 = 100, j0 = 200, width = 3, height = 2,
+                                   heights = {10, 11, 12, 13, 14, 15}})
+  T.eq(res.samples, 6)
+  T.eq(r:edit_version(), v + 1, "one edit")
+  T.near(r:height(202, 402), 14, 1e-4, "sample (101, 201) is the fifth value")
+  local back = r:get_heights{i0 = 100, j0 = 200, width = 3, height = 2}
+  for k = 1, 6 do T.near(back[k], 9 + k, 1e-4, "value " .. k) end
+  local t2, err = r:get_heights{i0 = 1024, j0 = 0, width = 2, height = 1}
+  T.eq(t2, nil); T.truthy(err:find("pass the stored 1025 x 1025", 1, true), err)
+  T.raises("field 'heights': 2 values for 3 x 2 samples", r.set_heights, r,
+           {i0 = 0, j0 = 0, width = 3, height = 2, heights = {1, 2}})
+  T.raises("field 'heights': value 2 is not a number", r.set_heights, r,
+           {i0 = 0, j0 = 0, width = 2, height = 1, heights = {1, "x"}})
+  T.raises("field 'width': whole number >= 0 expected", r.get_heights, r,
+           {i0 = 0, j0 = 0, width = 1.5, height = 1})
+  T.raises("1000 x 1000 samples: at most 65536 per call", r.get_heights, r,
+           {i0 = 0, j0 = 0, width = 1000, height = 1000})
+  r:release()
+end)

@@ -788,3 +788,82 @@ TEST(Brushes, KeepDetailFalseIsRefusedOverDetailAndNeedsNothingWithout) {
   ASSERT_TRUE(b->apply_edit(flat_false));
   EXPECT_EQ(a->surface().heights_hash(), b->surface().heights_hash());
 }
+
+// ---- heights over a rectangle ------------------------------------------------------------------
+
+// set_heights writes exactly the given heights (row stride honoured, the rest untouched) as one
+// edit: one version and one change-log entry covering the rectangle, bounds equal to a rebuild,
+// a view over it crack-free, queries at the samples exact, and get_heights and a save / load
+// round trip give them back.
+TEST(HeightsOverARectangle, SetThenGetWithAStride) {
+  auto t = noise_terrain(129);
+  auto land = Landscape::create(t).value();
+  auto view = RoamView::create(land, {.threshold = 1.0}).value();
+  const WorldInfo& w = t->info();
+  const std::uint32_t i0 = 40, j0 = 50, cw = 17, ch = 9, stride = 20;
+  std::vector<float> in(std::size_t(ch) * stride, -1.0f);
+  for (std::uint32_t r = 0; r < ch; ++r)
+    for (std::uint32_t c = 0; c < cw; ++c) in[r * stride + c] = 300.0f + 0.5f * float(c) - 1.25f * float(r);
+  std::vector<float> outside_before(4);
+  ASSERT_TRUE(t->get_heights(i0 - 1, j0, 1, 4, outside_before, 1));
+  const std::uint64_t v0 = t->edit_version();
+  auto r = t->set_heights(i0, j0, cw, ch, in, stride);
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_EQ(r->samples_changed, std::size_t(cw) * ch);
+  EXPECT_EQ(t->edit_version(), v0 + 1);
+  const TerrainChanges changes = t->changes_since(v0);
+  ASSERT_EQ(changes.changes.size(), 1u);
+  EXPECT_LE(changes.changes[0].box.min.x, w.origin_x + i0 * w.spacing_x);
+  EXPECT_GE(changes.changes[0].box.max.x, w.origin_x + (i0 + cw - 1) * w.spacing_x);
+  for (std::uint32_t r2 = 0; r2 < ch; ++r2)
+    for (std::uint32_t c = 0; c < cw; ++c) {
+      const auto h = t->height(w.origin_x + (i0 + c) * w.spacing_x, w.origin_z + (j0 + r2) * w.spacing_z);
+      ASSERT_TRUE(h);
+      EXPECT_EQ(float(*h), in[r2 * stride + c]) << "sample " << c << ", " << r2;
+    }
+  std::vector<float> back(std::size_t(ch) * 31, 0.0f);
+  ASSERT_TRUE(t->get_heights(i0, j0, cw, ch, back, 31));
+  for (std::uint32_t r2 = 0; r2 < ch; ++r2)
+    for (std::uint32_t c = 0; c < cw; ++c) EXPECT_EQ(back[r2 * 31 + c], in[r2 * stride + c]);
+  std::vector<float> outside_after(4);
+  ASSERT_TRUE(t->get_heights(i0 - 1, j0, 1, 4, outside_after, 1));
+  EXPECT_EQ(outside_after, outside_before) << "the column left of the rectangle is untouched";
+  expect_bounds_equal_rebuild(*land);
+  ASSERT_TRUE(view->converge(camera_at({w.origin_x + 30, 500, w.origin_z + 30},
+                                       {w.origin_x + (i0 + 8) * w.spacing_x, 300,
+                                        w.origin_z + (j0 + 4) * w.spacing_z})));
+  EXPECT_EQ(check_crack_free(*view), "");
+  // Saved with the edits.
+  const std::string saved = save_edits_to_memory(*t);
+  auto fresh = noise_terrain(129);
+  ASSERT_TRUE(load_edits_from_memory(*fresh, saved));
+  std::vector<float> loaded(std::size_t(cw) * ch);
+  ASSERT_TRUE(fresh->get_heights(i0, j0, cw, ch, loaded, cw));
+  for (std::uint32_t r2 = 0; r2 < ch; ++r2)
+    for (std::uint32_t c = 0; c < cw; ++c) EXPECT_EQ(loaded[r2 * cw + c], in[r2 * stride + c]);
+}
+
+TEST(HeightsOverARectangle, BadRectanglesAndHeightsChangeNothing) {
+  auto t = noise_terrain(65);
+  std::vector<float> v(64 * 64, 100.0f);
+  auto msg = [](const Status& s) { return s ? std::string() : s.message(); };
+  EXPECT_EQ(msg(t->get_heights(0, 0, 0, 4, v, 4)), "get_heights: an empty rectangle (0 x 4 samples)");
+  EXPECT_EQ(msg(t->get_heights(60, 0, 6, 2, v, 6)), "get_heights: samples 60..65 x 0..1 pass the stored 65 x 65");
+  EXPECT_EQ(msg(t->get_heights(0, 0, 8, 2, v, 7)), "get_heights: stride 7 is below the width 8");
+  EXPECT_EQ(msg(t->get_heights(0, 0, 8, 3, std::span<float>(v).first(20), 8)),
+            "get_heights: 20 values given; the rectangle needs 24");
+  const std::uint64_t v0 = t->edit_version();
+  v[9] = std::nanf("");
+  auto r = t->set_heights(2, 3, 8, 2, v, 8);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().message, "set_heights: the height of sample (3, 4) is nan; need a finite value");
+
+  EditLimits lim = t->edit_limits();
+  lim.max_area_m2 = 100;  // 2 m spacing: 4 m^2 a sample
+  ASSERT_TRUE(t->set_edit_limits(lim));
+  v[9] = 1.0f;
+  r = t->set_heights(0, 0, 6, 5, v, 6);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("EditLimits::max_area_m2"), std::string::npos) << r.error().message;
+  EXPECT_EQ(t->edit_version(), v0) << "nothing changed";
+}

@@ -173,6 +173,8 @@ std::size_t terrain_charge_bytes(const Terrain& terrain, std::size_t cache_bytes
 int new_view(lua_State* L);               // terrain:new_view, defined in wrap_view.cpp
 int new_budget_controller(lua_State* L);  // ridgeline.budget_controller, wrap_budget.cpp
 int t_deform(lua_State* L);               // terrain:deform, wrap_edit.cpp
+int t_get_heights(lua_State* L);          // terrain:get_heights, wrap_edit.cpp
+int t_set_heights(lua_State* L);          // terrain:set_heights, wrap_edit.cpp
 int r_save_edits(lua_State* L);           // ridgeline.save_edits, wrap_edit.cpp
 int r_load_edits(lua_State* L);           // ridgeline.load_edits, wrap_edit.cpp
 int t_save_edits(lua_State* L);           // terrain:save_edits, wrap_edit.cpp

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <exception>
+#include <vector>
 
 #include "lua_util.h"
 #include "ridgeline/edit.h"
@@ -191,6 +192,104 @@ int t_deform(lua_State* L) {
   char err[kErrSize];
   EditResult r;
   const bool ok = do_edit(t, e, &r, err);
+  if (charge_pages) box->terrain_charge->set(paged_terrain_charge_bytes(t, box->cache_bytes));
+  if (!ok) {
+    lua_pushnil(L);
+    lua_pushstring(L, err);
+    return 2;
+  }
+  push_edit_result(L, r);
+  return 1;
+}
+
+namespace {
+
+// The rectangle fields {i0=, j0=, width=, height=} of get_heights / set_heights: whole numbers,
+// at most kMaxBatchPoints samples.
+void check_rect(lua_State* L, int arg, std::uint32_t v[4]) {
+  const char* names[4] = {"i0", "j0", "width", "height"};
+  for (int k = 0; k < 4; ++k) {
+    double x = 0;
+    if (!get_number_field(L, arg, names[k], &x) || x != std::floor(x) || x < 0 || x > 4294967295.0)
+      luaL_argerror(L, arg, lua_pushfstring(L, "field '%s': whole number >= 0 expected", names[k]));
+    v[k] = std::uint32_t(x);
+  }
+  if (double(v[2]) * double(v[3]) > double(kMaxBatchPoints))
+    luaL_argerror(L, arg, lua_pushfstring(L, "%d x %d samples: at most %d per call",
+                                          int(v[2]), int(v[3]), int(kMaxBatchPoints)));
+}
+
+}  // namespace
+
+// terrain:get_heights{i0=, j0=, width=, height=} -> array of width x height heights, row by row
+// (stored heights in metres, edits included) or nil, message
+int t_get_heights(lua_State* L) {
+  Terrain& t = editable_terrain(L, 1);
+  luaL_checktype(L, 2, LUA_TTABLE);
+  static const char* const kFields[] = {"i0", "j0", "width", "height", nullptr};
+  check_fields(L, 2, kFields);
+  std::uint32_t v[4];
+  check_rect(L, 2, v);
+  std::vector<float> out(std::size_t(v[2]) * v[3]);
+  if (auto s = t.get_heights(v[0], v[1], v[2], v[3], out, v[2]); !s) {
+    lua_pushnil(L);
+    lua_pushstring(L, s.message().c_str());
+    return 2;
+  }
+  lua_createtable(L, int(out.size()), 0);
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    lua_pushnumber(L, double(out[k]));
+    lua_rawseti(L, -2, lua_Integer(k + 1));
+  }
+  return 1;
+}
+
+// terrain:set_heights{i0=, j0=, width=, height=, heights=} -> result (as deform) or nil, message
+int t_set_heights(lua_State* L) {
+  Terrain& t = editable_terrain(L, 1);
+  luaL_checktype(L, 2, LUA_TTABLE);
+  static const char* const kFields[] = {"i0", "j0", "width", "height", "heights", nullptr};
+  check_fields(L, 2, kFields);
+  std::uint32_t v[4];
+  check_rect(L, 2, v);
+  if (lua_getfield(L, 2, "heights") != LUA_TTABLE)
+    luaL_argerror(L, 2, lua_pushfstring(L, "field 'heights': table expected, got %s",
+                                        luaL_typename(L, -1)));
+  const std::size_t n = std::size_t(v[2]) * v[3];
+  if (lua_rawlen(L, -1) != n)
+    luaL_argerror(L, 2, lua_pushfstring(L, "field 'heights': %d values for %d x %d samples",
+                                        int(lua_rawlen(L, -1)), int(v[2]), int(v[3])));
+  std::vector<float> in(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    if (lua_rawgeti(L, -1, lua_Integer(k + 1)) != LUA_TNUMBER)
+      luaL_argerror(L, 2, lua_pushfstring(L, "field 'heights': value %d is not a number",
+                                          int(k + 1)));
+    in[k] = float(lua_tonumber(L, -1));
+    lua_pop(L, 1);
+  }
+  lua_pop(L, 1);
+  auto* box = static_cast<TerrainBox*>(lua_touserdata(L, 1));
+  const bool charge_pages = t.paged() && box->terrain_charge && box->budget;
+  if (charge_pages) {
+    const std::size_t own = box->terrain_charge->bytes();
+    Edit e;
+    const WorldInfo& i = t.info();
+    e.radius = 0.5 * std::max(double(v[2]) * i.spacing_x, double(v[3]) * i.spacing_z) / 1.5;
+    reserve_objects(L, box->budget, own + edit_page_bytes(t, e), "set_heights", own);
+  }
+  char err[kErrSize];
+  EditResult r;
+  bool ok = false;
+  try {
+    auto res = t.set_heights(v[0], v[1], v[2], v[3], in, v[2]);
+    ok = bool(res);
+    if (ok)
+      r = *res;
+    else
+      copy_error(err, res.error().message.c_str());
+  } catch (const std::exception& ex) {
+    copy_error(err, ex.what());
+  }
   if (charge_pages) box->terrain_charge->set(paged_terrain_charge_bytes(t, box->cache_bytes));
   if (!ok) {
     lua_pushnil(L);

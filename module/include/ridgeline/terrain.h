@@ -260,6 +260,22 @@ class Terrain {
   /// changes no height, is a no-op with an empty result (no version, no log entry). Exclusive
   /// access (see above).
   Result<EditResult> apply_edit(const Edit& edit);
+  /// Stored heights over a rectangle of samples, for editors and engines that stream their own
+  /// formats (as Jolt's HeightFieldShape::GetHeights / SetHeights): columns i0 .. i0 + width - 1
+  /// and rows j0 .. j0 + height - 1 of the stored lattice, row r of the rectangle at
+  /// heights[r * stride] (stride >= width, in floats). World heights in metres, edits included,
+  /// procedural detail not (it rides on top of the stored heights). Errors (nothing read or
+  /// changed): an empty rectangle or one past the stored samples, a stride below the width, a
+  /// span too short for the rectangle.
+  Status get_heights(std::uint32_t i0, std::uint32_t j0, std::uint32_t width,
+                     std::uint32_t height, std::span<float> heights, std::size_t stride) const;
+  /// Sets them: one edit (one version, one change-log entry, views and queries follow, saved with
+  /// the edits), clamped to EditLimits' height range as brushes are. Errors, besides
+  /// get_heights' (nothing changes): a non-finite height (naming the sample), a rectangle whose
+  /// area passes EditLimits::max_area_m2. Exclusive access (see above).
+  Result<EditResult> set_heights(std::uint32_t i0, std::uint32_t j0, std::uint32_t width,
+                                 std::uint32_t height, std::span<const float> heights,
+                                 std::size_t stride);
   /// Limits for later edits (validated: finite, area > 0, min < max; else an error and no change).
   Status set_edit_limits(const EditLimits& limits);
   const EditLimits& edit_limits() const noexcept { return edit_limits_; }

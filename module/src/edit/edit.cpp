@@ -261,6 +261,80 @@ Result<EditResult> Terrain::apply_edit(const Edit& e) {
   return r;
 }
 
+namespace {
+
+// The checks get_heights and set_heights share.
+Status check_rect(const WorldInfo& hf, const char* what, std::uint32_t i0, std::uint32_t j0,
+                  std::uint32_t w, std::uint32_t h, std::size_t span, std::size_t stride) {
+  if (w == 0 || h == 0)
+    return Error{fmt("%s: an empty rectangle (%u x %u samples)", what, w, h)};
+  if (std::uint64_t(i0) + w > hf.width || std::uint64_t(j0) + h > hf.height)
+    return Error{fmt("%s: samples %u..%llu x %u..%llu pass the stored %u x %u", what, i0,
+                     static_cast<unsigned long long>(std::uint64_t(i0) + w - 1), j0,
+                     static_cast<unsigned long long>(std::uint64_t(j0) + h - 1), hf.width,
+                     hf.height)};
+  if (stride < w) return Error{fmt("%s: stride %zu is below the width %u", what, stride, w)};
+  const std::uint64_t need = std::uint64_t(h - 1) * stride + w;
+  if (span < need)
+    return Error{fmt("%s: %zu values given; the rectangle needs %llu", what, span,
+                     static_cast<unsigned long long>(need))};
+  return {};
+}
+
+}  // namespace
+
+Status Terrain::get_heights(std::uint32_t i0, std::uint32_t j0, std::uint32_t w, std::uint32_t h,
+                            std::span<float> out, std::size_t stride) const {
+  const WorldInfo& hf = surface_.info();
+  if (auto s = check_rect(hf, "get_heights", i0, j0, w, h, out.size(), stride); !s) return s;
+  for (std::uint32_t r = 0; r < h; ++r)
+    for (std::uint32_t c = 0; c < w; ++c)
+      out[std::size_t(r) * stride + c] = float(
+          hf.height_offset + double(surface_.stored_height(std::int64_t(i0) + c, std::int64_t(j0) + r)));
+  return {};
+}
+
+Result<EditResult> Terrain::set_heights(std::uint32_t i0, std::uint32_t j0, std::uint32_t w,
+                                        std::uint32_t h, std::span<const float> in,
+                                        std::size_t stride) {
+  const WorldInfo& hf = surface_.info();
+  if (auto s = check_rect(hf, "set_heights", i0, j0, w, h, in.size(), stride); !s)
+    return Error{s.message()};
+  const EditLimits& lim = edit_limits_;
+  const double area = double(w) * hf.spacing_x * double(h) * hf.spacing_z;
+  if (area > lim.max_area_m2)
+    return Error{fmt("set_heights: the rectangle covers %s m^2, more than the per-edit cap of %s "
+                     "m^2 (EditLimits::max_area_m2, Terrain::set_edit_limits)",
+                     num(area).c_str(), num(lim.max_area_m2).c_str())};
+  for (std::uint32_t r = 0; r < h; ++r)
+    for (std::uint32_t c = 0; c < w; ++c)
+      if (!std::isfinite(in[std::size_t(r) * stride + c]))
+        return Error{fmt("set_heights: the height of sample (%u, %u) is %s; need a finite value",
+                         i0 + c, j0 + r, num(in[std::size_t(r) * stride + c]).c_str())};
+  EditLayer& layer = edit_layer();
+  EditResult result;
+  auto edit = surface_.store_->begin_edit();
+  SampleChanges changes;
+  for (std::uint32_t r = 0; r < h; ++r)
+    for (std::uint32_t c = 0; c < w; ++c) {
+      const std::uint32_t i = i0 + c, j = j0 + r;
+      double v = double(in[std::size_t(r) * stride + c]) - hf.height_offset;
+      if (v < lim.min_height_rel || v > lim.max_height_rel) {
+        v = std::clamp(v, lim.min_height_rel, lim.max_height_rel);
+        ++result.samples_clamped;
+      }
+      const float old = edit->height(i, j), nh = static_cast<float>(v);
+      if (nh == old) continue;
+      layer.touch(*edit, i, j, hf.width, hf.height);
+      edit->write(i, j, nh);
+      changes.add(i, j, old, nh);
+    }
+  result.clamped = result.samples_clamped > 0;
+  edit->commit();
+  commit(changes, result);
+  return result;
+}
+
 Status Terrain::set_edit_limits(const EditLimits& l) {
   if (!std::isfinite(l.max_area_m2) || !(l.max_area_m2 > 0))
     return Error{"edit limits: max_area_m2 is " + num(l.max_area_m2) + "; need a finite value > 0"};

@@ -12,6 +12,9 @@
 //   apron      the ring of entries around the tile (kPageEntries - 256^2 samples), Deflate
 //   materials  kPageEntries material ids, Deflate (empty when the world has none)
 //   records    the tessellator's baked bounds of the page (levels >= 1), Deflate (roam/records.h)
+// A level whose size is 2^k + 1 samples has one column and row past its pages' tiles: the TIFF
+// gets extra tiles for them (after the last page of each row and column, outside the index), so
+// that its tile grid covers the image; Ridgeline reads those samples from the pages' aprons.
 // Every part is covered by the page's checksum, the index by its own, and the locator by its
 // own. A file is written to a temporary name, flushed and renamed: a reader sees a whole world or
 // none.
