@@ -283,7 +283,9 @@ TEST(World, QueriesOverPagesNotResidentAreExact) {
     const glm::dvec3 d(1.0, -0.012 - 0.001 * k, 0.2);
     const auto a = memory->raycast(o, d, INFINITY), b = world->raycast(o, d, INFINITY);
     ASSERT_EQ(a.has_value(), b.has_value()) << "ray " << k;
-    if (a) EXPECT_EQ(a->distance, b->distance) << "ray " << k;
+    if (a) {
+      EXPECT_EQ(a->distance, b->distance) << "ray " << k;
+    }
   }
   EXPECT_GT(world->world_stats().sync_loads, 0u);
 }

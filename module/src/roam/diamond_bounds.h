@@ -25,9 +25,7 @@ inline bool within(std::int64_t v, std::int64_t r, std::int64_t lo, std::int64_t
   return (v - r >= lo || lo <= 0) && (v + r <= hi || hi >= pad);
 }
 
-inline std::int64_t floor_div(std::int64_t n, std::int64_t d) noexcept {  // d > 0
-  return n >= 0 ? n / d : -((-n + d - 1) / d);
-}
+using world::floor_div;
 // floor_div() by a shift when d is a power of two (the bintree's triangles' edges always are).
 inline std::int64_t floor_div_fast(std::int64_t n, std::int64_t d) noexcept {  // d > 0
   if ((d & (d - 1)) == 0) return n >> std::countr_zero(std::uint64_t(d));

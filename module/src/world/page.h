@@ -27,6 +27,11 @@ struct RecordBlock;  // the tessellator's bounds of one page's diamonds (roam/re
 
 namespace ridgeline::world {
 
+/// n / d rounded towards minus infinity (d > 0).
+inline std::int64_t floor_div(std::int64_t n, std::int64_t d) noexcept {
+  return n >= 0 ? n / d : -((-n + d - 1) / d);
+}
+
 /// Record slots a page carries: one per tessellator configuration in use (Landscape).
 inline constexpr std::size_t kRecordSlots = 4;
 /// Levels of the pyramid at most (4^15 * 256 cells is far beyond any world).
