@@ -37,6 +37,9 @@ namespace detail {
 struct SurfaceAccess;
 struct TerrainAccess;
 }  // namespace detail
+namespace world {
+class PageEdit;
+}  // namespace world
 
 /// An inclusive range of finest-lattice vertex indices, [i0, i1] x [j0, j1]: vertex (i, j) sits
 /// at world (origin_x + i * spacing_x / 2^L, origin_z + j * spacing_z / 2^L), L being the
@@ -323,6 +326,8 @@ class Terrain {
   // tessellator's bounds over them, bumps the version, records the change and fills the result's
   // box.
   void commit(const SampleChanges& changes, EditResult& result);
+  void write_sample(world::PageEdit& edit, EditLayer& layer, SampleChanges& changes,
+                    EditResult& result, std::uint32_t i, std::uint32_t j, float old, double h);
   EditLayer& edit_layer() noexcept;
   const EditLayer& edit_layer() const noexcept;
 
