@@ -41,6 +41,30 @@ Status check_page_data(const WorldInfo& info, const PageKey& key, const PageData
   return {};
 }
 
+// A level-0 page's heights against its summary in the source's index, which rays read before the
+// page is ever loaded: a source whose summary does not hold what the page holds (a damaged index
+// whose checksum still matched, a faulty writer) would make rays miss ground. The page's own
+// cells give lo and hi exactly; the ring around it must widen them.
+Status check_summary(const WorldInfo& info, const PageKey& key, const PageData& d,
+                     const PageSummary& have) {
+  float lo = INFINITY, hi = -INFINITY;
+  for (std::int32_t b = 0; b <= kPageCells; ++b)
+    for (std::int32_t a = 0; a <= kPageCells; ++a) {
+      const std::size_t e = entry_index(a, b);
+      const float v =
+          d.f32.empty() ? static_cast<float>(info.height_scale * double(d.u16[e])) : d.f32[e];
+      lo = std::min(lo, v), hi = std::max(hi, v);
+    }
+  if (lo != have.lo || hi != have.hi || !(have.lo8 <= lo) || !(have.hi8 >= hi))
+    return Error{fmt("%s: page (0, %d, %d) holds heights %s .. %s but its summary says %s .. %s "
+                     "(ring %s .. %s): corrupted",
+                     info.name.c_str(), key.px, key.pz, detail::num(lo).c_str(),
+                     detail::num(hi).c_str(), detail::num(have.lo).c_str(),
+                     detail::num(have.hi).c_str(), detail::num(have.lo8).c_str(),
+                     detail::num(have.hi8).c_str())};
+  return {};
+}
+
 }  // namespace
 
 // ---- creation ---------------------------------------------------------------------------------
@@ -132,6 +156,9 @@ Result<std::shared_ptr<PageStore>> PageStore::open(std::shared_ptr<const PageSou
         PageData d;
         if (auto st = s->source_->load(key, d); !st) return Error{st.message()};
         if (auto st = check_page_data(info, key, d); !st) return Error{st.message()};
+        if (k == 0)
+          if (auto st = check_summary(info, key, d, s->summary(px, pz)); !st)
+            return Error{st.message()};
         top.push_back(s->make_page(key, std::move(d)));
       }
   }
@@ -296,6 +323,7 @@ std::vector<std::shared_ptr<const Page>> PageStore::load_chain(const PageKey& ke
     PageData d;
     Status st = source_->load(*it, d);
     if (st) st = check_page_data(info_, *it, d);
+    if (st && it->level == 0) st = check_summary(info_, *it, d, summary(it->px, it->pz));
     if (!st) {
       error = st.message();
       std::lock_guard lock(cache_->mu);
