@@ -323,6 +323,8 @@ class Terrain {
   // tessellator's bounds over them, bumps the version, records the change and fills the result's
   // box.
   void commit(const SampleChanges& changes, EditResult& result);
+  // The hole brushes (edit/hole_edit.cpp), after apply_edit's checks: `result` holds the radius.
+  EditResult edit_holes(const Edit& edit, EditResult result);
   EditLayer& edit_layer() noexcept;
   const EditLayer& edit_layer() const noexcept;
 

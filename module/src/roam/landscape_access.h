@@ -5,6 +5,7 @@
 
 #include <cfloat>
 #include <cmath>
+#include <limits>
 #include <memory>
 
 #include "ridgeline/landscape.h"
@@ -85,14 +86,18 @@ class Reader {
   };
 
   Reader() = default;
-  Reader(const Landscape& l, std::shared_ptr<const world::PageTable> table) noexcept
+  Reader(const Landscape& l, std::shared_ptr<const world::PageTable> table,
+         std::shared_ptr<const HoleMask> holes = nullptr) noexcept
       : land_(&l),
         im_(&LandscapeAccess::impl(l)),
         table_(std::move(table)),
+        holes_(std::move(holes)),
         L_(int(l.detail_levels())),
         K_(int(l.patch_exponent())) {}
 
   const world::PageTable& table() const noexcept { return *table_; }
+  /// The terrain's holes when this update began (null without holes).
+  const HoleMask* holes() const noexcept { return holes_.get(); }
   const Landscape& landscape() const noexcept { return *land_; }
 
   /// The page of level k = min(t / 2, the coarsest level) holding stored vertex (si, sj) with
@@ -160,12 +165,16 @@ class Reader {
     const float hc = p.local(a, b);
     const float hl = horizontal ? p.local(a - 1, b) : p.local(a, b - 1);
     const float hr = horizontal ? p.local(a + 1, b) : p.local(a, b + 1);
-    return edge_bound_of(im_->config, hc, hl, hr, i, j, horizontal);
+    DiamondBound bound = edge_bound_of(im_->config, hc, hl, hr, i, j, horizontal);
+    if (holes_ != nullptr && straddles_hole(*holes_, K_, im_->config.pad_i, im_->config.pad_j, i, j))
+      bound.radius = std::numeric_limits<float>::infinity();  // as bound_of() gives it
+    return bound;
   }
 
   const Landscape* land_ = nullptr;
   const Landscape::Impl* im_ = nullptr;
   std::shared_ptr<const world::PageTable> table_;
+  std::shared_ptr<const HoleMask> holes_;
   int L_ = 0, K_ = 6;
 };
 

@@ -31,6 +31,7 @@ class ChangeTracker {
   std::uint64_t synced_version_ = 0;                     // the terrain's edit_version() applied
   std::uint64_t tiles_generation_ = ~std::uint64_t{0};   // the detail cache's snapshot last seen
   std::uint64_t pages_generation_ = 0;                   // the page table last seen
+  bool had_holes_ = false;                               // the terrain had holes last update
   std::unordered_set<std::uint64_t> known_tiles_;        // finest tiles resident at the last look
 };
 
