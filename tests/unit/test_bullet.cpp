@@ -18,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include "bullet_test_util.h"
 #include "ridgeline/bullet/terrain_shape.h"
 #include "ridgeline/bullet/terrain_sync.h"
 #include "ridgeline/detail.h"
@@ -28,78 +29,11 @@
 using ridgeline::bullet::TerrainShape;
 using ridgeline::bullet::TerrainShapeDesc;
 using ridgeline::bullet::TerrainSync;
+using ridgeline::test::RayRecord;
+using ridgeline::test::terrain_of;
+using ridgeline::test::World;
 
 namespace {
-
-// A Bullet world with one static terrain object (identity transform) and owned bodies.
-struct World {
-  btDefaultCollisionConfiguration config;
-  btCollisionDispatcher dispatcher{&config};
-  btDbvtBroadphase broadphase;
-  btSequentialImpulseConstraintSolver solver;
-  btDiscreteDynamicsWorld world{&dispatcher, &broadphase, &solver, &config};
-  std::unique_ptr<TerrainShape> shape;
-  btCollisionObject ground;
-  std::vector<std::unique_ptr<btCollisionShape>> shapes;
-  std::vector<std::unique_ptr<btDefaultMotionState>> states;
-  std::vector<std::unique_ptr<btRigidBody>> bodies;
-
-  explicit World(std::shared_ptr<const ridgeline::Terrain> terrain, TerrainShapeDesc desc = {}) {
-    world.setGravity(btVector3(0, -9.81f, 0));
-    shape = TerrainShape::create(std::move(terrain), desc).value();
-    ground.setCollisionShape(shape.get());
-    ground.setFriction(1);
-    world.addCollisionObject(&ground, btBroadphaseProxy::StaticFilter,
-                             btBroadphaseProxy::AllFilter ^ btBroadphaseProxy::StaticFilter);
-  }
-  ~World() {
-    for (auto& b : bodies) world.removeRigidBody(b.get());
-    world.removeCollisionObject(&ground);
-  }
-  btRigidBody* add(std::unique_ptr<btCollisionShape> s, const glm::dvec3& world_pos, double mass) {
-    btVector3 inertia(0, 0, 0);
-    s->calculateLocalInertia(btScalar(mass), inertia);
-    btTransform t;
-    t.setIdentity();
-    t.setOrigin(shape->to_local(world_pos));
-    states.push_back(std::make_unique<btDefaultMotionState>(t));
-    btRigidBody::btRigidBodyConstructionInfo info(btScalar(mass), states.back().get(), s.get(),
-                                                  inertia);
-    info.m_friction = 0.8f;
-    bodies.push_back(std::make_unique<btRigidBody>(info));
-    shapes.push_back(std::move(s));
-    world.addRigidBody(bodies.back().get());
-    return bodies.back().get();
-  }
-  btRigidBody* sphere(double r, const glm::dvec3& p, double mass = 10) {
-    return add(std::make_unique<btSphereShape>(btScalar(r)), p, mass);
-  }
-  btRigidBody* box(const glm::dvec3& half, const glm::dvec3& p, double mass = 10) {
-    return add(std::make_unique<btBoxShape>(
-                   btVector3(btScalar(half.x), btScalar(half.y), btScalar(half.z))),
-               p, mass);
-  }
-  void step(int n) {
-    for (int i = 0; i < n; ++i) world.stepSimulation(1.0f / 60.0f, 0);
-  }
-  glm::dvec3 position(const btRigidBody* b) const {
-    return shape->to_world(b->getWorldTransform().getOrigin());
-  }
-};
-
-// A field of w x w samples at `spacing` whose height is h(x, z) at world (x, z), metres.
-std::shared_ptr<ridgeline::Terrain> terrain_of(std::uint32_t w, double spacing, double ox,
-                                               double oz,
-                                               const std::function<double(double, double)>& h) {
-  ridgeline::scenes::FieldDesc d;
-  d.width = d.height = w;
-  d.spacing_x = d.spacing_z = spacing;
-  d.origin_x = ox;
-  d.origin_z = oz;
-  auto hf = ridgeline::scenes::field(
-      d, [&](int i, int j) { return h(ox + i * spacing, oz + j * spacing); });
-  return ridgeline::Terrain::create(std::move(hf).value()).value();
-}
 
 // Hills with a material map (cells in 8 x 8 blocks cycle through ids 0..3) and one detail level.
 std::shared_ptr<ridgeline::Terrain> hills_with_detail(double ox, double oz) {
@@ -266,18 +200,6 @@ TEST(BulletSync, GroundRaisedUnderASleepingBodyLiftsIt) {
 // ---- rays ---------------------------------------------------------------------------------------
 
 namespace {
-// Bullet's closest-hit callback, also recording the shape part and triangle index.
-struct RayRecord final : btCollisionWorld::ClosestRayResultCallback {
-  using ClosestRayResultCallback::ClosestRayResultCallback;
-  int part = -2, index = -2;
-  btScalar addSingleResult(btCollisionWorld::LocalRayResult& r, bool normal_in_world) override {
-    if (r.m_localShapeInfo != nullptr) {
-      part = r.m_localShapeInfo->m_shapePart;
-      index = r.m_localShapeInfo->m_triangleIndex;
-    }
-    return ClosestRayResultCallback::addSingleResult(r, normal_in_world);
-  }
-};
 }  // namespace
 
 TEST(BulletShape, RayTestsEqualRidgelinesRaycast) {

@@ -39,6 +39,8 @@ enum class Brush : std::uint8_t {
 
 /// "crater", "raise", "lower", "flatten", "smooth", "hole", "fill_hole".
 const char* brush_name(Brush b) noexcept;
+/// "crater, raise, lower, flatten, smooth, hole or fill_hole": every brush name, for messages.
+const char* brush_names() noexcept;
 /// The brush named `name`; empty for anything else.
 std::optional<Brush> parse_brush(std::string_view name) noexcept;
 

@@ -36,6 +36,10 @@ const char* brush_name(Brush b) noexcept {
   return "?";
 }
 
+const char* brush_names() noexcept {
+  return "crater, raise, lower, flatten, smooth, hole or fill_hole";
+}
+
 std::optional<Brush> parse_brush(std::string_view name) noexcept {
   for (Brush b : {Brush::kCrater, Brush::kRaise, Brush::kLower, Brush::kFlatten, Brush::kSmooth,
                   Brush::kHole, Brush::kFillHole})
@@ -46,8 +50,7 @@ std::optional<Brush> parse_brush(std::string_view name) noexcept {
 Status validate_edit(const Edit& e) {
   auto finite = [](double v) { return std::isfinite(v); };
   if (static_cast<unsigned>(e.brush) > static_cast<unsigned>(Brush::kFillHole))
-    return Error{fmt("edit: brush %u; need crater, raise, lower, flatten, smooth, hole or fill_hole",
-                     static_cast<unsigned>(e.brush))};
+    return Error{fmt("edit: brush %u; need %s", static_cast<unsigned>(e.brush), brush_names())};
   if (!finite(e.x)) return Error{"edit: x is " + num(e.x) + "; need a finite value"};
   if (!finite(e.z)) return Error{"edit: z is " + num(e.z) + "; need a finite value"};
   if (!finite(e.radius) || !(e.radius > 0))
