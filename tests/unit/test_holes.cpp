@@ -11,6 +11,7 @@
 #include <limits>
 #include <map>
 
+#include "ridgeline/detail.h"
 #include "ridgeline/edit.h"
 #include "ridgeline/roam_view.h"
 #include "ridgeline/scenes.h"
@@ -57,15 +58,17 @@ std::vector<std::array<glm::dvec3, 3>> drawn(const RoamView& v) {
 }
 
 // The drawn mesh covers exactly the ground: every half-cell (triangle of the diagonal rule) of a
-// solid cell once, none of a hole cell; every drawn edge is shared by two drawn triangles unless
-// across it lies a hole or the terrain's edge (no crack, no T-junction). "" when it holds.
+// solid cell once, none of a hole cell (without detail); every drawn edge is shared by two drawn
+// triangles unless across it lies a hole or the terrain's edge (no crack, no T-junction). Unit
+// stored spacing; with L detail levels lattice coordinates are in finest cells. "" when it holds.
 std::string check_drawn_over_ground(const RoamView& v, const Terrain& t) {
   const Surface& s = t.surface();
   const std::int64_t W = t.info().width - 1, H = t.info().height - 1;  // cells (unit spacing)
+  const double scale = double(std::int64_t{1} << s.detail_levels());
   std::vector<int> covered(std::size_t(2 * W * H), 0);
   std::map<std::array<std::int64_t, 4>, int> edges;
-  auto lat = [](const glm::dvec3& p) {
-    return std::array<std::int64_t, 2>{std::llround(p.x), std::llround(p.z)};
+  auto lat = [&](const glm::dvec3& p) {
+    return std::array<std::int64_t, 2>{std::llround(p.x * scale), std::llround(p.z * scale)};
   };
   for (const auto& tri : drawn(v)) {
     std::array<std::int64_t, 2> c[3] = {lat(tri[0]), lat(tri[1]), lat(tri[2])};
@@ -73,6 +76,12 @@ std::string check_drawn_over_ground(const RoamView& v, const Terrain& t) {
     if (s.hole(std::int64_t(std::floor(cx)), std::int64_t(std::floor(cz))))
       return "a triangle with its centroid at (" + std::to_string(cx) + ", " + std::to_string(cz) +
              ") is drawn over a hole";
+    for (int e = 0; e < 3; ++e) {
+      auto a = c[e], b = c[(e + 1) % 3];
+      if (b < a) std::swap(a, b);
+      ++edges[{a[0], a[1], b[0], b[1]}];
+    }
+    if (s.detail_levels() != 0) continue;
     // Half-cells inside: their centroids (exact in thirds).
     const std::int64_t x0 = std::min({c[0][0], c[1][0], c[2][0]}), x1 = std::max({c[0][0], c[1][0], c[2][0]});
     const std::int64_t z0 = std::min({c[0][1], c[1][1], c[2][1]}), z1 = std::max({c[0][1], c[1][1], c[2][1]});
@@ -91,13 +100,8 @@ std::string check_drawn_over_ground(const RoamView& v, const Terrain& t) {
           }
           if (in) ++covered[std::size_t(2 * (i + j * W) + which)];
         }
-    for (int e = 0; e < 3; ++e) {
-      auto a = c[e], b = c[(e + 1) % 3];
-      if (b < a) std::swap(a, b);
-      ++edges[{a[0], a[1], b[0], b[1]}];
-    }
   }
-  for (std::int64_t j = 0; j < H; ++j)
+  for (std::int64_t j = 0; j < H && s.detail_levels() == 0; ++j)
     for (std::int64_t i = 0; i < W; ++i)
       for (int which = 0; which < 2; ++which) {
         const int n = covered[std::size_t(2 * (i + j * W) + which)];
@@ -114,7 +118,7 @@ std::string check_drawn_over_ground(const RoamView& v, const Terrain& t) {
     const double nx = -double(e[3] - e[1]), nz = double(e[2] - e[0]);
     int ground = 0;
     for (const double side : {-1e-3, 1e-3}) {
-      const double x = mx + side * nx, z = mz + side * nz;
+      const double x = (mx + side * nx) / scale, z = (mz + side * nz) / scale;
       if (x < 0 || z < 0 || x > double(W) || z > double(H)) continue;
       ground += s.hole(std::int64_t(std::floor(x)), std::int64_t(std::floor(z))) ? 0 : 1;
     }
@@ -379,4 +383,59 @@ TEST(Holes, EditFileHoleBlocksAreChecked) {
   ASSERT_TRUE(load_edits_from_memory(*target, bytes));
   EXPECT_EQ(target->surface().hole_cells(), t->surface().hole_cells());
   EXPECT_FALSE(target->height(40.5, 40.5));
+}
+
+TEST(Holes, ANoDataValueMakesHolesAtLoadWithFiniteHeights) {
+  // 5 x 4 samples, the no-data value -9999 at samples (2, 1) and (4, 3).
+  std::vector<float> v(20, 7.0f);
+  v[2 + 1 * 5] = -9999;
+  v[4 + 3 * 5] = -9999;
+  HeightfieldDesc d{.width = 5, .height = 4, .nodata = -9999.0, .fill = FillPolicy::kHole};
+  auto hf = Heightfield::create(d, v);
+  ASSERT_TRUE(hf) << hf.error().message;
+  EXPECT_EQ(hf->filled_samples(), 2u);
+  EXPECT_EQ(hf->local(2, 1), 7.0f) << "the nearest valid height: bounds stay finite";
+  // Cells with a missing corner: (1, 0), (2, 0), (1, 1), (2, 1) around (2, 1); (3, 2) at (4, 3).
+  const std::vector<std::uint64_t> want = {1, 2, 5, 6, 11};
+  EXPECT_EQ(std::vector<std::uint64_t>(hf->hole_cells().begin(), hf->hole_cells().end()), want);
+  auto t = Terrain::create(std::move(*hf)).value();
+  EXPECT_EQ(t->edit_version(), 0u) << "part of the terrain as made, not an edit";
+  EXPECT_EQ(t->surface().hole_cells(), 5u);
+  EXPECT_FALSE(t->height(2.0, 1.0));
+  EXPECT_FALSE(t->height(3.5, 2.5));
+  EXPECT_EQ(t->height(0.5, 0.5), std::optional<double>(7.0));
+  EXPECT_EQ(t->height(1.0, 2.0), std::optional<double>(7.0)) << "the holes' edge is ground";
+  // Filled, the ground shows the filled height; the refuse policy still refuses.
+  ASSERT_TRUE(t->apply_edit({.brush = Brush::kFillHole, .x = 2, .z = 1, .radius = 2}));
+  EXPECT_EQ(t->height(2.0, 1.0), std::optional<double>(7.0));
+  d.fill = FillPolicy::kRefuse;
+  EXPECT_FALSE(Heightfield::create(d, v));
+}
+
+TEST(Holes, WithProceduralDetailEveryFinestCellOfAHoleIsNoGround) {
+  auto hf = scenes::field({.width = 65, .height = 65},
+                          [](int i, int j) { return 3.0 + 0.05 * i + 0.5 * std::sin(j * 0.3); });
+  DetailParams dp;
+  dp.levels = 2;
+  dp.amplitude = 0.4;
+  dp.seed = 3;
+  auto t = Terrain::create(std::move(hf).value(), dp, {}).value();
+  const double inside = *t->height(20.6, 30.3);  // a detail point of cell (20, 30)
+  EXPECT_TRUE(std::isfinite(inside));
+  ASSERT_TRUE(t->apply_edit({.brush = Brush::kHole, .x = 20.5, .z = 30.5, .radius = 1.2}));
+  EXPECT_FALSE(t->height(20.6, 30.3));
+  EXPECT_FALSE(t->height(20.25, 30.75)) << "a finest-lattice vertex inside the hole cell";
+  EXPECT_TRUE(t->height(22.25, 30.5)) << "two cells away";
+  EXPECT_FALSE(t->raycast({20.6, 50, 30.3}, {0, -1, 0}, 100));
+  auto l = Landscape::create(t, {.patch_exponent = 4}).value();
+  const Camera cam = camera_at({32, 60, -20}, {32, 0, 32});
+  auto v = converged_view(l, cam, 0.05);
+  ASSERT_EQ(v->check_invariants(), "");
+  ASSERT_EQ(check_crack_free(*v), "");
+  EXPECT_EQ(check_drawn_over_ground(*v, *t), "");
+  ASSERT_TRUE(t->apply_edit({.brush = Brush::kFillHole, .x = 20.5, .z = 30.5, .radius = 1.2}));
+  EXPECT_EQ(t->height(20.6, 30.3), std::optional<double>(inside));
+  ASSERT_TRUE(v->converge(cam));
+  ASSERT_EQ(v->check_invariants(), "");
+  EXPECT_EQ(check_drawn_over_ground(*v, *t), "");
 }

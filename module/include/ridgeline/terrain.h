@@ -325,6 +325,8 @@ class Terrain {
   void commit(const SampleChanges& changes, EditResult& result);
   // The hole brushes (edit/hole_edit.cpp), after apply_edit's checks: `result` holds the radius.
   EditResult edit_holes(const Edit& edit, EditResult result);
+  // The holes of a field made with FillPolicy::kHole, at creation.
+  void take_holes(const Heightfield& heightfield);
   EditLayer& edit_layer() noexcept;
   const EditLayer& edit_layer() const noexcept;
 

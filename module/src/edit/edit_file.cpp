@@ -66,6 +66,25 @@ std::size_t max_file_bytes(const WorldInfo& hf) {
          8;
 }
 
+// Entry n of a list of `stride`-byte entries starting at `first`, each opening with its (x, z)
+// index (u32 each; chunks and hole blocks alike): inside nx x nz, after the entry before it in
+// (z, x) order.
+Status check_index(std::string_view in, std::size_t first, std::size_t stride, std::uint64_t n,
+                   std::uint64_t nx, std::uint64_t nz, const char* kind) {
+  const std::size_t at = first + n * stride;
+  const auto x = get<std::uint32_t>(in, at), z = get<std::uint32_t>(in, at + 4);
+  if (x >= nx || z >= nz)
+    return Error{fmt("edit file: %s %llu at (%u, %u) lies outside the terrain", kind,
+                     static_cast<unsigned long long>(n), x, z)};
+  const auto key = [&](std::size_t a) {
+    return (std::uint64_t(get<std::uint32_t>(in, a + 4)) << 32) | get<std::uint32_t>(in, a);
+  };
+  if (n > 0 && key(at) <= key(at - stride))
+    return Error{fmt("edit file: %s %llu out of order or repeated", kind,
+                     static_cast<unsigned long long>(n))};
+  return {};
+}
+
 // Bytes handed to the sink at a time: at most 64 KiB (edit.h).
 constexpr std::size_t kSinkBytes = std::size_t{64} << 10;
 
@@ -208,18 +227,10 @@ Result<EditResult> load_edits_from_memory(Terrain& terrain, std::string_view in)
                  ": reserved header bytes are not zero (written by a newer version, "
                  "or corrupted)"};
   const EditLimits& lim = terrain.edit_limits();
-  std::uint64_t prev_key = 0;
   for (std::uint64_t c = 0; c < count; ++c) {
     const std::size_t at = kHeaderBytes + c * kChunkBytes;
-    const auto cx = get<std::uint32_t>(in, at), cz = get<std::uint32_t>(in, at + 4);
-    if (cx >= chunks_x || cz >= chunks_z)
-      return Error{fmt("%s: chunk %llu at (%u, %u) lies outside the terrain", what.c_str(),
-                       static_cast<unsigned long long>(c), cx, cz)};
-    const std::uint64_t k = EditLayer::key(cx, cz);
-    if (c > 0 && k <= prev_key)
-      return Error{fmt("%s: chunk %llu out of order or repeated", what.c_str(),
-                       static_cast<unsigned long long>(c))};
-    prev_key = k;
+    if (auto s = check_index(in, kHeaderBytes, kChunkBytes, c, chunks_x, chunks_z, "chunk"); !s)
+      return Error{s.message()};
     for (std::size_t v = 0; v < kChunkValues; ++v) {
       const auto h = get<float>(in, at + 8 + 4 * v);
       if (!std::isfinite(h) || h < lim.min_height_rel || h > lim.max_height_rel)
@@ -232,15 +243,10 @@ Result<EditResult> load_edits_from_memory(Terrain& terrain, std::string_view in)
   auto mask = std::make_shared<HoleMask>();
   for (std::uint64_t b = 0; b < holes; ++b) {
     const std::size_t at = holes_at + b * kHoleBytes;
+    if (auto s = check_index(in, holes_at, kHoleBytes, b, blocks_x, blocks_z, "hole block"); !s)
+      return Error{s.message()};
     const auto bx = get<std::uint32_t>(in, at), bz = get<std::uint32_t>(in, at + 4);
-    if (bx >= blocks_x || bz >= blocks_z)
-      return Error{fmt("%s: hole block %llu at (%u, %u) lies outside the terrain", what.c_str(),
-                       static_cast<unsigned long long>(b), bx, bz)};
     const std::uint64_t k = HoleMask::key(bx, bz);
-    if (b > 0 && k <= HoleMask::key(get<std::uint32_t>(in, at - kHoleBytes),
-                                    get<std::uint32_t>(in, at - kHoleBytes + 4)))
-      return Error{fmt("%s: hole block %llu out of order or repeated", what.c_str(),
-                       static_cast<unsigned long long>(b))};
     const auto bits = get<HoleMask::Bits>(in, at + 8);
     for (std::int64_t c = 0; c < HoleMask::kBlock * HoleMask::kBlock; ++c) {
       const std::int64_t i = (std::int64_t(bx) << HoleMask::kShift) + (c & (HoleMask::kBlock - 1));

@@ -14,8 +14,12 @@ namespace ridgeline::roam {
 
 class ChangeTracker {
  public:
-  /// The mesh was rebuilt from the terrain as of `edit_version`: older edits need no pulling.
-  void mark_synced(std::uint64_t edit_version) noexcept { synced_version_ = edit_version; }
+  /// The mesh was rebuilt from the terrain as of `edit_version` (with holes or not): older edits
+  /// need no pulling.
+  void mark_synced(std::uint64_t edit_version, bool holes) noexcept {
+    synced_version_ = edit_version;
+    had_holes_ = holes;
+  }
   /// Edits since the last update (Terrain::changes_since()): refreshes the front's diamonds
   /// (bounds, positions) and the output vertices (heights, normals, bounds) they reach.
   void pull_edits(Refiner& refiner);
