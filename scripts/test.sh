@@ -97,7 +97,7 @@ asan() {
 # that stage did not run), each run for FUZZ_SECONDS on a copy of its committed corpus. A crash
 # fails the stage; the input is kept in build/asan/crashes/ (commit it under tests/fuzz/corpus/
 # with the fix).
-FUZZ_TARGETS=(fuzz_raw fuzz_camera_path fuzz_image fuzz_edit_json fuzz_edit_state fuzz_lua)
+FUZZ_TARGETS=(fuzz_raw fuzz_camera_path fuzz_image fuzz_edit_json fuzz_edit_state fuzz_lua fuzz_world)
 fuzz() {
   local dir=build/asan t rc=0 secs=${FUZZ_SECONDS:-30}
   mkdir -p "$dir/crashes"

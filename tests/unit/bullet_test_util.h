@@ -1,20 +1,16 @@
-// The Bullet world and fields the Bullet tests share (test_bullet.cpp, test_bullet_holes.cpp).
+// Test helper: a Bullet world with Ridgeline's terrain shape as its static ground.
 #pragma once
 
 #include <btBulletDynamicsCommon.h>
 
-#include <functional>
+#include <glm/vec3.hpp>
 #include <memory>
 #include <vector>
 
 #include "ridgeline/bullet/terrain_shape.h"
-#include "ridgeline/scenes.h"
 #include "ridgeline/terrain.h"
 
-namespace ridgeline::test {
-
-using bullet::TerrainShape;
-using bullet::TerrainShapeDesc;
+namespace ridgeline::bullet::test {
 
 // A Bullet world with one static terrain object (identity transform) and owned bodies.
 struct World {
@@ -29,7 +25,7 @@ struct World {
   std::vector<std::unique_ptr<btDefaultMotionState>> states;
   std::vector<std::unique_ptr<btRigidBody>> bodies;
 
-  explicit World(std::shared_ptr<const ridgeline::Terrain> terrain, TerrainShapeDesc desc = {}) {
+  explicit World(std::shared_ptr<const Terrain> terrain, TerrainShapeDesc desc = {}) {
     world.setGravity(btVector3(0, -9.81f, 0));
     shape = TerrainShape::create(std::move(terrain), desc).value();
     ground.setCollisionShape(shape.get());
@@ -72,31 +68,4 @@ struct World {
   }
 };
 
-// A field of w x w samples at `spacing` whose height is h(x, z) at world (x, z), metres.
-inline std::shared_ptr<ridgeline::Terrain> terrain_of(std::uint32_t w, double spacing, double ox,
-                                               double oz,
-                                               const std::function<double(double, double)>& h) {
-  ridgeline::scenes::FieldDesc d;
-  d.width = d.height = w;
-  d.spacing_x = d.spacing_z = spacing;
-  d.origin_x = ox;
-  d.origin_z = oz;
-  auto hf = ridgeline::scenes::field(
-      d, [&](int i, int j) { return h(ox + i * spacing, oz + j * spacing); });
-  return ridgeline::Terrain::create(std::move(hf).value()).value();
-}
-
-// Bullet's closest-hit ray callback, recording the part (material) and triangle index it hit.
-struct RayRecord final : btCollisionWorld::ClosestRayResultCallback {
-  using ClosestRayResultCallback::ClosestRayResultCallback;
-  int part = -2, index = -2;
-  btScalar addSingleResult(btCollisionWorld::LocalRayResult& r, bool normal_in_world) override {
-    if (r.m_localShapeInfo != nullptr) {
-      part = r.m_localShapeInfo->m_shapePart;
-      index = r.m_localShapeInfo->m_triangleIndex;
-    }
-    return ClosestRayResultCallback::addSingleResult(r, normal_in_world);
-  }
-};
-
-}  // namespace ridgeline::test
+}  // namespace ridgeline::bullet::test

@@ -29,11 +29,23 @@
 using ridgeline::bullet::TerrainShape;
 using ridgeline::bullet::TerrainShapeDesc;
 using ridgeline::bullet::TerrainSync;
-using ridgeline::test::RayRecord;
-using ridgeline::test::terrain_of;
-using ridgeline::test::World;
+using ridgeline::bullet::test::World;
 
 namespace {
+
+// A field of w x w samples at `spacing` whose height is h(x, z) at world (x, z), metres.
+std::shared_ptr<ridgeline::Terrain> terrain_of(std::uint32_t w, double spacing, double ox,
+                                               double oz,
+                                               const std::function<double(double, double)>& h) {
+  ridgeline::scenes::FieldDesc d;
+  d.width = d.height = w;
+  d.spacing_x = d.spacing_z = spacing;
+  d.origin_x = ox;
+  d.origin_z = oz;
+  auto hf = ridgeline::scenes::field(
+      d, [&](int i, int j) { return h(ox + i * spacing, oz + j * spacing); });
+  return ridgeline::Terrain::create(std::move(hf).value()).value();
+}
 
 // Hills with a material map (cells in 8 x 8 blocks cycle through ids 0..3) and one detail level.
 std::shared_ptr<ridgeline::Terrain> hills_with_detail(double ox, double oz) {
@@ -200,6 +212,18 @@ TEST(BulletSync, GroundRaisedUnderASleepingBodyLiftsIt) {
 // ---- rays ---------------------------------------------------------------------------------------
 
 namespace {
+// Bullet's closest-hit callback, also recording the shape part and triangle index.
+struct RayRecord final : btCollisionWorld::ClosestRayResultCallback {
+  using ClosestRayResultCallback::ClosestRayResultCallback;
+  int part = -2, index = -2;
+  btScalar addSingleResult(btCollisionWorld::LocalRayResult& r, bool normal_in_world) override {
+    if (r.m_localShapeInfo != nullptr) {
+      part = r.m_localShapeInfo->m_shapePart;
+      index = r.m_localShapeInfo->m_triangleIndex;
+    }
+    return ClosestRayResultCallback::addSingleResult(r, normal_in_world);
+  }
+};
 }  // namespace
 
 TEST(BulletShape, RayTestsEqualRidgelinesRaycast) {

@@ -10,19 +10,20 @@
 #include "bullet_test_util.h"
 #include "ridgeline/bullet/terrain_sync.h"
 #include "ridgeline/edit.h"
+#include "ridgeline/scenes.h"
 
 using ridgeline::Brush;
 using ridgeline::bullet::TerrainSync;
-using ridgeline::test::RayRecord;
-using ridgeline::test::terrain_of;
-using ridgeline::test::World;
+using ridgeline::bullet::test::World;
 
 namespace {
 
 constexpr double kGround = 20.0, kR = 0.5;
 
+// 129 x 129 samples 1 m apart, flat at kGround.
 std::shared_ptr<ridgeline::Terrain> flat_ground() {
-  return terrain_of(129, 1.0, 0, 0, [](double, double) { return kGround; });
+  auto hf = ridgeline::scenes::field({.width = 129, .height = 129}, [](int, int) { return kGround; });
+  return ridgeline::Terrain::create(std::move(hf).value()).value();
 }
 
 }  // namespace
@@ -74,19 +75,19 @@ TEST(BulletHoles, RaysPassThroughTheHoleAsRidgelinesDo) {
   World w(terrain, {.origin = {64, 0, 64}});
   auto trace = [&](const glm::dvec3& a, const glm::dvec3& b) {
     const btVector3 from = w.shape->to_local(a), to = w.shape->to_local(b);
-    RayRecord cb(from, to);
+    btCollisionWorld::ClosestRayResultCallback cb(from, to);
     w.world.rayTest(from, to, cb);
     return cb;
   };
   // Straight down the hole: no hit; beside it: the ground.
   EXPECT_FALSE(trace({40.5, 30, 40.5}, {40.5, -30, 40.5}).hasHit());
-  const RayRecord down = trace({50.5, 30, 40.5}, {50.5, -30, 40.5});
+  const auto down = trace({50.5, 30, 40.5}, {50.5, -30, 40.5});
   ASSERT_TRUE(down.hasHit());
   EXPECT_NEAR(w.shape->to_world(down.m_hitPointWorld).y, kGround, 1e-4);
   // Slanted across the hole (cells 36..44 of row 40): it would land at x = 40 without it, and
   // hits the hole's far wall at x = 45 instead, where Ridgeline's raycast does.
   const glm::dvec3 a(30, kGround + 1, 40.5), b(60, kGround - 2, 40.5);
-  const RayRecord slanted = trace(a, b);
+  const auto slanted = trace(a, b);
   ASSERT_TRUE(slanted.hasHit());
   const auto hit = terrain->raycast(a, b - a, glm::length(b - a));
   ASSERT_TRUE(hit);

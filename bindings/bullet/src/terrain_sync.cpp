@@ -65,6 +65,9 @@ Result<TerrainSync> TerrainSync::create(btCollisionWorld* world, btCollisionObje
   if (!(std::isfinite(desc.wake_margin) && desc.wake_margin >= 0))
     return Error{"bullet terrain sync: wake margin is " + std::to_string(desc.wake_margin) +
                  "; need a finite value >= 0 metres"};
+  if (!(std::isfinite(desc.residency_margin) && desc.residency_margin >= 0))
+    return Error{"bullet terrain sync: residency margin is " +
+                 std::to_string(desc.residency_margin) + "; need a finite value >= 0 metres"};
   return TerrainSync(world, terrain_object, shape, desc);
 }
 
@@ -76,8 +79,65 @@ TerrainSync::TerrainSync(btCollisionWorld* world, btCollisionObject* object,
       desc_(desc),
       seen_(shape->terrain().edit_version()) {}
 
+void TerrainSync::keep_resident(TerrainSyncStats& stats) {
+  const Terrain& terrain = shape_->terrain();
+  const WorldInfo& w = terrain.info();
+  const double page_x = w.spacing_x * kPageCells, page_z = w.spacing_z * kPageCells;
+  const std::int64_t last_px = std::int64_t(w.width - 2) / kPageCells;
+  const std::int64_t last_pz = std::int64_t(w.height - 2) / kPageCells;
+  auto page = [](double v, double size, std::int64_t last) {
+    const double p = std::floor(v / size);
+    return std::int64_t(std::clamp(p, 0.0, double(last)));
+  };
+  // Every body's box in the terrain's frame (in world metres), widened by the margin, as the
+  // level-0 pages it covers.
+  const btTransform to_shape = object_->getWorldTransform().inverse();
+  const btCollisionObjectArray& objects = world_->getCollisionObjectArray();
+  next_keys_.clear();
+  for (int k = 0; k < objects.size(); ++k) {
+    const btCollisionObject* o = objects[k];
+    if (o == object_ || o->isStaticObject() || o->getCollisionShape() == nullptr) continue;
+    btVector3 lo, hi;
+    o->getCollisionShape()->getAabb(to_shape * o->getWorldTransform(), lo, hi);
+    const glm::dvec3 a = shape_->to_world(lo), b = shape_->to_world(hi);
+    if (!std::isfinite(a.x + a.z + b.x + b.z)) continue;
+    const double m = desc_.residency_margin;
+    const std::int64_t x0 = page(a.x - m - w.origin_x, page_x, last_px),
+                       x1 = page(b.x + m - w.origin_x, page_x, last_px),
+                       z0 = page(a.z - m - w.origin_z, page_z, last_pz),
+                       z1 = page(b.z + m - w.origin_z, page_z, last_pz);
+    for (std::int64_t pz = z0; pz <= z1; ++pz)
+      for (std::int64_t px = x0; px <= x1; ++px)
+        next_keys_.push_back(std::uint64_t(pz) << 32 | std::uint64_t(px));
+  }
+  std::sort(next_keys_.begin(), next_keys_.end());
+  next_keys_.erase(std::unique(next_keys_.begin(), next_keys_.end()), next_keys_.end());
+  stats.pinned_pages = next_keys_.size();
+  if (next_keys_ == page_keys_) return;
+  stats.residency_changed = true;
+  // The new pins first, then the old ones released: a page under a body in both sets stays.
+  std::vector<RegionPin> pins;
+  pins.reserve(next_keys_.size());
+  for (const std::uint64_t key : next_keys_) {
+    const double px = double(key & 0xffffffffu), pz = double(key >> 32);
+    // The page's inside, half a cell from its edges: it lies on no other page.
+    // (pin() and prefetch() read the xz range only.)
+    const Box inside{{w.origin_x + (px * kPageCells + 0.5) * w.spacing_x, 0.0,
+                      w.origin_z + (pz * kPageCells + 0.5) * w.spacing_z},
+                     {w.origin_x + ((px + 1) * kPageCells - 0.5) * w.spacing_x, 0.0,
+                      w.origin_z + ((pz + 1) * kPageCells - 0.5) * w.spacing_z}};
+    pins.push_back(terrain.pin(inside));
+    const glm::dvec3 around(desc_.residency_margin + 0.5 * page_x, 0.0,
+                            desc_.residency_margin + 0.5 * page_z);
+    terrain.prefetch(Box{inside.min - around, inside.max + around});
+  }
+  pins_ = std::move(pins);
+  page_keys_.swap(next_keys_);
+}
+
 TerrainSyncStats TerrainSync::update() {
   TerrainSyncStats stats;
+  if (shape_->terrain().paged()) keep_resident(stats);
   const TerrainChanges c = shape_->terrain().changes_since(seen_);
   seen_ = c.version;
   if (c.empty()) return stats;

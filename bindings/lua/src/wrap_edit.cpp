@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <exception>
-#include <vector>
+#include <span>
 
 #include "lua_util.h"
 #include "ridgeline/edit.h"
@@ -85,13 +85,35 @@ bool take_result(const Result<EditResult>& r, EditResult* out, char* err) noexce
   return true;
 }
 
-bool do_edit(Terrain& t, const Edit& e, EditResult* out, char* err) noexcept {
+// Runs apply() (-> Result<EditResult>) for the terrain at index 1 and pushes its result or nil,
+// message. On a paged terrain, room for the pages under `reach` comes first (raising `what`'s
+// budget error) and the charge then follows what the terrain holds.
+void push_edit_result(lua_State* L, const EditResult& r);
+
+template <class Apply>
+int scripted_edit(lua_State* L, Terrain& t, const Edit& reach, const char* what, Apply apply) {
+  auto* box = static_cast<TerrainBox*>(lua_touserdata(L, 1));
+  const bool charge_pages = t.paged() && box->terrain_charge && box->budget;
+  if (charge_pages) {
+    const std::size_t own = box->terrain_charge->bytes();
+    reserve_objects(L, box->budget, own + edit_page_bytes(t, reach), what, own);
+  }
+  char err[kErrSize];
+  EditResult r;
+  bool ok = false;
   try {
-    return take_result(t.apply_edit(e), out, err);
+    ok = take_result(apply(), &r, err);
   } catch (const std::exception& ex) {
     copy_error(err, ex.what());
-    return false;
   }
+  if (charge_pages) box->terrain_charge->set(paged_terrain_charge_bytes(t, box->cache_bytes));
+  if (!ok) {
+    lua_pushnil(L);
+    lua_pushstring(L, err);
+    return 2;
+  }
+  push_edit_result(L, r);
+  return 1;
 }
 
 void set_field(lua_State* L, const char* key, double v) {
@@ -185,25 +207,7 @@ int file_op(lua_State* L, FileOp op, bool method) {
 int t_deform(lua_State* L) {
   Terrain& t = editable_terrain(L, 1);
   const Edit e = check_edit(L, 2);
-  auto* box = static_cast<TerrainBox*>(lua_touserdata(L, 1));
-  // A paged terrain keeps every page an edit copies: room for the pages under the brush first,
-  // then the charge follows what the terrain holds.
-  const bool charge_pages = t.paged() && box->terrain_charge && box->budget;
-  if (charge_pages) {
-    const std::size_t own = box->terrain_charge->bytes();
-    reserve_objects(L, box->budget, own + edit_page_bytes(t, e), "deform", own);
-  }
-  char err[kErrSize];
-  EditResult r;
-  const bool ok = do_edit(t, e, &r, err);
-  if (charge_pages) box->terrain_charge->set(paged_terrain_charge_bytes(t, box->cache_bytes));
-  if (!ok) {
-    lua_pushnil(L);
-    lua_pushstring(L, err);
-    return 2;
-  }
-  push_edit_result(L, r);
-  return 1;
+  return scripted_edit(L, t, e, "deform", [&] { return t.apply_edit(e); });
 }
 
 namespace {
@@ -223,6 +227,12 @@ void check_rect(lua_State* L, int arg, std::uint32_t v[4]) {
                                           int(v[2]), int(v[3]), int(kMaxBatchPoints)));
 }
 
+// Scratch floats the Lua collector owns, pushed on the stack: an error raised later (a longjmp
+// when Lua is built as C) cannot leak them as it would a std::vector.
+float* scratch_floats(lua_State* L, std::size_t n) {
+  return static_cast<float*>(lua_newuserdatauv(L, std::max<std::size_t>(n, 1) * sizeof(float), 0));
+}
+
 }  // namespace
 
 // terrain:get_heights{i0=, j0=, width=, height=} -> array of width x height heights, row by row
@@ -234,14 +244,24 @@ int t_get_heights(lua_State* L) {
   check_fields(L, 2, kFields);
   std::uint32_t v[4];
   check_rect(L, 2, v);
-  std::vector<float> out(std::size_t(v[2]) * v[3]);
-  if (auto s = t.get_heights(v[0], v[1], v[2], v[3], out, v[2]); !s) {
+  const std::size_t n = std::size_t(v[2]) * v[3];
+  float* out = scratch_floats(L, n);
+  char err[kErrSize];
+  bool ok = false;
+  try {
+    const Status s = t.get_heights(v[0], v[1], v[2], v[3], std::span<float>(out, n), v[2]);
+    ok = bool(s);
+    if (!ok) copy_error(err, s.message().c_str());
+  } catch (const std::exception& ex) {
+    copy_error(err, ex.what());
+  }
+  if (!ok) {
     lua_pushnil(L);
-    lua_pushstring(L, s.message().c_str());
+    lua_pushstring(L, err);
     return 2;
   }
-  lua_createtable(L, int(out.size()), 0);
-  for (std::size_t k = 0; k < out.size(); ++k) {
+  lua_createtable(L, int(n), 0);
+  for (std::size_t k = 0; k < n; ++k) {
     lua_pushnumber(L, double(out[k]));
     lua_rawseti(L, -2, lua_Integer(k + 1));
   }
@@ -256,14 +276,14 @@ int t_set_heights(lua_State* L) {
   check_fields(L, 2, kFields);
   std::uint32_t v[4];
   check_rect(L, 2, v);
+  const std::size_t n = std::size_t(v[2]) * v[3];
+  float* in = scratch_floats(L, n);
   if (lua_getfield(L, 2, "heights") != LUA_TTABLE)
     luaL_argerror(L, 2, lua_pushfstring(L, "field 'heights': table expected, got %s",
                                         luaL_typename(L, -1)));
-  const std::size_t n = std::size_t(v[2]) * v[3];
   if (lua_rawlen(L, -1) != n)
     luaL_argerror(L, 2, lua_pushfstring(L, "field 'heights': %d values for %d x %d samples",
                                         int(lua_rawlen(L, -1)), int(v[2]), int(v[3])));
-  std::vector<float> in(n);
   for (std::size_t k = 0; k < n; ++k) {
     if (lua_rawgeti(L, -1, lua_Integer(k + 1)) != LUA_TNUMBER)
       luaL_argerror(L, 2, lua_pushfstring(L, "field 'heights': value %d is not a number",
@@ -272,36 +292,12 @@ int t_set_heights(lua_State* L) {
     lua_pop(L, 1);
   }
   lua_pop(L, 1);
-  auto* box = static_cast<TerrainBox*>(lua_touserdata(L, 1));
-  const bool charge_pages = t.paged() && box->terrain_charge && box->budget;
-  if (charge_pages) {
-    const std::size_t own = box->terrain_charge->bytes();
-    Edit e;
-    const WorldInfo& i = t.info();
-    e.radius = 0.5 * std::max(double(v[2]) * i.spacing_x, double(v[3]) * i.spacing_z) / 1.5;
-    reserve_objects(L, box->budget, own + edit_page_bytes(t, e), "set_heights", own);
-  }
-  char err[kErrSize];
-  EditResult r;
-  bool ok = false;
-  try {
-    auto res = t.set_heights(v[0], v[1], v[2], v[3], in, v[2]);
-    ok = bool(res);
-    if (ok)
-      r = *res;
-    else
-      copy_error(err, res.error().message.c_str());
-  } catch (const std::exception& ex) {
-    copy_error(err, ex.what());
-  }
-  if (charge_pages) box->terrain_charge->set(paged_terrain_charge_bytes(t, box->cache_bytes));
-  if (!ok) {
-    lua_pushnil(L);
-    lua_pushstring(L, err);
-    return 2;
-  }
-  push_edit_result(L, r);
-  return 1;
+  // The brush reaching over the rectangle, for the pages it may copy.
+  Edit reach;
+  const WorldInfo& i = t.info();
+  reach.radius = 0.5 * std::max(double(v[2]) * i.spacing_x, double(v[3]) * i.spacing_z) / 1.5;
+  return scripted_edit(L, t, reach, "set_heights",
+                       [&] { return t.set_heights(v[0], v[1], v[2], v[3], std::span<const float>(in, n), v[2]); });
 }
 
 // ridgeline.save_edits(terrain, file) -> true or nil, message

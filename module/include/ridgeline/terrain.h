@@ -37,6 +37,9 @@ namespace detail {
 struct SurfaceAccess;
 struct TerrainAccess;
 }  // namespace detail
+namespace world {
+class PageEdit;
+}  // namespace world
 
 /// An inclusive range of finest-lattice vertex indices, [i0, i1] x [j0, j1]: vertex (i, j) sits
 /// at world (origin_x + i * spacing_x / 2^L, origin_z + j * spacing_z / 2^L), L being the
@@ -327,6 +330,8 @@ class Terrain {
   EditResult edit_holes(const Edit& edit, EditResult result);
   // The holes of a field made with FillPolicy::kHole, at creation.
   void take_holes(const Heightfield& heightfield);
+  void write_sample(world::PageEdit& edit, EditLayer& layer, SampleChanges& changes,
+                    EditResult& result, std::uint32_t i, std::uint32_t j, float old, double h);
   EditLayer& edit_layer() noexcept;
   const EditLayer& edit_layer() const noexcept;
 

@@ -172,6 +172,24 @@ TerrainChanges Terrain::changes_since(std::uint64_t version) const {
   return out;
 }
 
+// Writes local height `h` to sample (i, j) of an open edit, clamped to the edit limits' range
+// (counted in `r`), unless it equals `old`; the edit layer and the changes record it.
+void Terrain::write_sample(world::PageEdit& edit, EditLayer& layer, SampleChanges& c,
+                           EditResult& r, std::uint32_t i, std::uint32_t j, float old,
+                           double h) {
+  const EditLimits& lim = edit_limits_;
+  if (h < lim.min_height_rel || h > lim.max_height_rel) {
+    h = std::clamp(h, lim.min_height_rel, lim.max_height_rel);
+    ++r.samples_clamped;
+  }
+  const float nh = static_cast<float>(h);
+  if (nh == old) return;
+  const WorldInfo& hf = surface_.info();
+  layer.touch(edit, i, j, hf.width, hf.height);
+  edit.write(i, j, nh);
+  c.add(i, j, old, nh);
+}
+
 Result<EditResult> Terrain::apply_edit(const Edit& e) {
   if (auto s = validate_edit(e); !s) return Error{s.message()};
   const WorldInfo& hf = surface_.info();
@@ -254,15 +272,7 @@ Result<EditResult> Terrain::apply_edit(const Edit& e) {
         case Brush::kHole:
         case Brush::kFillHole: break;  // edit_holes()
       }
-      if (h < lim.min_height_rel || h > lim.max_height_rel) {
-        h = std::clamp(h, lim.min_height_rel, lim.max_height_rel);
-        ++r.samples_clamped;
-      }
-      const float nh = static_cast<float>(h);
-      if (nh == old) continue;
-      layer.touch(*edit, i, j, hf.width, hf.height);
-      edit->write(i, j, nh);
-      c.add(i, j, old, nh);
+      write_sample(*edit, layer, c, r, i, j, old, h);
     }
   }
   r.clamped = r.samples_clamped > 0;
@@ -328,16 +338,8 @@ Result<EditResult> Terrain::set_heights(std::uint32_t i0, std::uint32_t j0, std:
   for (std::uint32_t r = 0; r < h; ++r)
     for (std::uint32_t c = 0; c < w; ++c) {
       const std::uint32_t i = i0 + c, j = j0 + r;
-      double v = double(in[std::size_t(r) * stride + c]) - hf.height_offset;
-      if (v < lim.min_height_rel || v > lim.max_height_rel) {
-        v = std::clamp(v, lim.min_height_rel, lim.max_height_rel);
-        ++result.samples_clamped;
-      }
-      const float old = edit->height(i, j), nh = static_cast<float>(v);
-      if (nh == old) continue;
-      layer.touch(*edit, i, j, hf.width, hf.height);
-      edit->write(i, j, nh);
-      changes.add(i, j, old, nh);
+      write_sample(*edit, layer, changes, result, i, j, edit->height(i, j),
+                   double(in[std::size_t(r) * stride + c]) - hf.height_offset);
     }
   result.clamped = result.samples_clamped > 0;
   edit->commit();

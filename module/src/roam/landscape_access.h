@@ -3,12 +3,14 @@
 // each vertex.
 #pragma once
 
+#include <array>
 #include <cfloat>
 #include <cmath>
 #include <limits>
 #include <memory>
 
 #include "ridgeline/landscape.h"
+#include "platform/memory_hints.h"
 #include "ridgeline/terrain.h"
 #include "roam/diamond.h"
 #include "roam/records.h"
@@ -92,8 +94,10 @@ class Reader {
         im_(&LandscapeAccess::impl(l)),
         table_(std::move(table)),
         holes_(std::move(holes)),
+        grid_(&im_->store->grid()),
         L_(int(l.detail_levels())),
-        K_(int(l.patch_exponent())) {}
+        K_(int(l.patch_exponent())),
+        slot_(std::size_t(im_->slot)) {}
 
   const world::PageTable& table() const noexcept { return *table_; }
   /// The terrain's holes when this update began (null without holes).
@@ -101,14 +105,11 @@ class Reader {
   const Landscape& landscape() const noexcept { return *land_; }
 
   /// The page of level k = min(t / 2, the coarsest level) holding stored vertex (si, sj) with
-  /// size 2^t, and its entry.
+  /// size 2^t, and its entry. The last page found per level is remembered (a view's reads are
+  /// coherent: most land in the page of the read before), so a Reader is one thread's.
   const world::Page* page_of(std::int64_t si, std::int64_t sj, int t, std::int32_t& a,
                              std::int32_t& b, PageKey& key) const noexcept {
-    const std::uint32_t k = std::min(std::uint32_t(t >> 1), im_->store->grid().levels - 1);
-    key = im_->store->grid().page_of(k, si, sj);
-    a = std::int32_t((si >> (2 * k)) - (std::int64_t(key.px) << 8));
-    b = std::int32_t((sj >> (2 * k)) - (std::int64_t(key.pz) << 8));
-    return table_->find(key);
+    return lookup(si, sj, t, a, b, key).page;
   }
 
   /// Height and bounds of finest-lattice vertex (i, j), which is a diamond centre (not a patch
@@ -123,17 +124,17 @@ class Reader {
     const Diamond d = diamond_at(i, j, K_);
     std::int32_t a, b;
     PageKey key;
-    const world::Page* p = page_of(i, j, d.t, a, b, key);
-    if (p == nullptr || p->records[std::size_t(im_->slot)] == nullptr || a < 0 || b < 0 ||
-        a > kPageCells || b > kPageCells) {
+    const Cached& c = lookup(i, j, d.t, a, b, key);
+    if (c.records == nullptr || a < 0 || b < 0 || a > kPageCells || b > kPageCells) {
       if (missing) *missing = key;
       return Vertex::kMissing;
     }
-    y = p->local(a, b);
+    const world::Page& p = *c.page;
+    y = p.local(a, b);
     if (d.t == 0 && !d.square && L_ == 0) {
-      bound = edge(*p, a, b, i, j);
+      bound = edge(p, a, b, i, j);
     } else {
-      bound = p->records[std::size_t(im_->slot)]->get(a, b);
+      bound = RecordBlock::at(c.records, RecordBlock::slot(key.level, a, b));
     }
     return Vertex::kResident;
   }
@@ -144,7 +145,35 @@ class Reader {
   bool stored_shading(std::int64_t si, std::int64_t sj, const Diamond& d, int t,
                       VertexShading& out, float* height = nullptr) const noexcept;
 
-  /// Address of what stored() reads for vertex (i, j) (a prefetch hint; null when unknown).
+  /// Hints the caches to fetch what stored() reads for vertex (i, j): its height and its bound
+  /// (two lines: they live in the page's samples and in its bounds block); with `shading`, the
+  /// rows above and below that stored_shading() reads too.
+  void prefetch(std::int64_t i, std::int64_t j, bool shading = false) const noexcept {
+    if (L_ > 0) {
+      const std::int64_t mask = (std::int64_t{1} << L_) - 1;
+      if ((i & mask) != 0 || (j & mask) != 0) return;
+      i >>= L_, j >>= L_;
+    }
+    const int t = std::min(ctz64(i), ctz64(j));
+    if (t >= K_) return;
+    std::int32_t a, b;
+    PageKey key;
+    const Cached& c = lookup(i, j, t, a, b, key);
+    if (c.records == nullptr || !RecordBlock::holds(a, b)) return;
+    const world::Page& p = *c.page;
+    auto sample = [&p](std::size_t e) {
+      return p.f32 ? static_cast<const void*>(p.f32 + e) : static_cast<const void*>(p.u16 + e);
+    };
+    const std::size_t e = world::entry_index(a, b);
+    detail::prefetch(sample(e));
+    detail::prefetch(c.records + sizeof(std::uint32_t) * RecordBlock::slot(key.level, a, b));
+    if (shading) {
+      detail::prefetch(sample(e - std::size_t(kPageStride)));
+      detail::prefetch(sample(e + std::size_t(kPageStride)));
+    }
+  }
+
+  /// Address of what stored() reads for vertex (i, j) (null when unknown).
   const void* address(std::int64_t i, std::int64_t j) const noexcept {
     if (L_ > 0) i >>= L_, j >>= L_;
     const int t = std::min(ctz64(i), ctz64(j));
@@ -171,11 +200,37 @@ class Reader {
     return bound;
   }
 
+  // A page found for one level: its grid position, the page and its packed bounds for this
+  // landscape's slot (null: the page is resident without them yet).
+  struct Cached {
+    std::int32_t px = -1, pz = -1;
+    const world::Page* page = nullptr;
+    const std::uint8_t* records = nullptr;
+  };
+  const Cached& lookup(std::int64_t si, std::int64_t sj, int t, std::int32_t& a, std::int32_t& b,
+                       PageKey& key) const noexcept {
+    static const Cached kAbsent{};
+    const std::uint32_t k = std::min(std::uint32_t(t >> 1), grid_->levels - 1);
+    key = grid_->page_of(k, si, sj);
+    a = std::int32_t((si >> (2 * k)) - (std::int64_t(key.px) << 8));
+    b = std::int32_t((sj >> (2 * k)) - (std::int64_t(key.pz) << 8));
+    Cached& c = last_[k];
+    if (c.px == key.px && c.pz == key.pz) return c;
+    const world::Page* p = table_->find(key);
+    if (p == nullptr) return kAbsent;
+    const RecordBlock* r = p->records[slot_].get();
+    c = {key.px, key.pz, p, r ? r->packed_values() : nullptr};
+    return c;
+  }
+
   const Landscape* land_ = nullptr;
   const Landscape::Impl* im_ = nullptr;
   std::shared_ptr<const world::PageTable> table_;
   std::shared_ptr<const HoleMask> holes_;
+  const world::PageGrid* grid_ = nullptr;
   int L_ = 0, K_ = 6;
+  std::size_t slot_ = 0;
+  mutable std::array<Cached, world::kMaxLevels> last_{};
 };
 
 }  // namespace ridgeline::roam

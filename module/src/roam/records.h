@@ -139,7 +139,8 @@ struct RecordBlock {
   }
   /// Slot of entry (a, b), a, b in 0 .. 256 (holds()); at level 0 never a size-1 edge diamond
   /// without `edges`.
-  std::size_t slot(std::int32_t a, std::int32_t b) const noexcept {
+  std::size_t slot(std::int32_t a, std::int32_t b) const noexcept { return slot(level, a, b); }
+  static std::size_t slot(std::uint32_t level, std::int32_t a, std::int32_t b) noexcept {
     if (level > 0) return std::size_t(a) + std::size_t(b) * std::size_t(kSide);
     const bool oa = (a & 1) != 0, ob = (b & 1) != 0;
     if (oa && ob) return std::size_t(a >> 1) + std::size_t(b >> 1) * 128;
@@ -148,11 +149,18 @@ struct RecordBlock {
     return kOdd + kEven + kEdge + std::size_t(a >> 1) + std::size_t(b >> 1) * 129;
   }
   DiamondBound get(std::int32_t a, std::int32_t b) const noexcept {
+    return at(packed_values(), slot(a, b));
+  }
+  /// The packed values' bytes (`values`, or the payload read in place): what get() reads, for
+  /// readers that look many slots up in one block.
+  const std::uint8_t* packed_values() const noexcept {
+    return !values.empty() ? reinterpret_cast<const std::uint8_t*>(values.data())
+                           : encoded->data() + kHeaderBytes;
+  }
+  /// The bound in slot `s` of packed values `p` (packed_values()).
+  static DiamondBound at(const std::uint8_t* p, std::size_t s) noexcept {
     std::uint32_t v;
-    if (!values.empty())
-      v = values[slot(a, b)];
-    else
-      std::memcpy(&v, encoded->data() + kHeaderBytes + sizeof v * slot(a, b), sizeof v);
+    std::memcpy(&v, p + sizeof v * s, sizeof v);
     return packed::unpack(v);
   }
   /// Sets one slot (a block read in place is copied into `values` first).

@@ -193,6 +193,9 @@ class PageEdit {
   std::unordered_map<PageKey, std::shared_ptr<PageSamples>, PageKeyHash> samples_;
   std::unordered_map<PageKey, std::array<std::int32_t, 4>, PageKeyHash> touched_;  // a0 b0 a1 b1
   std::shared_ptr<const PageTable> keep_;
+  // The page height() read last (in pages_ or keep_), and its key.
+  const Page* last_ = nullptr;
+  PageKey last_key_{};
 };
 
 }  // namespace ridgeline::world

@@ -115,6 +115,7 @@ std::unique_ptr<PageEdit> PageStore::begin_edit() { return std::make_unique<Page
 
 Page& PageEdit::writable(const PageKey& key) {
   if (auto it = pages_.find(key); it != pages_.end()) return *it->second;
+  last_ = nullptr;  // the page read last may be the one copied here
   const Page* cur = store_.require(key, keep_);
   RIDGELINE_ASSERT(cur != nullptr);
   auto p = cur->copy();
@@ -135,9 +136,19 @@ float PageEdit::height(std::int64_t i, std::int64_t j) {
   const PageKey key = store_.grid().page_of(0, i, j);
   const std::int32_t a = std::int32_t(i - (std::int64_t(key.px) << 8));
   const std::int32_t b = std::int32_t(j - (std::int64_t(key.pz) << 8));
-  if (auto it = pages_.find(key); it != pages_.end()) return it->second->local(a, b);
-  const Page* p = store_.require(key, keep_);
-  return p ? p->local(a, b) : 0.0f;
+  // Reads come in runs over one page (a brush's footprint, the pyramid above it): the page of
+  // the last read is kept, and otherwise the edit's own copy, then the snapshot it holds, are
+  // looked in before the store (whose require() takes its lock).
+  if (last_ == nullptr || !(last_key_ == key)) {
+    if (auto it = pages_.find(key); it != pages_.end())
+      last_ = it->second.get();
+    else if (const Page* p = keep_ ? keep_->find(key) : nullptr)
+      last_ = p;
+    else
+      last_ = store_.require(key, keep_);
+    last_key_ = key;
+  }
+  return last_ ? last_->local(a, b) : 0.0f;
 }
 
 void PageEdit::write(std::int64_t i, std::int64_t j, float h) {

@@ -60,7 +60,7 @@ void prefetch_change(const Refiner& r, const std::vector<std::uint32_t>& list, b
     nodes.prefetch(linked_node(f.link[kLeftLink]));
     nodes.prefetch(linked_node(f.link[kRightLink]));
   }
-  source.prefetch(i, j);
+  source.prefetch(i, j, true);
   if (((hu - hw) | (hu + hw)) & 1) return;  // finest: no child diamonds
   const std::int64_t au = (hu - hw) / 2, aw = (hu + hw) / 2, bu = (hu + hw) / 2, bw = (hw - hu) / 2;
   source.prefetch(i + au, j + aw);

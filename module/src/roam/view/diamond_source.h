@@ -69,9 +69,10 @@ class DiamondSource {
   /// The detail cache (null without procedural detail) and this update's snapshot of it.
   DetailCache* detail_cache() const noexcept { return cache_; }
   const DetailSnapshot* detail_snapshot() const noexcept { return snapshot_.get(); }
-  /// Hints the caches to fetch what read(i, j) reads.
-  void prefetch(std::int64_t i, std::int64_t j) const noexcept {
-    if (const void* a = reader_.address(i, j)) detail::prefetch(a);
+  /// Hints the caches to fetch what read(i, j) reads (with `shading`: what a split writing the
+  /// vertex reads too).
+  void prefetch(std::int64_t i, std::int64_t j, bool shading = false) const noexcept {
+    reader_.prefetch(i, j, shading);
   }
 
  private:

@@ -27,6 +27,12 @@ struct TerrainSyncDesc {
   /// triangles' upward normals, but a body buried past its middle may be pushed down through the
   /// ground instead. Velocities are kept.
   bool lift_buried = true;
+  /// On a paged terrain (Terrain::paged()): metres (finite, >= 0) around each non-static body's
+  /// bounding box whose stored pages are kept resident (Terrain::pin) while the body is there,
+  /// so that its contacts and rays never load a page on the stepping thread; the pages within
+  /// twice that are prefetched in the background when a body reaches new pages. Nothing is
+  /// pinned on a terrain held in memory.
+  double residency_margin = 16.0;
 };
 
 /// What one TerrainSync::update() did.
@@ -42,6 +48,10 @@ struct TerrainSyncStats {
   std::size_t bodies_woken = 0;
   /// Of those, rigid bodies lifted out of the ground (TerrainSyncDesc::lift_buried).
   std::size_t bodies_lifted = 0;
+  /// Level-0 pages kept resident under the bodies after this update (paged terrains).
+  std::size_t pinned_pages = 0;
+  /// Whether the set of pages under the bodies changed (new pins, prefetches sent).
+  bool residency_changed = false;
 };
 
 /// Follows a terrain's edits for one Bullet world: the TerrainShape reads the surface live, so
@@ -56,7 +66,9 @@ struct TerrainSyncStats {
 ///     clears the contact manifolds between the terrain object and those objects (their points
 ///     were on the old surface; Bullet makes new ones at the next step);
 ///  4. lifts the woken rigid bodies the edit buried (TerrainSyncDesc::lift_buried).
-/// Call it once per step, before btDynamicsWorld::stepSimulation, on the thread that steps.
+/// On a paged terrain it first keeps the pages under the non-static bodies resident
+/// (TerrainSyncDesc::residency_margin): one pass over the world's objects, new pins only when a
+/// body reaches other pages. Call it once per step, before btDynamicsWorld::stepSimulation, on the thread that steps.
 ///
 /// The helper holds raw pointers to the world and the terrain object: both must outlive it, and
 /// the object must stay in that world. Bodies may be added and removed freely between updates.
@@ -78,8 +90,9 @@ class TerrainSync {
   TerrainSync& operator=(const TerrainSync&) = delete;
 
   /// Brings the world's contacts and sleeping bodies up to date with every edit since the last
-  /// call (see the class comment). Cost: nothing without edits; else one broadphase box query
-  /// per change plus one pass over the world's manifolds.
+  /// call (see the class comment). Cost: nothing without edits on a terrain held in memory; else
+  /// one broadphase box query per change plus one pass over the world's manifolds, and on a
+  /// paged terrain one pass over the world's objects.
   TerrainSyncStats update();
 
   /// The terrain version handled so far (Terrain::edit_version() at the last update()).
@@ -97,6 +110,10 @@ class TerrainSync {
   bool lift_if_buried(btCollisionObject& o) const;
   std::uint64_t seen_ = 0;
   std::vector<const btCollisionObject*> touched_;  // reused: the objects over changed boxes
+  // Paged terrains: keeps the pages under the bodies pinned (see residency_margin).
+  void keep_resident(TerrainSyncStats& stats);
+  std::vector<std::uint64_t> page_keys_, next_keys_;  // pages pinned, as (pz << 32 | px)
+  std::vector<RegionPin> pins_;
 };
 
 }  // namespace ridgeline::bullet
