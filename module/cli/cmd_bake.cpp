@@ -117,6 +117,12 @@ int run_bake(const BakeArgs& a) {
     io::LoadReport lr;
     auto hf = a.terrain.load_heightfield(&lr);
     if (!hf) return report_error(hf.error().message);
+    // A world's pages hold heights and materials only; its holes would be lost.
+    if (!hf->hole_cells().empty())
+      return report_error("bake: --fill hole made " + std::to_string(hf->hole_cells().size()) +
+                          " cells holes, and a baked world does not hold holes yet; bake with "
+                          "--fill nearest and make the holes with hole edits (saved with the "
+                          "edits, docs/deformation.md)");
     rep = io::bake_world(*hf, a.out, o);
   }
   if (bar) std::fprintf(stderr, "\n");

@@ -46,7 +46,7 @@ int run_deform(const DeformArgs& a) {
   if (!terrain) return report_error(terrain.error().message);
   Terrain& t = **terrain;
   std::size_t changed = 0, empty = 0, clipped = 0, clamped = 0;
-  std::uint64_t samples = 0;
+  std::uint64_t samples = 0, hole_cells = 0;
   Box total{glm::dvec3(std::numeric_limits<double>::infinity()),
             glm::dvec3(-std::numeric_limits<double>::infinity())};
   const auto t0 = bench::Clock::now();
@@ -61,6 +61,7 @@ int run_deform(const DeformArgs& a) {
     clipped += r->clipped;
     clamped += r->clamped;
     samples += r->samples_changed;
+    hole_cells += r->cells_changed;
     total.min = glm::min(total.min, r->changed.min);
     total.max = glm::max(total.max, r->changed.max);
   }
@@ -74,6 +75,8 @@ int run_deform(const DeformArgs& a) {
                               {"edits_clipped", clipped},
                               {"edits_clamped", clamped},
                               {"samples_changed", samples},
+                              {"hole_cells_changed", hole_cells},
+                              {"hole_cells", t.surface().hole_cells()},
                               {"edited_chunks", t.surface().edited_chunks()},
                               {"apply_ms", ms},
                               {"base_hash", hex(t.base_hash())},

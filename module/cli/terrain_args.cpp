@@ -105,9 +105,9 @@ void TerrainArgs::add_to(CLI::App& app) {
       ->type_name("V")
       ->group(g);
   app.add_option("--fill", fill_,
-                 "Replace missing (no-data or non-finite) samples: by the nearest valid sample, or "
-                 "by the raw value V")
-      ->type_name("nearest|constant:V")
+                 "Replace missing (no-data or non-finite) samples: by the nearest valid sample, "
+                 "by the raw value V, or make every cell with a missing corner a hole (no ground)")
+      ->type_name("nearest|constant:V|hole")
       ->group(g);
   app.add_option("--max-samples", max_samples_,
                  "Refuse heightmaps of more samples than N, checked before allocating (default "
@@ -118,6 +118,10 @@ void TerrainArgs::add_to(CLI::App& app) {
                  "Channel of a multi-channel image to use (0-based); without it colour images are "
                  "refused")
       ->type_name("C")
+      ->group(g);
+  app.add_flag("--alpha-nodata", alpha_nodata_,
+               "Samples whose alpha is 0 are missing (as no-data samples are; --fill hole makes "
+               "them holes)")
       ->group(g);
   app.add_option("--materials", materials_,
                  "8-bit single-channel image of the heightmap's size holding a material id per "
@@ -240,13 +244,15 @@ Result<HeightfieldDesc> TerrainArgs::placement() const {
   if (given("--fill")) {
     if (fill_ == "nearest") {
       d.fill = FillPolicy::kNearest;
+    } else if (fill_ == "hole") {
+      d.fill = FillPolicy::kHole;
     } else if (fill_.rfind("constant:", 0) == 0) {
       auto v = parse_finite(std::string_view(fill_).substr(9), "--fill constant");
       if (!v) return v.error();
       d.fill = FillPolicy::kConstant;
       d.fill_constant = *v;
     } else {
-      return Error{"--fill '" + fill_ + "': expected 'nearest' or 'constant:V'"};
+      return Error{"--fill '" + fill_ + "': expected 'nearest', 'constant:V' or 'hole'"};
     }
   }
   if (given("--max-samples")) {
@@ -292,7 +298,7 @@ Result<Heightfield> TerrainArgs::load_heightfield_uncapped(io::LoadReport* repor
   if (given("--default-size") && !default_terrain_)
     return Error{"--default-size applies to --default-terrain"};
   if (default_terrain_) {
-    for (const char* flag : {"--raw-size", "--raw-type", "--channel", "--materials"})
+    for (const char* flag : {"--raw-size", "--raw-type", "--channel", "--materials", "--alpha-nodata"})
       if (given(flag))
         return Error{std::string(flag) + " applies to --heightmap, not to --default-terrain"};
     DefaultTerrainParams params;
@@ -331,6 +337,7 @@ Result<Heightfield> TerrainArgs::load_heightfield_uncapped(io::LoadReport* repor
   // A GeoTIFF's own placement unless the flags give one.
   options.spacing_from_file = !given("--spacing");
   options.origin_from_file = !given("--origin");
+  options.alpha_nodata = alpha_nodata_;
   if (given("--channel")) {
     auto c = parse_count(channel_, "--channel", 0, 1023);
     if (!c) return c.error();
@@ -426,6 +433,7 @@ Result<std::shared_ptr<Terrain>> TerrainArgs::load_terrain(io::LoadReport* repor
     // A baked world: its own placement and heights; detail is not baked into worlds.
     for (const char* flag : {"--spacing", "--height-scale", "--height-offset", "--origin",
                              "--nodata", "--fill", "--max-samples", "--channel", "--materials",
+                             "--alpha-nodata",
                              "--raw-size", "--raw-type", "--layout", "--unshared-edges"})
       if (given(flag))
         return Error{std::string(flag) + " does not apply to --world (the world carries its "

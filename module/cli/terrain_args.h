@@ -62,6 +62,7 @@ class TerrainArgs {
   std::string world_, layout_, cache_mb_, cache_workers_;
   bool unshared_edges_ = false;
   bool default_terrain_ = false;
+  bool alpha_nodata_ = false;
   std::string raw_size_, raw_type_, spacing_, height_scale_, height_offset_, origin_, nodata_,
       fill_, max_samples_, channel_, materials_, load_, default_size_;
   // Procedural detail (docs/detail.md): --detail-levels N --detail-seed S and the shape flags.

@@ -7,6 +7,7 @@
 
 #include "ridgeline/mesh_error.h"
 #include "ridgeline/roam_view.h"
+#include "surface/lattice.h"
 
 namespace ridgeline {
 
@@ -19,7 +20,11 @@ DrawnMesh leaves_mesh(const RoamView& view) {
   auto corner = [&](std::int64_t i, std::int64_t j) {
     return glm::dvec3(double(i), offset + double(float(s.vertex_height(i, j))), double(j));
   };
+  // The leaves over holes are not drawn (the view hides them): left out.
+  const HoleMask* holes = detail::SurfaceAccess::holes(s);
+  const int L = int(l.detail_levels());
   view.for_each_leaf([&](std::uint32_t, std::uint64_t, const LatticeTriangle& t) {
+    if (holes != nullptr && holes->all_holes(t.ax, t.az, t.lx, t.lz, t.rx, t.rz, L)) return;
     out.add(corner(t.ax, t.az), corner(t.lx, t.lz), corner(t.rx, t.rz));
   });
   return out;

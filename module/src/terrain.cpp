@@ -49,10 +49,23 @@ WorldInfo info_of(const Heightfield& hf, bool u16) {
 
 }  // namespace
 
+// The field's own holes (FillPolicy::kHole) as the terrain's first hole mask: part of what the
+// terrain is made of, so no version and no change-log entry.
+void Terrain::take_holes(const Heightfield& hf) {
+  if (hf.hole_cells().empty()) return;
+  auto mask = std::make_shared<HoleMask>();
+  const std::uint64_t cells_x = hf.width() - 1;
+  for (const std::uint64_t c : hf.hole_cells())
+    mask->set(std::int64_t(c % cells_x), std::int64_t(c / cells_x), true);
+  surface_.publish_holes(std::move(mask));
+}
+
 Result<std::shared_ptr<Terrain>> Terrain::create(Heightfield heightfield) {
   auto store =
       world::PageStore::from_heightfield(heightfield, info_of(heightfield, world::fits_u16(heightfield)));
-  return std::shared_ptr<Terrain>(new Terrain(std::move(store), nullptr, nullptr));
+  std::shared_ptr<Terrain> t(new Terrain(std::move(store), nullptr, nullptr));
+  t->take_holes(heightfield);
+  return t;
 }
 
 Result<std::shared_ptr<Terrain>> Terrain::create(Heightfield heightfield,
@@ -74,7 +87,9 @@ Result<std::shared_ptr<Terrain>> Terrain::create(Heightfield heightfield,
   if (!c) return c.error();
   auto store =
       world::PageStore::from_heightfield(heightfield, info_of(heightfield, world::fits_u16(heightfield)));
-  return std::shared_ptr<Terrain>(new Terrain(std::move(store), std::move(*field), std::move(*c)));
+  std::shared_ptr<Terrain> t(new Terrain(std::move(store), std::move(*field), std::move(*c)));
+  t->take_holes(heightfield);
+  return t;
 }
 
 Result<std::shared_ptr<Terrain>> Terrain::open(std::shared_ptr<const PageSource> source,

@@ -342,6 +342,17 @@ run deform --default-terrain --spacing 3 --load "$T/state.bin" --edits "$T/none.
 expect "--load onto another terrain" 1 "another terrain"
 head -c 100 "$T/state.bin" > "$T/cut.bin"
 run info --default-terrain --load "$T/cut.bin"; expect "--load truncated" 1 "truncated"
+cat > "$T/holes.json" <<'JSON'
+{"edits": [{"brush": "hole", "x": 501, "z": 301, "radius": 3},
+           {"brush": "hole", "x": 801, "z": 301, "radius": 3},
+           {"brush": "fill_hole", "x": 801, "z": 301, "radius": 3}]}
+JSON
+run deform --default-terrain --edits "$T/holes.json" --save "$T/holes.bin"
+expect "deform hole and fill_hole" 0
+contains "deform counts the hole cells (3 x 3 cells of 2 m, three times)" '"hole_cells_changed": 27'
+contains "deform leaves one hole" '"hole_cells": 9'
+run deform --default-terrain --load "$T/holes.bin" --edits "$T/none.json"
+contains "deform --load brings the hole back" '"hole_cells": 9'
 echo '{"edits": [{"brush": "crater", "x": 1, "z": 1}]}' > "$T/e1.json"
 run deform --default-terrain --edits "$T/e1.json"
 expect "deform edit without radius" 1 "edits[0]: 'radius' is missing"

@@ -96,7 +96,8 @@ T.case("bad arguments", function()
   T.raises("field 'origin': array of 2 numbers expected", ridgeline.load, {heightmap = "x.png", origin = {1}})
   T.raises("field 'height_scale': finite number expected, got inf",
            ridgeline.load, {heightmap = "x.png", height_scale = math.huge})
-  T.raises("field 'fill': 'refuse' or 'nearest' expected", ridgeline.load, {heightmap = "x.png", fill = "zero"})
+  T.raises("field 'fill': 'refuse', 'nearest' or 'hole' expected", ridgeline.load, {heightmap = "x.png", fill = "zero"})
+  T.raises("field 'alpha_nodata': boolean expected", ridgeline.load, {heightmap = "x.png", alpha_nodata = 1})
 end)
 
 T.case("expected misses return nil, message", function()

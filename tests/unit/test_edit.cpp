@@ -365,9 +365,9 @@ TEST(EditFile, ASourceErrorOrAnOversizedStreamChangesNothing) {
   EXPECT_EQ(r.error().message, "source broke");
   EXPECT_EQ(target->surface().heights_hash(), h0);
   EXPECT_EQ(target->edit_version(), 0u);
-  // A stream longer than any edit file of this terrain (5 x 5 chunks): refused after reading one
-  // chunk past that size, not to its end.
-  const std::size_t chunk = 8 + 4 * 32 * 32, largest = 64 + 25 * chunk + 8;
+  // A stream longer than any edit file of this terrain (5 x 5 chunks, 4 x 4 blocks of holes):
+  // refused after reading one chunk past that size, not to its end.
+  const std::size_t chunk = 8 + 4 * 32 * 32, largest = 64 + 25 * chunk + 16 * (8 + 128) + 8;
   ChunkedSource endless;
   endless.bytes = bytes + std::string(std::size_t{64} << 20, '\0');
   endless.step = std::size_t{1} << 16;
@@ -703,7 +703,8 @@ TEST(EditFile, EveryRegionOfTheHeaderAndBodyIsGuarded) {
       {24, 32, "detail", "detail"},
       {32, 40, "terrain; this one is", "terrain; this one is"},
       {40, 48, "chunk", "chunk"},
-      {48, 64, "checksum mismatch", "reserved header bytes"},
+      {48, 56, "hole block", "hole block"},  // the hole blocks' count (version 3)
+      {56, 64, "checksum mismatch", "reserved header bytes"},
   };
   for (const Region& g : header)
     for (std::size_t at = g.from; at < g.to; ++at) {

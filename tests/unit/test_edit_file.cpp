@@ -14,6 +14,7 @@
 #include "io/durable_file.h"
 #include "ridgeline/edit.h"
 #include "ridgeline/edit_file.h"
+#include "ridgeline/edit_json.h"
 #include "ridgeline/heightfield.h"
 
 using namespace ridgeline;
@@ -136,6 +137,26 @@ TEST(EditFileIo, AFailedSaveKeepsThePreviousFileAndLeavesNoTemporaryFile) {
   EXPECT_NE(s.message().find("save edits '" + nowhere + "'"), std::string::npos) << s.message();
   EXPECT_EQ(read_bytes(f), before);
   EXPECT_EQ(others(dir, "state.bin"), std::vector<std::string>{}) << "temporary file left";
+}
+
+TEST(EditJson, HoleAndFillHoleAreBrushes) {
+  auto edits = io::parse_edits(R"({"edits": [
+      {"brush": "hole", "x": 101, "z": 61, "radius": 3},
+      {"brush": "fill_hole", "x": 101, "z": 61, "radius": 1}]})");
+  ASSERT_TRUE(edits) << edits.error().message;
+  ASSERT_EQ(edits->size(), 2u);
+  EXPECT_EQ((*edits)[0].brush, Brush::kHole);
+  EXPECT_EQ((*edits)[1].brush, Brush::kFillHole);
+  auto t = noise_terrain(129);
+  ASSERT_TRUE(t->apply_edit((*edits)[0]));
+  EXPECT_EQ(t->surface().hole_cells(), 9u);  // 2 m cells: the centre's and its 8 neighbours'
+  EXPECT_FALSE(t->height(103, 63));
+  ASSERT_TRUE(t->apply_edit((*edits)[1]));
+  EXPECT_EQ(t->surface().hole_cells(), 8u);  // the centre's given back
+  EXPECT_TRUE(t->height(101, 61));
+  auto bad = io::parse_edits(R"({"edits": [{"brush": "holes", "x": 1, "z": 1, "radius": 1}]})");
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("hole or fill_hole"), std::string::npos) << bad.error().message;
 }
 
 TEST(DurableFile, ATemporaryFileIsRemovedUnlessCommitted) {

@@ -281,6 +281,33 @@ TEST(IoBadInput, GreyAlphaUsesGreyAndSaysSo) {
   EXPECT_TRUE(contains(log.messages[0], path)) << log.messages[0];
 }
 
+TEST(IoImage, AlphaZeroMarksMissingSamplesThatTheFillPolicyMakesHoles) {
+  // 3 x 3 grey + alpha, alpha 0 at the centre sample: the four cells around it are holes.
+  std::vector<std::uint8_t> px;
+  for (int k = 0; k < 9; ++k) px.insert(px.end(), {std::uint8_t(10 + k), std::uint8_t(k == 4 ? 0 : 255)});
+  const auto path = tmp_path("holes_ya.png");
+  write_image(path, 3, 3, 2, OIIO::TypeDesc::UINT8, px);
+  io::LoadOptions o = options();
+  o.alpha_nodata = true;
+  o.placement.fill = FillPolicy::kHole;
+  auto hf = io::load_image(path, o);
+  ASSERT_TRUE(hf) << hf.error().message;
+  EXPECT_EQ(hf->hole_cells().size(), 4u);
+  EXPECT_EQ(hf->filled_samples(), 1u);
+  // Without a fill policy the alpha-marked sample is refused, naming it; without alpha_nodata
+  // alpha is ignored; a grey image has no alpha to use.
+  o.placement.fill = FillPolicy::kRefuse;
+  auto refused = io::load_image(path, o);
+  ASSERT_FALSE(refused);
+  EXPECT_TRUE(contains(refused.error().message, "sample (1, 1)")) << refused.error().message;
+  EXPECT_TRUE(io::load_image(path, options())->hole_cells().empty());
+  const auto grey = tmp_path("holes_y.png");
+  write_image(grey, 2, 2, 1, OIIO::TypeDesc::UINT8, std::vector<std::uint8_t>{1, 2, 3, 4});
+  auto none = io::load_image(grey, o);
+  ASSERT_FALSE(none);
+  EXPECT_TRUE(contains(none.error().message, "no alpha channel")) << none.error().message;
+}
+
 TEST(IoBadInput, TooNarrowImages) {
   for (auto [w, h] : {std::pair{1, 5}, std::pair{5, 1}}) {
     const auto path = tmp_path(std::to_string(w) + "x" + std::to_string(h) + ".png");

@@ -563,3 +563,28 @@ TEST(World, PagesLoadedBeforeTheLandscapeGetItsBounds) {
   EXPECT_EQ(cracks, "");
   EXPECT_EQ(from_world, converged_mesh(memory, cam));
 }
+
+// Holes on a paged world: queries as in memory, a view made before the hole and a landscape
+// made after it (its baked bounds remade around the hole blocks) draw the map's mesh.
+TEST(World, HolesOnABakedWorldAreTheMapsHoles) {
+  const std::string path = tmp_path("w.tif");
+  ASSERT_TRUE(io::bake_world(generated(513, 513), path));
+  auto memory = Terrain::create(generated(513, 513)).value();
+  auto world = open_baked(path);
+  const WorldInfo& w = memory->info();
+  const Camera cam = looking_over(*memory, 0.2, 0.2);
+  auto before_land = Landscape::create(world).value();
+  auto before_view = RoamView::create(before_land, {.threshold = 1.5}).value();
+  ASSERT_TRUE(before_view->converge(cam));
+  const double x = w.origin_x + 0.5 * w.extent_x() + 1.0, z = w.origin_z + 0.5 * w.extent_z();
+  for (auto* t : {memory.get(), world.get()})
+    ASSERT_TRUE(t->apply_edit({.brush = Brush::kHole, .x = x, .z = z, .radius = 30}));
+  EXPECT_GT(world->surface().hole_cells(), 100u);
+  EXPECT_FALSE(world->height(x, z));
+  EXPECT_EQ(world->height(x + 40, z), memory->height(x + 40, z));
+  ASSERT_TRUE(before_view->converge(cam));
+  std::string cracks;
+  EXPECT_EQ(before_view->mesh_hash(), converged_mesh(memory, cam, &cracks));
+  EXPECT_EQ(cracks, "");
+  EXPECT_EQ(converged_mesh(world, cam), converged_mesh(memory, cam));
+}

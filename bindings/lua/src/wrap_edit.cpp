@@ -41,8 +41,10 @@ Edit check_edit(lua_State* L, int arg) {
   lua_getfield(L, arg, "brush");
   const char* name = lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : nullptr;
   const std::optional<Brush> brush = name ? parse_brush(name) : std::nullopt;
-  if (!brush)
-    luaL_argerror(L, arg, "field 'brush': \"crater\", \"raise\", \"lower\", \"flatten\" or \"smooth\" expected");
+  if (!brush) {
+    lua_pushfstring(L, "field 'brush': one of %s expected", brush_names());
+    luaL_argerror(L, arg, lua_tostring(L, -1));
+  }
   lua_pop(L, 1);
   e.brush = *brush;
   if (!get_number_field(L, arg, "x", &e.x)) luaL_argerror(L, arg, "field 'x': number expected");
@@ -123,6 +125,8 @@ void push_edit_result(lua_State* L, const EditResult& r) {
   lua_createtable(L, 0, 11);
   lua_pushinteger(L, static_cast<lua_Integer>(r.samples_changed));
   lua_setfield(L, -2, "samples");
+  lua_pushinteger(L, static_cast<lua_Integer>(r.cells_changed));
+  lua_setfield(L, -2, "hole_cells");
   if (!r.empty()) {
     set_field(L, "min_x", r.changed.min.x);
     set_field(L, "min_y", r.changed.min.y);

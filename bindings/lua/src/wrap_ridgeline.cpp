@@ -41,7 +41,8 @@ struct LoadArgs {
   double height_scale = 1, height_offset = 0;
   bool has_nodata = false;
   double nodata = 0;
-  bool fill_nearest = false;
+  FillPolicy fill = FillPolicy::kRefuse;
+  bool alpha_nodata = false;
   double detail_levels = 0, detail_seed = 1, detail_amplitude = 0, detail_gain = 0;
   bool has_amplitude = false, has_gain = false;
   io::RawFormat raw;  // width 0: not a raw file
@@ -77,7 +78,8 @@ bool do_load(const ConfigBox& config, const LoadArgs& a, TerrainBox* box, std::s
     p.height_scale = a.height_scale;
     p.height_offset = a.height_offset;
     if (a.has_nodata) p.nodata = a.nodata;
-    if (a.fill_nearest) p.fill = FillPolicy::kNearest;
+    p.fill = a.fill;
+    options.alpha_nodata = a.alpha_nodata;
     p.max_samples = a.max_samples != 0 ? a.max_samples : config.max_samples;
     auto hf = io::load_heightmap(path, options, a.raw.width != 0 ? &a.raw : nullptr);
     if (!hf) {
@@ -259,7 +261,7 @@ int r_load(lua_State* L) {
   static const char* const kFields[] = {
       "heightmap",   "spacing",       "origin",      "height_scale",     "height_offset",
       "nodata",      "fill",          "detail_levels", "detail_seed",    "detail_amplitude",
-      "detail_gain", "raw",           "max_samples",   nullptr};
+      "detail_gain", "raw",           "max_samples",   "alpha_nodata",  nullptr};
   check_fields(L, 1, kFields);
   lua_settop(L, 1);
   LoadArgs a;
@@ -286,10 +288,17 @@ int r_load(lua_State* L) {
   if (fill != LUA_TNIL) {
     const char* f = fill == LUA_TSTRING ? lua_tostring(L, -1) : "";
     if (std::strcmp(f, "nearest") == 0)
-      a.fill_nearest = true;
+      a.fill = FillPolicy::kNearest;
+    else if (std::strcmp(f, "hole") == 0)
+      a.fill = FillPolicy::kHole;
     else if (std::strcmp(f, "refuse") != 0)
-      luaL_argerror(L, 1, "field 'fill': 'refuse' or 'nearest' expected");
+      luaL_argerror(L, 1, "field 'fill': 'refuse', 'nearest' or 'hole' expected");
   }
+  lua_pop(L, 1);
+  const int alpha = lua_getfield(L, 1, "alpha_nodata");
+  if (alpha != LUA_TNIL && alpha != LUA_TBOOLEAN)
+    luaL_argerror(L, 1, "field 'alpha_nodata': boolean expected");
+  a.alpha_nodata = lua_toboolean(L, -1) != 0;
   lua_pop(L, 1);
   if (get_number_field(L, 1, "detail_levels", &a.detail_levels) &&
       (a.detail_levels != std::floor(a.detail_levels) || a.detail_levels < 0 ||

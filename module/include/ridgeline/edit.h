@@ -28,10 +28,19 @@ enum class Brush : std::uint8_t {
   kLower,    ///< the same, downwards
   kFlatten,  ///< blends towards world height `height`: full weight inside radius / 2, smooth to 0
   kSmooth,   ///< blends each sample towards the mean of its 3 x 3 neighbourhood
+  /// Removes the ground over every stored cell whose centre lies within `radius` of (x, z): no
+  /// height, no triangle, rays and bodies pass through (docs/deformation.md, "Holes"). Heights
+  /// are kept, so kFillHole gives them back. strength, depth, rim and height are not used.
+  kHole,
+  /// Gives the ground back over the hole cells whose centre lies within `radius`, with the
+  /// heights they had.
+  kFillHole,
 };
 
-/// "crater", "raise", "lower", "flatten", "smooth".
+/// "crater", "raise", "lower", "flatten", "smooth", "hole", "fill_hole".
 const char* brush_name(Brush b) noexcept;
+/// "crater, raise, lower, flatten, smooth, hole or fill_hole": every brush name, for messages.
+const char* brush_names() noexcept;
 /// The brush named `name`; empty for anything else.
 std::optional<Brush> parse_brush(std::string_view name) noexcept;
 
@@ -58,9 +67,10 @@ Status validate_edit(const Edit& edit);
 
 /// What an edit did.
 struct EditResult {
-  /// The region whose surface (heights or normals) changed: every cell touching a changed
-  /// sample, in world metres; y spans the old and new heights there. Empty (samples_changed == 0)
-  /// for a brush wholly outside the terrain or one that changed nothing.
+  /// The region whose surface (heights, normals or holes) changed: every cell touching a changed
+  /// sample and every cell made a hole or given back, in world metres; y spans the old and new
+  /// heights there. Empty (empty()) for a brush wholly outside the terrain or one that changed
+  /// nothing.
   Box changed;
   std::size_t samples_changed = 0;
   /// The brush was larger than EditLimits::max_area_m2 and was applied with radius `radius_used`.
@@ -69,7 +79,9 @@ struct EditResult {
   /// Some samples hit EditLimits' height range and were clamped (`samples_clamped` of them).
   bool clamped = false;
   std::size_t samples_clamped = 0;
-  bool empty() const noexcept { return samples_changed == 0; }
+  /// Stored cells made holes or given back by `hole` / `fill_hole` (or by loading an edit file).
+  std::size_t cells_changed = 0;
+  bool empty() const noexcept { return samples_changed == 0 && cells_changed == 0; }
 };
 
 // ---- the edit layer saved and loaded (docs/deformation.md, "The edit file") -------------------

@@ -28,6 +28,11 @@ enum class FillPolicy {
   kRefuse,    ///< creation fails, naming the first bad sample (the default)
   kNearest,   ///< replaced by the nearest valid sample (4-neighbour distance, ties by scan order)
   kConstant,  ///< replaced by `fill_constant` (a raw value, scaled like any other)
+  /// No ground there: every cell with a missing corner becomes a hole of the terrain made from
+  /// the field (Surface::hole, docs/deformation.md, "Holes"); the missing samples themselves
+  /// take the nearest valid sample's height as kNearest gives it, so heights and bounds stay
+  /// finite (and filling a hole later shows that height).
+  kHole,
 };
 
 /// Everything needed to turn raw sample values into a placed heightfield. Defaults are sane.
@@ -118,9 +123,13 @@ class Heightfield {
 
   /// Number of samples replaced by the fill policy at creation.
   std::uint64_t filled_samples() const noexcept { return filled_samples_; }
+  /// The cells (index i + j * (width - 1)) that FillPolicy::kHole made holes, ascending; empty
+  /// for other policies. A Terrain made from the field starts with these holes.
+  std::span<const std::uint64_t> hole_cells() const noexcept { return hole_cells_; }
   /// Bytes held by this object (heights and materials).
   std::size_t memory_bytes() const noexcept {
-    return heights_.capacity() * sizeof(float) + materials_.capacity();
+    return heights_.capacity() * sizeof(float) + materials_.capacity() +
+           hole_cells_.capacity() * sizeof(std::uint64_t);
   }
   /// A 64-bit FNV-1a hash of size, placement and height bits: identifies the base data (save files
   /// refuse to load onto another terrain).
@@ -140,6 +149,7 @@ class Heightfield {
     h.height_offset_ = height_offset_, h.height_scale_ = height_scale_;
     h.min_local_ = min_local_, h.max_local_ = max_local_;
     h.filled_samples_ = filled_samples_;
+    h.hole_cells_ = hole_cells_;
     return h;
   }
 
@@ -150,6 +160,7 @@ class Heightfield {
   double height_offset_ = 0, height_scale_ = 1;
   float min_local_ = 0, max_local_ = 0;
   std::uint64_t filled_samples_ = 0;
+  std::vector<std::uint64_t> hole_cells_;
 };
 
 /// The built-in default terrain: 1025 x 1025 samples, 2 m spacing (a 2048 m square) at origin

@@ -39,6 +39,11 @@ struct LoadOptions {
   bool spacing_from_file = false;
   /// The same for the origin; only projected files (metres) carry one.
   bool origin_from_file = false;
+  /// Samples whose alpha is 0 are missing, as no-data samples are, and the fill policy decides
+  /// what they become (FillPolicy::kHole: holes, no ground). Images only; an image without an
+  /// alpha channel (or whose chosen channel is its alpha) is refused when this is set. Off by
+  /// default: alpha is ignored.
+  bool alpha_nodata = false;
 };
 
 /// Georeferencing read from a heightmap file (GeoTIFF: ModelPixelScale + ModelTiepoint or an

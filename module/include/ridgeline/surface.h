@@ -27,6 +27,7 @@ namespace ridgeline {
 class DetailField;
 class DetailCache;
 class EditLayer;
+class HoleMask;
 class Terrain;
 namespace world {
 class PageStore;
@@ -192,10 +193,24 @@ class Surface {
   double measured_detail_bound(std::uint32_t from_level, std::int64_t i0, std::int64_t j0,
                                std::int64_t i1, std::int64_t j1) const noexcept;
 
-  // ---- point queries ---------------------------------------------------------------------------
+  // ---- holes (docs/deformation.md, "Holes") -----------------------------------------------------
 
-  /// World height of the surface at (x, z), metres; empty off the footprint or for non-finite
-  /// input.
+  /// Whether stored cell (i, j) (between samples i..i+1 and j..j+1) is a hole: no ground there,
+  /// so every point query over it is empty, rays and bodies pass through and no mesh triangle
+  /// covers it. False outside the cells. Holes come from the `hole` brush and from no-data or
+  /// alpha at load (io.h); `fill_hole` gives the ground back. Cost: one branch on a terrain
+  /// without holes, a hash lookup with them.
+  bool hole(std::int64_t i, std::int64_t j) const noexcept;
+  /// Stored cells that are holes (0 on a terrain without holes).
+  std::uint64_t hole_cells() const noexcept;
+
+  // ---- point queries ---------------------------------------------------------------------------
+  // Over a hole every query is empty (batched heights: NaN). A point on the boundary between a
+  // hole cell and a solid one belongs to the solid one: the ground ends exactly at the hole's
+  // edge, as the mesh does.
+
+  /// World height of the surface at (x, z), metres; empty off the footprint, over a hole or for
+  /// non-finite input.
   std::optional<double> height(double x, double z) const noexcept;
   /// Face normal (unit, y > 0) of the finest triangle under (x, z). Points on an edge shared by
   /// two triangles take the triangle that locate_in_cell() picks. Empty as for height().
@@ -229,7 +244,9 @@ class Surface {
   Surface(const Surface& other, CloneTag);
 
   std::shared_ptr<world::PageStore> store_;
-  std::unique_ptr<EditLayer> edits_;  // the original heights of every edited chunk
+  std::unique_ptr<EditLayer> edits_;  // the original heights of every edited chunk, the holes
+  const HoleMask* holes_ = nullptr;   // edits_->holes(), read by every query: null without holes
+  void publish_holes(std::shared_ptr<const HoleMask> mask);
   SurfaceLattice lattice_;
   SurfaceLattice stored_at_;  // the stored samples as a lattice (L = 0)
   std::shared_ptr<const DetailField> detail_;

@@ -326,6 +326,10 @@ class Terrain {
   // tessellator's bounds over them, bumps the version, records the change and fills the result's
   // box.
   void commit(const SampleChanges& changes, EditResult& result);
+  // The hole brushes (edit/hole_edit.cpp), after apply_edit's checks: `result` holds the radius.
+  EditResult edit_holes(const Edit& edit, EditResult result);
+  // The holes of a field made with FillPolicy::kHole, at creation.
+  void take_holes(const Heightfield& heightfield);
   void write_sample(world::PageEdit& edit, EditLayer& layer, SampleChanges& changes,
                     EditResult& result, std::uint32_t i, std::uint32_t j, float old, double h);
   EditLayer& edit_layer() noexcept;

@@ -30,21 +30,27 @@ const char* brush_name(Brush b) noexcept {
     case Brush::kLower: return "lower";
     case Brush::kFlatten: return "flatten";
     case Brush::kSmooth: return "smooth";
+    case Brush::kHole: return "hole";
+    case Brush::kFillHole: return "fill_hole";
   }
   return "?";
 }
 
+const char* brush_names() noexcept {
+  return "crater, raise, lower, flatten, smooth, hole or fill_hole";
+}
+
 std::optional<Brush> parse_brush(std::string_view name) noexcept {
-  for (Brush b : {Brush::kCrater, Brush::kRaise, Brush::kLower, Brush::kFlatten, Brush::kSmooth})
+  for (Brush b : {Brush::kCrater, Brush::kRaise, Brush::kLower, Brush::kFlatten, Brush::kSmooth,
+                  Brush::kHole, Brush::kFillHole})
     if (name == brush_name(b)) return b;
   return std::nullopt;
 }
 
 Status validate_edit(const Edit& e) {
   auto finite = [](double v) { return std::isfinite(v); };
-  if (static_cast<unsigned>(e.brush) > static_cast<unsigned>(Brush::kSmooth))
-    return Error{fmt("edit: brush %u; need crater, raise, lower, flatten or smooth",
-                     static_cast<unsigned>(e.brush))};
+  if (static_cast<unsigned>(e.brush) > static_cast<unsigned>(Brush::kFillHole))
+    return Error{fmt("edit: brush %u; need %s", static_cast<unsigned>(e.brush), brush_names())};
   if (!finite(e.x)) return Error{"edit: x is " + num(e.x) + "; need a finite value"};
   if (!finite(e.z)) return Error{"edit: z is " + num(e.z) + "; need a finite value"};
   if (!finite(e.radius) || !(e.radius > 0))
@@ -136,7 +142,8 @@ static TerrainChange describe_change(const Surface& s, const SampleChanges& c) {
 // views and engines pull the log (Terrain::changes_since).
 void Terrain::commit(const SampleChanges& c, EditResult& r) {
   r.samples_changed = c.samples;
-  if (c.samples == 0) return;
+  r.cells_changed = c.cells;
+  if (c.empty()) return;
   world::PageStore& store = *surface_.store_;
   for (int slot = 0; slot < int(world::kRecordSlots); ++slot)
     if (const world::RecordMaker* m = store.maker(slot))
@@ -212,6 +219,7 @@ Result<EditResult> Terrain::apply_edit(const Edit& e) {
     r.clipped = true;
   }
   r.radius_used = radius;
+  if (e.brush == Brush::kHole || e.brush == Brush::kFillHole) return edit_holes(e, r);
   const double reach = radius * reach_factor(e.brush);
   // Sample range under the brush (lattice units relative to the origin, double: no overflow).
   const double cu = (e.x - hf.origin_x) / hf.spacing_x, cv = (e.z - hf.origin_z) / hf.spacing_z;
@@ -261,6 +269,8 @@ Result<EditResult> Terrain::apply_edit(const Edit& e) {
           h += e.strength * falloff(r_n) * (sum / n - h);
           break;
         }
+        case Brush::kHole:
+        case Brush::kFillHole: break;  // edit_holes()
       }
       write_sample(*edit, layer, c, r, i, j, old, h);
     }

@@ -21,11 +21,21 @@ namespace {
 
 constexpr char kMagic[8] = {'R', 'I', 'D', 'G', 'E', 'E', 'D', 'T'};
 // 2: the terrain hash a file records is the page-wise content hash (version 1 recorded an older
-// hash of the same samples, which no build computes any more).
-constexpr std::uint32_t kVersion = 2;
+// hash of the same samples, which no build computes any more). 3: the hole mask, in blocks after
+// the chunks, counted at offset 48 (0 in a version 2 file, which is read as one without holes).
+constexpr std::uint32_t kVersion = 3;
 constexpr std::size_t kHeaderBytes = 64;
 constexpr std::size_t kChunkValues = std::size_t{EditLayer::kChunk} * EditLayer::kChunk;
 constexpr std::size_t kChunkBytes = 8 + 4 * kChunkValues;
+constexpr std::size_t kHoleBytes = 8 + sizeof(HoleMask::Bits);  // bx, bz, 32 x 32 bits
+
+// Hole blocks along x and z of a terrain (its cells, not its samples).
+std::uint64_t hole_blocks_x(const WorldInfo& hf) {
+  return (std::uint64_t(hf.width) - 1 + HoleMask::kBlock - 1) / HoleMask::kBlock;
+}
+std::uint64_t hole_blocks_z(const WorldInfo& hf) {
+  return (std::uint64_t(hf.height) - 1 + HoleMask::kBlock - 1) / HoleMask::kBlock;
+}
 
 constexpr std::uint64_t kFnvBasis = 1469598103934665603ull;
 
@@ -52,7 +62,27 @@ T get(std::string_view in, std::size_t at) {
 std::size_t max_file_bytes(const WorldInfo& hf) {
   const std::size_t chunks = std::size_t((hf.width + EditLayer::kChunk - 1) / EditLayer::kChunk) *
                              ((hf.height + EditLayer::kChunk - 1) / EditLayer::kChunk);
-  return kHeaderBytes + chunks * kChunkBytes + 8;
+  return kHeaderBytes + chunks * kChunkBytes + hole_blocks_x(hf) * hole_blocks_z(hf) * kHoleBytes +
+         8;
+}
+
+// Entry n of a list of `stride`-byte entries starting at `first`, each opening with its (x, z)
+// index (u32 each; chunks and hole blocks alike): inside nx x nz, after the entry before it in
+// (z, x) order.
+Status check_index(std::string_view in, std::size_t first, std::size_t stride, std::uint64_t n,
+                   std::uint64_t nx, std::uint64_t nz, const char* kind) {
+  const std::size_t at = first + n * stride;
+  const auto x = get<std::uint32_t>(in, at), z = get<std::uint32_t>(in, at + 4);
+  if (x >= nx || z >= nz)
+    return Error{fmt("edit file: %s %llu at (%u, %u) lies outside the terrain", kind,
+                     static_cast<unsigned long long>(n), x, z)};
+  const auto key = [&](std::size_t a) {
+    return (std::uint64_t(get<std::uint32_t>(in, a + 4)) << 32) | get<std::uint32_t>(in, a);
+  };
+  if (n > 0 && key(at) <= key(at - stride))
+    return Error{fmt("edit file: %s %llu out of order or repeated", kind,
+                     static_cast<unsigned long long>(n))};
+  return {};
 }
 
 // Bytes handed to the sink at a time: at most 64 KiB (edit.h).
@@ -65,6 +95,9 @@ Status save_edits(const Terrain& terrain, EditSink& sink) {
   const detail::StoredLattice g = detail::stored_lattice(terrain.surface());
   const EditLayer& layer = terrain.edit_layer();
   const std::vector<std::uint64_t> keys = layer.sorted_keys();
+  const std::shared_ptr<const HoleMask> holes = layer.hole_snapshot();
+  const auto hole_blocks =
+      holes ? holes->sorted_blocks() : std::vector<std::pair<std::uint64_t, HoleMask::Bits>>{};
   // The checksum runs over everything before it: hashed as each block goes out.
   std::uint64_t sum = kFnvBasis;
   std::string out;
@@ -83,7 +116,7 @@ Status save_edits(const Terrain& terrain, EditSink& sink) {
   put(out, hf.width);
   put(out, hf.height);
   put(out, std::uint64_t{keys.size()});
-  put(out, std::uint64_t{0});
+  put(out, std::uint64_t{hole_blocks.size()});
   put(out, std::uint64_t{0});
   for (std::uint64_t k : keys) {
     if (out.size() + kChunkBytes > kSinkBytes)
@@ -97,6 +130,13 @@ Status save_edits(const Terrain& terrain, EditSink& sink) {
         const bool in = i0 + di < hf.width && j0 + dj < hf.height;
         put(out, in ? g.local(i0 + di, j0 + dj) : 0.0f);
       }
+  }
+  for (const auto& [k, bits] : hole_blocks) {
+    if (out.size() + kHoleBytes > kSinkBytes)
+      if (Status s = flush(); !s) return s;
+    put(out, std::uint32_t(k));
+    put(out, std::uint32_t(k >> 32));
+    put(out, bits);
   }
   if (out.size() + 8 > kSinkBytes)
     if (Status s = flush(); !s) return s;
@@ -112,7 +152,8 @@ std::string save_edits_to_memory(const Terrain& terrain) {
       return {};
     }
   } memory;
-  memory.bytes.reserve(kHeaderBytes + terrain.surface().edited_chunks() * kChunkBytes + 8);
+  memory.bytes.reserve(kHeaderBytes + terrain.surface().edited_chunks() * kChunkBytes + 8 +
+                       (terrain.surface().hole_cells() > 0 ? kHoleBytes : 0));
   const Status s = save_edits(terrain, memory);
   RIDGELINE_ASSERT(s.ok());  // memory never refuses
   return std::move(memory.bytes);
@@ -130,9 +171,9 @@ static Status check_edit_header(const Terrain& terrain, std::string_view in) {
     return Error{what + ": version 1, written by an older build: it names its terrain by a hash "
                         "this build no longer computes; load it with that build and apply the "
                         "edits again, or re-create them"};
-  if (version != kVersion)
-    return Error{
-        fmt("%s: version %u; this build reads version %u", what.c_str(), version, kVersion)};
+  if (version != kVersion && version != 2)
+    return Error{fmt("%s: version %u; this build reads versions 2 and %u", what.c_str(), version,
+                     kVersion)};
   if (get<std::uint32_t>(in, 12) != EditLayer::kChunk)
     return Error{fmt("%s: chunk size %u; need %u", what.c_str(), get<std::uint32_t>(in, 12),
                      EditLayer::kChunk)};
@@ -165,36 +206,58 @@ Result<EditResult> load_edits_from_memory(Terrain& terrain, std::string_view in)
     return Error{fmt("%s: %llu chunks; this terrain has only %llu", what.c_str(),
                      static_cast<unsigned long long>(count),
                      static_cast<unsigned long long>(chunks_x * chunks_z))};
-  const std::size_t expected = kHeaderBytes + count * kChunkBytes + 8;
+  // Version 3 counts hole blocks at 48; in version 2 those bytes are reserved (0).
+  const auto holes = get<std::uint64_t>(in, 48);
+  const std::uint64_t blocks_x = hole_blocks_x(hf), blocks_z = hole_blocks_z(hf);
+  if (holes > blocks_x * blocks_z)
+    return Error{fmt("%s: %llu hole blocks; this terrain has only %llu", what.c_str(),
+                     static_cast<unsigned long long>(holes),
+                     static_cast<unsigned long long>(blocks_x * blocks_z))};
+  const std::size_t holes_at = kHeaderBytes + count * kChunkBytes;
+  const std::size_t expected = holes_at + holes * kHoleBytes + 8;
   if (in.size() != expected)
-    return Error{fmt("%s: %zu bytes; %s (%llu chunks need %zu)", what.c_str(), in.size(),
-                     in.size() < expected ? "truncated" : "trailing bytes",
-                     static_cast<unsigned long long>(count), expected)};
+    return Error{fmt("%s: %zu bytes; %s (%llu chunks and %llu hole blocks need %zu)", what.c_str(),
+                     in.size(), in.size() < expected ? "truncated" : "trailing bytes",
+                     static_cast<unsigned long long>(count),
+                     static_cast<unsigned long long>(holes), expected)};
   if (fnv1a(in.data(), in.size() - 8) != get<std::uint64_t>(in, in.size() - 8))
     return Error{what + ": checksum mismatch (the file is corrupted)"};
-  if (get<std::uint64_t>(in, 48) != 0 || get<std::uint64_t>(in, 56) != 0)
+  if ((get<std::uint32_t>(in, 8) == 2 && holes != 0) || get<std::uint64_t>(in, 56) != 0)
     return Error{what +
-                 ": reserved header bytes 48..63 are not zero (written by a newer version, "
+                 ": reserved header bytes are not zero (written by a newer version, "
                  "or corrupted)"};
   const EditLimits& lim = terrain.edit_limits();
-  std::uint64_t prev_key = 0;
   for (std::uint64_t c = 0; c < count; ++c) {
     const std::size_t at = kHeaderBytes + c * kChunkBytes;
-    const auto cx = get<std::uint32_t>(in, at), cz = get<std::uint32_t>(in, at + 4);
-    if (cx >= chunks_x || cz >= chunks_z)
-      return Error{fmt("%s: chunk %llu at (%u, %u) lies outside the terrain", what.c_str(),
-                       static_cast<unsigned long long>(c), cx, cz)};
-    const std::uint64_t k = EditLayer::key(cx, cz);
-    if (c > 0 && k <= prev_key)
-      return Error{fmt("%s: chunk %llu out of order or repeated", what.c_str(),
-                       static_cast<unsigned long long>(c))};
-    prev_key = k;
+    if (auto s = check_index(in, kHeaderBytes, kChunkBytes, c, chunks_x, chunks_z, "chunk"); !s)
+      return Error{s.message()};
     for (std::size_t v = 0; v < kChunkValues; ++v) {
       const auto h = get<float>(in, at + 8 + 4 * v);
       if (!std::isfinite(h) || h < lim.min_height_rel || h > lim.max_height_rel)
         return Error{fmt("%s: chunk %llu holds height %g, outside the edit limits", what.c_str(),
                          static_cast<unsigned long long>(c), double(h))};
     }
+  }
+
+  // The hole blocks: inside, ascending, no bit past the terrain's last cell.
+  auto mask = std::make_shared<HoleMask>();
+  for (std::uint64_t b = 0; b < holes; ++b) {
+    const std::size_t at = holes_at + b * kHoleBytes;
+    if (auto s = check_index(in, holes_at, kHoleBytes, b, blocks_x, blocks_z, "hole block"); !s)
+      return Error{s.message()};
+    const auto bx = get<std::uint32_t>(in, at), bz = get<std::uint32_t>(in, at + 4);
+    const std::uint64_t k = HoleMask::key(bx, bz);
+    const auto bits = get<HoleMask::Bits>(in, at + 8);
+    for (std::int64_t c = 0; c < HoleMask::kBlock * HoleMask::kBlock; ++c) {
+      const std::int64_t i = (std::int64_t(bx) << HoleMask::kShift) + (c & (HoleMask::kBlock - 1));
+      const std::int64_t j = (std::int64_t(bz) << HoleMask::kShift) + (c >> HoleMask::kShift);
+      if (((bits[std::size_t(c) >> 6] >> (c & 63)) & 1u) &&
+          (i >= std::int64_t(hf.width) - 1 || j >= std::int64_t(hf.height) - 1))
+        return Error{fmt("%s: hole block %llu marks cell (%lld, %lld), past the terrain's cells",
+                         what.c_str(), static_cast<unsigned long long>(b),
+                         static_cast<long long>(i), static_cast<long long>(j))};
+    }
+    mask->set_block(k, bits);
   }
 
   // Checked: apply. Undo the current edits, then write the saved chunks. What changed is found
@@ -245,6 +308,19 @@ Result<EditResult> load_edits_from_memory(Terrain& terrain, std::string_view in)
         changes.add(i, j, before, after);
     }
   edit->commit();
+  // The holes: the file's replace the current ones; cells that differ are changes.
+  if (const HoleMask* now = detail::SurfaceAccess::holes(terrain.surface())) {
+    const std::int64_t last_i = std::int64_t(W) - 2, last_j = std::int64_t(H) - 2;
+    now->for_each_in(0, 0, last_i, last_j, [&](std::int64_t i, std::int64_t j) {
+      if (!mask->hole(i, j)) changes.add_cell(std::uint32_t(i), std::uint32_t(j));
+    });
+  }
+  mask->for_each_in(0, 0, std::int64_t(W) - 2, std::int64_t(H) - 2,
+                    [&](std::int64_t i, std::int64_t j) {
+                      if (!terrain.surface().hole(i, j))
+                        changes.add_cell(std::uint32_t(i), std::uint32_t(j));
+                    });
+  detail::SurfaceAccess::publish_holes(const_cast<Surface&>(terrain.surface()), std::move(mask));
   EditResult r;
   terrain.commit(changes, r);
   return r;

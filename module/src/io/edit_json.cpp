@@ -33,13 +33,11 @@ Result<std::vector<Edit>> parse_edits(std::string_view text) {
     Edit ed;
     auto b = e.find("brush");
     if (b == e.end() || !b->is_string())
-      return Error{
-          fmt("edits[%zu]: 'brush' must be one of crater, raise, lower, flatten, smooth", k)};
+      return Error{fmt("edits[%zu]: 'brush' must be one of %s", k, brush_names())};
     auto brush = parse_brush(b->get_ref<const std::string&>());
     if (!brush)
-      return Error{
-          fmt("edits[%zu]: unknown brush '%s'; need crater, raise, lower, flatten or smooth", k,
-              b->get_ref<const std::string&>().c_str())};
+      return Error{fmt("edits[%zu]: unknown brush '%s'; need %s", k,
+                       b->get_ref<const std::string&>().c_str(), brush_names())};
     ed.brush = *brush;
     std::string err;
     bool ok = detail::json_number(e, "x", ed.x, true, err) &&

@@ -6,6 +6,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
+#include <limits>
 #include <cctype>
 #include <filesystem>
 #include <memory>
@@ -375,8 +376,8 @@ Result<Heightfield> load_image(const std::string& path, const LoadOptions& optio
                                        spec.channelnames[channel].c_str(), img->nchannels));
   } else if (img->nchannels == 2 && spec.alpha_channel == 1) {
     log_message(LogLevel::kInfo,
-                fmt("%s: greyscale + alpha image; using the grey channel (0), ignoring alpha",
-                    name.c_str()));
+                fmt("%s: greyscale + alpha image; using the grey channel (0), %s", name.c_str(),
+                    options.alpha_nodata ? "alpha 0 marking missing samples" : "ignoring alpha"));
   } else if (img->nchannels > 1) {
     return Error{
         fmt("%s: %d channels (%s); a heightmap needs one channel (choose one with the "
@@ -390,6 +391,19 @@ Result<Heightfield> load_image(const std::string& path, const LoadOptions& optio
 
   std::vector<float> values;
   if (auto s = read_values(*img->input, channel, values, name); !s) return Error{s.message()};
+  if (options.alpha_nodata) {
+    const int alpha = spec.alpha_channel;
+    if (alpha < 0 || alpha == channel)
+      return Error{fmt("%s: alpha marks missing samples, but the image has no alpha channel "
+                       "besides the heights (%s)",
+                       name.c_str(), channel_list(spec).c_str())};
+    std::vector<float> a;
+    if (auto s = read_channel(*img->input, alpha, TypeDesc::FLOAT, a, name); !s)
+      return Error{s.message()};
+    // Non-finite samples are always missing (heightfield.h): the fill policy takes them.
+    for (std::size_t k = 0; k < values.size(); ++k)
+      if (a[k] == 0.0f) values[k] = std::numeric_limits<float>::quiet_NaN();
+  }
   img->input->close();
   return detail::finish_heightfield(desc, values, options, report);
 }

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <vector>
 
 #include "ridgeline/detail.h"
@@ -203,8 +204,11 @@ DiamondBound bound_of(const RecordConfig& c, const H& h, std::int64_t i, std::in
   const Diamond d = diamond_at(i, j, c.patch_log2);
   if (L == 0 && d.t == 0 && !d.square) {
     const bool horizontal = (i & 1) != 0;
-    return edge_bound_of(c, h(i, j), horizontal ? h(i - 1, j) : h(i, j - 1),
-                         horizontal ? h(i + 1, j) : h(i, j + 1), i, j, horizontal);
+    DiamondBound b = edge_bound_of(c, h(i, j), horizontal ? h(i - 1, j) : h(i, j - 1),
+                                   horizontal ? h(i + 1, j) : h(i, j + 1), i, j, horizontal);
+    if (c.holes != nullptr && straddles_hole(*c.holes, c.patch_log2, c.pad_i, c.pad_j, i, j))
+      b.radius = std::numeric_limits<float>::infinity();  // what FLT_MAX quantises to
+    return b;
   }
   const std::int64_t W = c.pad_i, Hh = c.pad_j;
   std::int64_t hx0, hz0, hx1, hz1, ax0, az0, ax1, az1;
@@ -229,6 +233,9 @@ DiamondBound bound_of(const RecordConfig& c, const H& h, std::int64_t i, std::in
     err = std::max(err, e);
   }
   if (!any_data) err = 0;
+  // Over a hole's edge as over the data's border: split until the mesh ends on it.
+  if (c.holes != nullptr && !straddles)
+    straddles = straddles_hole(*c.holes, c.patch_log2, c.pad_i, c.pad_j, i, j);
   double morph = err, radius = 0;
   const double hv = h(i, j);
   auto visit = [&](const DiamondBound& cb, double dist) {

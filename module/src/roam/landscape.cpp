@@ -19,6 +19,7 @@
 #include "roam/diamond.h"
 #include "roam/landscape_access.h"
 #include "roam/records.h"
+#include "surface/edit_layer.h"
 #include "surface/lattice.h"
 #include "world/page_store.h"
 
@@ -443,6 +444,11 @@ Result<std::shared_ptr<const Landscape>> Landscape::create(std::shared_ptr<const
       return LandscapeAccess::detail_offset_bound(*raw, i, j);
     };
   }
+  {
+    // Holes change the bounds (records.h): every remake and page made later reads them anew.
+    const EditLayer* layer = &detail::SurfaceAccess::edits(surface);
+    c.hole_source = [layer] { return layer->hole_snapshot(); };
+  }
   l->impl_ = std::move(im);
   Impl& m = *l->impl_;
 
@@ -505,6 +511,17 @@ Result<std::shared_ptr<const Landscape>> Landscape::create(std::shared_ptr<const
                                       std::min(j0 + kPageCells, store.grid().last_j)),
                         true);
     }
+    // So do the holes (records.h): remade around every block of them.
+    if (const auto holes = c.hole_source())
+      for (const auto& [k, bits] : holes->sorted_blocks()) {
+        const std::int64_t i0 = std::int64_t(k & 0xffffffffu) << HoleMask::kShift;
+        const std::int64_t j0 = std::int64_t(k >> 32) << HoleMask::kShift;
+        store.set_records(
+            m.slot,
+            maker->remake(store, i0, j0, std::min(i0 + HoleMask::kBlock, store.grid().last_i),
+                          std::min(j0 + HoleMask::kBlock, store.grid().last_j)),
+            true);
+      }
   }
   store.set_records(m.slot, blocks);
   l->build_ms_ =

@@ -6,6 +6,7 @@
 #include <array>
 #include <cfloat>
 #include <cmath>
+#include <limits>
 #include <memory>
 
 #include "ridgeline/landscape.h"
@@ -87,16 +88,20 @@ class Reader {
   };
 
   Reader() = default;
-  Reader(const Landscape& l, std::shared_ptr<const world::PageTable> table) noexcept
+  Reader(const Landscape& l, std::shared_ptr<const world::PageTable> table,
+         std::shared_ptr<const HoleMask> holes = nullptr) noexcept
       : land_(&l),
         im_(&LandscapeAccess::impl(l)),
         table_(std::move(table)),
+        holes_(std::move(holes)),
         grid_(&im_->store->grid()),
         L_(int(l.detail_levels())),
         K_(int(l.patch_exponent())),
         slot_(std::size_t(im_->slot)) {}
 
   const world::PageTable& table() const noexcept { return *table_; }
+  /// The terrain's holes when this update began (null without holes).
+  const HoleMask* holes() const noexcept { return holes_.get(); }
   const Landscape& landscape() const noexcept { return *land_; }
 
   /// The page of level k = min(t / 2, the coarsest level) holding stored vertex (si, sj) with
@@ -189,7 +194,10 @@ class Reader {
     const float hc = p.local(a, b);
     const float hl = horizontal ? p.local(a - 1, b) : p.local(a, b - 1);
     const float hr = horizontal ? p.local(a + 1, b) : p.local(a, b + 1);
-    return edge_bound_of(im_->config, hc, hl, hr, i, j, horizontal);
+    DiamondBound bound = edge_bound_of(im_->config, hc, hl, hr, i, j, horizontal);
+    if (holes_ != nullptr && straddles_hole(*holes_, K_, im_->config.pad_i, im_->config.pad_j, i, j))
+      bound.radius = std::numeric_limits<float>::infinity();  // as bound_of() gives it
+    return bound;
   }
 
   // A page found for one level: its grid position, the page and its packed bounds for this
@@ -218,6 +226,7 @@ class Reader {
   const Landscape* land_ = nullptr;
   const Landscape::Impl* im_ = nullptr;
   std::shared_ptr<const world::PageTable> table_;
+  std::shared_ptr<const HoleMask> holes_;
   const world::PageGrid* grid_ = nullptr;
   int L_ = 0, K_ = 6;
   std::size_t slot_ = 0;

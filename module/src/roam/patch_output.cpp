@@ -54,9 +54,14 @@ void PatchOutput::reset(const Landscape& land, const Reader& reader) {
     for (int c = 0; c < 4; ++c) add_vertex(p, i0 + (c & 1) * P, j0 + (c >> 1) * P);
     // Root 0: apex (P, 0), left (0, 0), right (P, P); root 1: apex (0, P), left (P, P),
     // right (0, 0) (landscape.h). Their slots are 0 and 1. A root over the padding is hidden.
+    // So is one wholly over holes.
     const bool pad = i0 >= LandscapeAccess::last_i(land) || j0 >= LandscapeAccess::last_j(land);
-    add_triangle(p, {1, 0, 3}, pad);
-    add_triangle(p, {2, 3, 0}, pad);
+    const HoleMask* holes = reader.holes();
+    const int L = int(land.detail_levels());
+    add_triangle(p, {1, 0, 3},
+                 pad || (holes && holes->all_holes(i0 + P, j0, i0, j0, i0 + P, j0 + P, L)));
+    add_triangle(p, {2, 3, 0},
+                 pad || (holes && holes->all_holes(i0, j0 + P, i0 + P, j0 + P, i0, j0, L)));
   }
 }
 

@@ -136,6 +136,11 @@ class PatchOutput {
     if (ix[0] != ix[1]) return {ix[0], ix[1], ix[2]};
     return p.hidden.at(slot);
   }
+  /// Whether a triangle slot in use is hidden (degenerate: over the padding or a hole).
+  bool hidden(std::uint32_t patch, std::uint32_t slot) const {
+    const std::uint32_t* ix = &patches_[patch].mesh.indices[std::size_t(slot) * 3];
+    return ix[0] == ix[1];
+  }
   /// Finest-lattice position of a vertex slot (from its patch-local x and z).
   std::array<std::int64_t, 2> coord(std::uint32_t patch, std::uint32_t slot) const {
     const MeshVertex& v = patches_[patch].mesh.vertices[slot];

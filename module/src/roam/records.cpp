@@ -38,6 +38,19 @@ DiamondBound edge_bound(const RecordConfig& c, const Heights& h, std::int64_t i,
   return edge_of(c, h, i, j);
 }
 
+bool straddles_hole(const HoleMask& holes, int patch_log2, std::int64_t pad_i, std::int64_t pad_j,
+                    std::int64_t i, std::int64_t j) {
+  const Diamond d = diamond_at(i, j, patch_log2);
+  std::int64_t hx0, hz0, hx1, hz1, ax0, az0, ax1, az1;
+  d.hypotenuse(hx0, hz0, hx1, hz1);
+  d.apexes(ax0, az0, ax1, az1);
+  for (const auto& [ax, az] : {std::pair{ax0, az0}, std::pair{ax1, az1}}) {
+    if (ax < 0 || az < 0 || ax > pad_i || az > pad_j) continue;
+    if (holes.cover(ax, az, hx0, hz0, hx1, hz1, 0).mixed()) return true;
+  }
+  return false;
+}
+
 // ---- encoding -----------------------------------------------------------------------------------
 
 std::vector<std::uint8_t> RecordBlock::encode() const {
@@ -79,7 +92,10 @@ void RecordBlock::own() {
 
 // ---- level 0, from the page alone ---------------------------------------------------------------
 
-std::shared_ptr<RecordBlock> level0_block(const RecordConfig& c, const world::Page& page) {
+std::shared_ptr<RecordBlock> level0_block(const RecordConfig& config, const world::Page& page) {
+  RecordConfig holed;
+  std::shared_ptr<const HoleMask> keep;
+  const RecordConfig& c = with_holes(config, holed, keep);
   const std::int64_t i0 = std::int64_t(page.key.px) << 8, j0 = std::int64_t(page.key.pz) << 8;
   auto block = std::make_shared<RecordBlock>();
   block->level = 0;
@@ -243,10 +259,13 @@ std::shared_ptr<RecordBlock> slice(const RecordConfig& c, const std::vector<Stri
 
 }  // namespace
 
-void build_all(const RecordConfig& c, const world::PageGrid& grid, const Heights& h,
+void build_all(const RecordConfig& config, const world::PageGrid& grid, const Heights& h,
                const std::function<const world::Page*(const PageKey&)>& page,
                const std::function<void(const PageKey&, std::shared_ptr<RecordBlock>)>& out,
                unsigned threads, bool level0) {
+  RecordConfig holed;
+  std::shared_ptr<const HoleMask> keep;
+  const RecordConfig& c = with_holes(config, holed, keep);
   const Heights& dh = h;
   // Grids of every level >= 1, coarsest last; each built from the one below.
   const int top_level = (c.patch_log2 - 1) / 2;
@@ -278,10 +297,13 @@ void build_all(const RecordConfig& c, const world::PageGrid& grid, const Heights
 }
 
 std::vector<std::pair<PageKey, std::shared_ptr<const RecordBlock>>> remake(
-    const RecordConfig& c, const world::PageGrid& grid, const Heights& h,
+    const RecordConfig& config, const world::PageGrid& grid, const Heights& h,
     const std::function<const world::Page*(const PageKey&)>& page,
     const std::function<const RecordBlock*(const PageKey&)>& block, std::int64_t i0,
     std::int64_t j0, std::int64_t i1, std::int64_t j1) {
+  RecordConfig holed;
+  std::shared_ptr<const HoleMask> keep;
+  const RecordConfig& c = with_holes(config, holed, keep);
   const Heights& dh = h;
   // The padding repeats the edge samples: an edited edge sample moves the padding too.
   if (i1 >= c.last_i) i1 = c.pad_i;

@@ -35,6 +35,7 @@
 
 #include "ridgeline/landscape.h"
 #include "roam/diamond.h"
+#include "surface/hole_mask.h"
 #include "world/page.h"
 
 namespace ridgeline {
@@ -193,7 +194,31 @@ struct RecordConfig {
   std::function<DiamondBound(std::int64_t, std::int64_t)> detail_child;
   /// |detail| bound at a finest-lattice vertex (0 at stored ones; set with detail).
   std::function<float(std::int64_t, std::int64_t)> detail_offset;
+  /// The terrain's holes now (a snapshot: null without holes), or null when the configuration
+  /// has no terrain (the bake). with_holes() fills `holes` from it.
+  std::function<std::shared_ptr<const HoleMask>()> hole_source;
+  /// The holes the bounds are computed against: a diamond one of whose triangles covers both a
+  /// hole cell and a solid one gets an infinite sphere, as one over the data's border does, so
+  /// views split it down to the finest level and the mesh ends exactly on the hole's edge.
+  const HoleMask* holes = nullptr;
 };
+
+/// `c` with `holes` set from its hole_source (kept alive by `keep`), or `c` itself when the
+/// terrain has no holes (the common case: nothing copied).
+inline const RecordConfig& with_holes(const RecordConfig& c, RecordConfig& copy,
+                                      std::shared_ptr<const HoleMask>& keep) {
+  if (!c.hole_source) return c;
+  keep = c.hole_source();
+  if (keep == nullptr) return c;
+  copy = c;
+  copy.holes = keep.get();
+  return copy;
+}
+
+/// Whether a triangle of the stored diamond centred at (i, j) (stored indices; patch exponent
+/// `patch_log2`, padded extent pad_i x pad_j) covers both a hole cell and a solid one.
+bool straddles_hole(const HoleMask& holes, int patch_log2, std::int64_t pad_i, std::int64_t pad_j,
+                    std::int64_t i, std::int64_t j);
 
 /// Local heights of stored samples by global index, clamped into the data (the padding's rule):
 /// a dense row-major array (floats, or 16-bit values times `scale`), or a function.

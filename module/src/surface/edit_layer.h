@@ -4,19 +4,29 @@
 // original heights, so that the edits can be saved (the current values of the touched chunks)
 // and undone (load_edits restores the originals first). Part of the surface: it knows pages, not
 // brushes, transactions or limits (module/src/edit/ writes through it).
+//
+// It also owns the hole mask (hole_mask.h): holes are edits too, so they are cloned, saved,
+// loaded and undone with the heights.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
+#include <mutex>
 #include <unordered_map>
 #include <vector>
 
+#include "surface/hole_mask.h"
 #include "world/page_store.h"
 
 namespace ridgeline {
 
 class EditLayer {
  public:
+  EditLayer() = default;
+  EditLayer(const EditLayer& o) : originals_(o.originals_), holes_(o.hole_snapshot()) {}
+  EditLayer& operator=(const EditLayer&) = delete;
+
   static constexpr std::uint32_t kChunkShift = 5;
   static constexpr std::uint32_t kChunk = 1u << kChunkShift;  ///< samples per chunk side
 
@@ -37,11 +47,29 @@ class EditLayer {
   void restore_all(world::PageEdit& edit, std::uint32_t width, std::uint32_t height);
   /// Bytes held by the originals.
   std::size_t memory_bytes() const noexcept {
-    return originals_.size() * (sizeof(float) * kChunk * kChunk + 48);
+    return originals_.size() * (sizeof(float) * kChunk * kChunk + 48) +
+           (holes_ ? holes_->memory_bytes() : 0);
+  }
+
+  /// The hole mask, or null when no cell is a hole. Read by queries (never during an edit).
+  const HoleMask* holes() const noexcept { return holes_.get(); }
+  /// The same as a snapshot that stays valid across later edits, for threads that may run
+  /// while an edit publishes a new mask (pages loading and making their bounds).
+  std::shared_ptr<const HoleMask> hole_snapshot() const {
+    std::lock_guard lock(holes_mu_);
+    return holes_;
+  }
+  /// Publishes a new mask (null or empty: no holes). Exclusive access (an edit).
+  void set_holes(std::shared_ptr<const HoleMask> m) {
+    if (m != nullptr && m->empty()) m.reset();
+    std::lock_guard lock(holes_mu_);
+    holes_ = std::move(m);
   }
 
  private:
   std::unordered_map<std::uint64_t, std::vector<float>> originals_;
+  mutable std::mutex holes_mu_;
+  std::shared_ptr<const HoleMask> holes_;
 };
 
 }  // namespace ridgeline

@@ -133,7 +133,15 @@ Result<Heightfield> Heightfield::create(const HeightfieldDesc& d, std::span<cons
     hf.filled_samples_ = filled;
     if (filled == count)
       return Error{fmt("%s: every sample is missing; nothing to fill from", d.name.c_str())};
-    if (d.fill == FillPolicy::kNearest) {
+    if (d.fill == FillPolicy::kHole)
+      // A cell is ground only where its four corners are measured.
+      for (std::size_t j = 0; j + 1 < d.height; ++j)
+        for (std::size_t i = 0; i + 1 < d.width; ++i) {
+          const std::size_t k = i + j * d.width;
+          if (missing[k] | missing[k + 1] | missing[k + d.width] | missing[k + d.width + 1])
+            hf.hole_cells_.push_back(i + j * (d.width - 1));
+        }
+    if (d.fill == FillPolicy::kNearest || d.fill == FillPolicy::kHole) {
       // Multi-source breadth-first search from every valid sample: each missing sample takes the
       // height of the valid sample that reached it first (4-neighbour distance).
       std::deque<std::size_t> queue;

@@ -15,6 +15,7 @@
 #include <memory>
 
 #include "ridgeline/surface.h"
+#include "surface/hole_mask.h"
 #include "surface/surface_eval.h"
 #include "world/page_store.h"
 
@@ -34,9 +35,17 @@ struct StoredLattice {
   mutable std::int64_t pi0 = 0, pj0 = 0;                 // its sample (0, 0)
   /// A page could not be loaded: what was read from it is 0 and the query answers nothing.
   mutable bool missing = false;
+  /// The surface's holes, null without any (one well-predicted branch per query then).
+  const HoleMask* holes = nullptr;
 
-  StoredLattice(const world::PageStore& s, const SurfaceLattice& a) noexcept
-      : store(s), at(a), table(&s.current()) {}
+  StoredLattice(const world::PageStore& s, const SurfaceLattice& a,
+                const HoleMask* h = nullptr) noexcept
+      : store(s), at(a), table(&s.current()), holes(h) {}
+
+  /// Whether cell (i, j) of this lattice lies in a hole.
+  bool hole(std::int64_t i, std::int64_t j) const noexcept {
+    return holes != nullptr && holes->hole(i, j);
+  }
 
   /// A page holding stored sample (i, j) (the last one read when its entries hold it).
   const world::Page* page_at(std::int64_t i, std::int64_t j) const noexcept {
@@ -133,6 +142,10 @@ struct DetailLattice {
     return stored.material(std::min(i >> levels, stored.store.grid().last_i - 1),
                            std::min(j >> levels, stored.store.grid().last_j - 1));
   }
+  /// Whether finest cell (i, j) lies in a hole (that of the stored cell holding it).
+  bool hole(std::int64_t i, std::int64_t j) const noexcept {
+    return stored.holes != nullptr && stored.holes->hole(i >> levels, j >> levels);
+  }
   void prefetch(std::int64_t, std::int64_t) const noexcept {}  // detail dominates; nothing to gain
   double spacing_x() const noexcept { return at.spacing_x; }
   double spacing_z() const noexcept { return at.spacing_z; }
@@ -148,11 +161,17 @@ struct SurfaceAccess {
   static const SurfaceLattice& stored_at(const Surface& s) noexcept { return s.stored_at_; }
   static EditLayer& edits(Surface& s) noexcept { return *s.edits_; }
   static const EditLayer& edits(const Surface& s) noexcept { return *s.edits_; }
+  static const HoleMask* holes(const Surface& s) noexcept { return s.holes_; }
+  /// Replaces the holes (an edit's transaction: exclusive access).
+  static void publish_holes(Surface& s, std::shared_ptr<const HoleMask> m) {
+    s.publish_holes(std::move(m));
+  }
 };
 
 /// The view of `s`'s lattice of each kind (the caller knows which one `s` has).
 inline StoredLattice stored_lattice(const Surface& s) noexcept {
-  return StoredLattice(SurfaceAccess::store(s), SurfaceAccess::stored_at(s));
+  return StoredLattice(SurfaceAccess::store(s), SurfaceAccess::stored_at(s),
+                       SurfaceAccess::holes(s));
 }
 inline DetailLattice detail_lattice(const Surface& s) noexcept {
   const int L = int(s.lattice().levels);
@@ -186,8 +205,31 @@ template <class Lattice>
   return locate_in_cell(i, j, static_cast<float>(u - double(i)), static_cast<float>(v - double(j)));
 }
 
+/// Lattice position (u, v) lies in hole cell p.(i, j): when it lies on that cell's edge or corner
+/// shared with a solid cell, moves p to the solid cell (the boundary is ground: docs/surface.md)
+/// and returns true; else false (no ground). Out of line: only points over holes get here.
+template <class Lattice>
+[[gnu::noinline]] bool leave_hole(const Lattice& g, double u, double v,
+                                  LatticePoint<Lattice>& p) noexcept {
+  const double fu = u - double(p.i), fv = v - double(p.j);
+  const std::int64_t last_i = g.at.vertices_x - 2, last_j = g.at.vertices_z - 2;
+  // The neighbours sharing the point: across u = i (or u = i + 1 at the far edge), v likewise.
+  const std::int64_t di = fu == 0.0 ? -1 : (fu == 1.0 ? 1 : 0);
+  const std::int64_t dj = fv == 0.0 ? -1 : (fv == 1.0 ? 1 : 0);
+  for (const auto& [a, b] : {std::pair{di, std::int64_t{0}}, std::pair{std::int64_t{0}, dj},
+                             std::pair{di, dj}}) {
+    if (a == 0 && b == 0) continue;
+    const std::int64_t i = p.i + a, j = p.j + b;
+    if (i < 0 || j < 0 || i > last_i || j > last_j || g.hole(i, j)) continue;
+    p.i = i, p.j = j;
+    p.tri = locate_in_cell(i, j, static_cast<float>(u - double(i)), static_cast<float>(v - double(j)));
+    return true;
+  }
+  return false;
+}
+
 /// Finds the cell and triangle under world (x, z) and reads its corners; false off the footprint
-/// (NaN fails the range test too).
+/// and over a hole (NaN fails the range test too).
 template <class Lattice>
 [[gnu::always_inline]] inline bool locate(const Lattice& g, double x, double z,
                                           LatticePoint<Lattice>& p) noexcept {
@@ -197,6 +239,7 @@ template <class Lattice>
   const double max_u = double(at.vertices_x - 1), max_v = double(at.vertices_z - 1);
   if (!(u >= 0.0 && u <= max_u && v >= 0.0 && v <= max_v)) return false;
   p.tri = cell_at(g, u, v, p.i, p.j);
+  if (g.hole(p.i, p.j) && !leave_hole(g, u, v, p)) return false;
   // Written out: as a loop, -O3 versions it for a unit row stride and spills the heights.
   p.h[0] = g.local(p.i + p.tri.di[0], p.j + p.tri.dj[0]);
   p.h[1] = g.local(p.i + p.tri.di[1], p.j + p.tri.dj[1]);

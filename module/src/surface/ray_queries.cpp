@@ -159,11 +159,14 @@ void fill_hit(const Lattice& g, const glm::dvec3& origin, const glm::dvec3& dir,
   hit.started_below = started_below;
 }
 
-// The surface under a point: its finest cell, the point's fractions in it, the triangle's plane.
+// The surface under a point: its finest cell, the point's fractions in it, the triangle's plane;
+// `hole` when there is no ground there (the boundary of a hole is ground, as for the point
+// queries).
 struct PointPlane {
   std::int64_t i = 0, j = 0;
   double fu = 0, fv = 0;
   detail::CellPlane plane{};
+  bool hole = false;
 };
 
 // (u, v) in stored-lattice units, inside the footprint.
@@ -171,10 +174,13 @@ template <class Lattice>
 PointPlane point_plane(const Lattice& g, double u, double v) noexcept {
   u *= g.scale, v *= g.scale;  // finest-lattice units (exact: a power of two)
   PointPlane p;
-  const CellTriangle tri = detail::cell_at(g, u, v, p.i, p.j);
+  detail::LatticePoint<Lattice> lp;
+  lp.tri = detail::cell_at(g, u, v, lp.i, lp.j);
+  if (g.hole(lp.i, lp.j) && !detail::leave_hole(g, u, v, lp)) p.hole = true;
+  p.i = lp.i, p.j = lp.j;
   p.fu = u - double(p.i);
   p.fv = v - double(p.j);
-  p.plane = detail::cell_plane(g, p.i, p.j, tri);
+  p.plane = detail::cell_plane(g, p.i, p.j, lp.tri);
   return p;
 }
 
@@ -213,12 +219,14 @@ bool RayQueries::walk_leaf(const Lattice& g, double touch_, const Ray& stored, s
                                   : kInf;
     const double tc = std::max(t, std::min({tnu, tnv, tb}));
 
-    // The cell: skip it when the ray stays above its highest corner.
+    // The cell: skip it when the ray stays above its highest corner, or when it is a hole (the
+    // ray passes through, on to the cells beyond).
+    const bool solid = !g.hole(ci, cj);
     const double h00 = g.local(ci, cj), h10 = g.local(ci + 1, cj);
     const double h01 = g.local(ci, cj + 1), h11 = g.local(ci + 1, cj + 1);
     const double cmax = std::max(std::max(h00, h10), std::max(h01, h11));
     const double ylow = r.y0 + r.dy * (r.dy < 0 ? tc : t);
-    if (ylow <= cmax + touch_) {
+    if (solid && ylow <= cmax + touch_) {
       // Split [t, tc] where the ray crosses the cell's diagonal (surface.h decides which one).
       const double ou = r.u0 - double(ci), ov = r.v0 - double(cj);
       const bool main = cell_has_main_diagonal(ci, cj);
@@ -309,6 +317,7 @@ std::optional<RayHit> RayQueries::raycast_impl(const Lattice& g, const Surface& 
     // Vertical: only the surface under the origin can be hit.
     if (!(r.u0 >= 0.0 && r.u0 <= umax && r.v0 >= 0.0 && r.v0 <= vmax)) return std::nullopt;
     const PointPlane p = point_plane(g, r.u0, r.v0);
+    if (p.hole) return std::nullopt;  // straight down a hole: nothing below
     const double f = r.y0 - p.plane.at(p.fu, p.fv);  // height above the surface
     if (f <= touch_) {
       fill_hit(g, origin, d, p.i, p.j, p.plane, 0.0, f < 0.0, hit);
@@ -334,7 +343,7 @@ std::optional<RayHit> RayQueries::raycast_impl(const Lattice& g, const Surface& 
     const double v = std::clamp(r.v0 + r.dv * t, 0.0, vmax);
     const PointPlane p = point_plane(g, u, v);
     const double f = (r.y0 + r.dy * t) - p.plane.at(p.fu, p.fv);
-    if (f <= touch_) {
+    if (!p.hole && f <= touch_) {
       fill_hit(g, origin, d, p.i, p.j, p.plane, t, t == 0.0 && f < 0.0, hit);
       return hit;
     }
@@ -449,6 +458,7 @@ std::size_t RayQueries::boxes_impl(const Lattice& g, double widen, const Box& bo
         ci |= (std::int64_t{1} << shift) - 1;  // to the block's last cell
         continue;
       }
+      if (g.hole(ci, cj)) continue;  // no ground: no triangles
       // The box in this cell's fractional coordinates.
       const double bu0 = ua - double(ci), bu1 = ub - double(ci);
       const double bv0 = va - double(cj), bv1 = vb - double(cj);

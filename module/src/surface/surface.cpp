@@ -76,6 +76,7 @@ Surface::Surface(std::shared_ptr<world::PageStore> store,
 Surface::Surface(const Surface& o, CloneTag)
     : store_(o.store_->clone()),
       edits_(std::make_unique<EditLayer>(*o.edits_)),
+      holes_(edits_->holes()),
       lattice_(o.lattice_),
       stored_at_(o.stored_at_),
       detail_(o.detail_),  // immutable, and bound to no terrain: shared
@@ -95,6 +96,17 @@ Surface::Surface(const Surface& o, CloneTag)
 Surface::~Surface() = default;
 
 const WorldInfo& Surface::info() const noexcept { return store_->info(); }
+
+bool Surface::hole(std::int64_t i, std::int64_t j) const noexcept {
+  return holes_ != nullptr && holes_->hole(i, j);
+}
+
+std::uint64_t Surface::hole_cells() const noexcept { return holes_ ? holes_->cells() : 0; }
+
+void Surface::publish_holes(std::shared_ptr<const HoleMask> mask) {
+  edits_->set_holes(std::move(mask));
+  holes_ = edits_->holes();
+}
 
 std::size_t Surface::edited_chunks() const noexcept {
   return edits_->chunks();

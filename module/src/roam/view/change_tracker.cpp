@@ -25,6 +25,11 @@ void ChangeTracker::pull_edits(Refiner& r) {
   const Landscape& land = r.landscape();
   const TerrainChanges pulled = land.terrain().changes_since(synced_version_);
   synced_version_ = pulled.version;
+  // Holes drawn or hidden by the leaves over a change follow the holes now (a hole edit leaves
+  // the heights alone; any edit may dig or fill while holes exist or existed).
+  const bool now_holes = r.source().reader().holes() != nullptr;
+  const bool holes = now_holes || had_holes_;
+  had_holes_ = now_holes;
   if (pulled.empty()) return;
   Front& front = r.front();
   PatchOutput& output = r.output();
@@ -32,6 +37,7 @@ void ChangeTracker::pull_edits(Refiner& r) {
   for (const TerrainChange& change : pulled.changes) {
     const LatticeRange& c = change.vertices;
     if (c.empty()) continue;
+    if (holes) r.rehide(c.i0, c.j0, c.i1, c.j1);
     for (std::uint32_t e = 0; e < front.size(); ++e) {
       const std::int64_t size = std::int64_t{1} << front.t(e);
       if (reaches(c, front.ci(e), front.cj(e), 3 * size + 1)) r.refresh_entry(e);

@@ -14,8 +14,12 @@ namespace ridgeline::roam {
 
 class ChangeTracker {
  public:
-  /// The mesh was rebuilt from the terrain as of `edit_version`: older edits need no pulling.
-  void mark_synced(std::uint64_t edit_version) noexcept { synced_version_ = edit_version; }
+  /// The mesh was rebuilt from the terrain as of `edit_version` (with holes or not): older edits
+  /// need no pulling.
+  void mark_synced(std::uint64_t edit_version, bool holes) noexcept {
+    synced_version_ = edit_version;
+    had_holes_ = holes;
+  }
   /// Edits since the last update (Terrain::changes_since()): refreshes the front's diamonds
   /// (bounds, positions) and the output vertices (heights, normals, bounds) they reach.
   void pull_edits(Refiner& refiner);
@@ -31,6 +35,7 @@ class ChangeTracker {
   std::uint64_t synced_version_ = 0;                     // the terrain's edit_version() applied
   std::uint64_t tiles_generation_ = ~std::uint64_t{0};   // the detail cache's snapshot last seen
   std::uint64_t pages_generation_ = 0;                   // the page table last seen
+  bool had_holes_ = false;                               // the terrain had holes last update
   std::unordered_set<std::uint64_t> known_tiles_;        // finest tiles resident at the last look
 };
 

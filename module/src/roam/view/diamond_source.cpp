@@ -6,6 +6,7 @@
 #include <tuple>
 
 #include "ridgeline/detail.h"
+#include "surface/edit_layer.h"
 #include "surface/lattice.h"
 
 namespace ridgeline::roam {
@@ -18,8 +19,9 @@ DiamondSource::DiamondSource(const Landscape& landscape)
       cache_(landscape.terrain().surface().detail_cache()) {}
 
 void DiamondSource::open_pages() {
-  reader_ = Reader(landscape_,
-                   detail::SurfaceAccess::store(landscape_.terrain().surface()).snapshot());
+  const Surface& s = landscape_.terrain().surface();
+  reader_ = Reader(landscape_, detail::SurfaceAccess::store(s).snapshot(),
+                   detail::SurfaceAccess::edits(s).hole_snapshot());
 }
 
 void DiamondSource::begin_update(bool world_metric) {

@@ -40,6 +40,39 @@ void Refiner::walk(Fn&& fn) const {
   }
 }
 
+void Refiner::rehide(std::int64_t i0, std::int64_t j0, std::int64_t i1, std::int64_t j1) {
+  // Down the trees of the patches over the range, into the triangles whose box meets it.
+  const std::int64_t cells = landscape_.patch_cells();
+  const std::int64_t px0 = std::max<std::int64_t>(0, (i0 - 1) / cells),
+                     px1 = std::min<std::int64_t>(landscape_.patches_x() - 1, (i1 + 1) / cells),
+                     pz0 = std::max<std::int64_t>(0, (j0 - 1) / cells),
+                     pz1 = std::min<std::int64_t>(landscape_.patches_z() - 1, (j1 + 1) / cells);
+  std::vector<std::pair<std::uint32_t, LatticeTriangle>> stack;
+  for (std::int64_t pz = pz0; pz <= pz1; ++pz)
+    for (std::int64_t px = px0; px <= px1; ++px)
+      for (std::uint32_t k = 0; k < 2; ++k) {
+        const auto root = std::uint32_t(2 * (px + pz * landscape_.patches_x()) + k);
+        stack.push_back({root, landscape_.triangle(root, 1)});
+        while (!stack.empty()) {
+          const auto [n, t] = stack.back();
+          stack.pop_back();
+          if (std::max({t.ax, t.lx, t.rx}) < i0 || std::min({t.ax, t.lx, t.rx}) > i1 ||
+              std::max({t.az, t.lz, t.rz}) < j0 || std::min({t.az, t.lz, t.rz}) > j1)
+            continue;
+          const Node& nd = nodes_[n];
+          if (!nd.leaf()) {
+            stack.push_back({nd.first_child(), Landscape::child_triangle(t, 0)});
+            stack.push_back({nd.first_child() + 1, Landscape::child_triangle(t, 1)});
+            continue;
+          }
+          const std::uint32_t patch = patch_of(t);
+          const bool hide = hidden(t);
+          if (hide != output_.hidden(patch, nd.slot()))
+            output_.set_triangle(patch, nd.slot(), output_.corners(patch, nd.slot()), hide);
+        }
+      }
+}
+
 }  // namespace roam
 
 void RoamView::for_each_leaf(
@@ -143,7 +176,7 @@ std::string Refiner::check_invariants() const {
         return;
       }
     }
-    drawn[patch] += over_padding(t) ? 0 : 1;
+    drawn[patch] += hidden(t) ? 0 : 1;
     // Links: leaves that link back, through the link their link word names; levels differ by
     // at most one.
     for (std::uint32_t f = 0; f < 3; ++f) {

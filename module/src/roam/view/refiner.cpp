@@ -31,6 +31,7 @@ Refiner::Refiner(const Landscape& landscape, DiamondSource& source, RangePool* p
       patches_x_(landscape.patches_x()),
       last_i_(LandscapeAccess::last_i(landscape)),
       last_j_(LandscapeAccess::last_j(landscape)),
+      detail_levels_(int(landscape.detail_levels())),
       nodes_(pool),
       front_(pool) {
   // Padding exists only in the last row or column of patches (landscape.h).
@@ -182,9 +183,9 @@ std::uint32_t Refiner::split_triangle(std::uint32_t p, const LatticeTriangle& t,
   const Node& x = nodes_[p];
   const std::array<std::uint32_t, 3> k = output_.corners(patch, x.slot());  // (A, L, R)
   bool pad0 = false, pad1 = false;
-  if (may_pad_) {
-    pad0 = over_padding(Landscape::child_triangle(t, 0));
-    pad1 = over_padding(Landscape::child_triangle(t, 1));
+  if (may_hide()) {
+    pad0 = hidden(Landscape::child_triangle(t, 0));
+    pad1 = hidden(Landscape::child_triangle(t, 1));
   }
   output_.set_triangle(patch, x.slot(), {v, k[0], k[1]}, pad0);
   const std::uint32_t s1 = output_.add_triangle(patch, {v, k[2], k[0]}, pad1);
@@ -353,7 +354,7 @@ void Refiner::merge(std::uint32_t n, std::vector<std::uint32_t>* queue) {
     relink(left, link_word(p, kLeftLink));
     relink(right, link_word(p, kRightLink));
     output_.set_triangle(patch, nodes_[c0].slot(), {k0[1], k0[2], k1[1]},
-                         may_pad_ && over_padding(whole));
+                         may_hide() && hidden(whole));
     output_.remove_triangle(patch, nodes_[c1].slot());
     if (!(vertex == removed_vertex && patch == removed_patch)) output_.remove_vertex(patch, vertex);
     removed_vertex = vertex, removed_patch = patch;

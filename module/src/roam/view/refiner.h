@@ -120,6 +120,20 @@ class Refiner {
     return std::min(std::min(t.ax, t.lx), t.rx) >= last_i_ ||
            std::min(std::min(t.az, t.lz), t.rz) >= last_j_;
   }
+  /// True when t is not drawn: over the padding, or wholly over hole cells (the holes of this
+  /// update's reader). A triangle over a hole's edge is never a leaf once converged: its
+  /// diamond's sphere is infinite (records.h), so it splits down to half-cells that are wholly
+  /// hole or wholly ground, and dropping the hole's leaves leaves a conforming mesh.
+  bool hidden(const LatticeTriangle& t) const noexcept {
+    if (may_pad_ && over_padding(t)) return true;
+    const HoleMask* h = source_.reader().holes();
+    return h != nullptr && h->all_holes(t.ax, t.az, t.lx, t.lz, t.rx, t.rz, detail_levels_);
+  }
+  /// Whether hidden() may be true for some triangle in this update (padding or holes).
+  bool may_hide() const noexcept { return may_pad_ || source_.reader().holes() != nullptr; }
+  /// After holes changed over finest-lattice vertices [i0, i1] x [j0, j1]: draws or hides every
+  /// leaf over them as hidden() now says (its patch's buffers patched).
+  void rehide(std::int64_t i0, std::int64_t j0, std::int64_t i1, std::int64_t j1);
 
   // ---- walks (mesh_walk.cpp) ---------------------------------------------------------------
 
@@ -181,6 +195,7 @@ class Refiner {
   const int patch_log2_;               // log2 of a patch's finest-lattice cells
   const std::uint32_t patches_x_;      // patches along x
   const std::int64_t last_i_, last_j_;  // the last sampled lattice index per axis
+  const int detail_levels_;             // finest-lattice levels below the stored samples
   bool may_pad_ = false;
 
   NodePool nodes_;

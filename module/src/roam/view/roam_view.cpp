@@ -124,7 +124,7 @@ RoamStats RoamView::Impl::update(const RoamSettings& s, const Camera& camera) {
       end == FrameEnd::kConverge || (end == FrameEnd::kThresholdSearch && triangle_cap.searching());
   if (reset_pending || s.mode == RoamMode::kRebuild) {
     reset_pending = false;
-    changes.mark_synced(land.terrain().edit_version());
+    changes.mark_synced(land.terrain().edit_version(), land.terrain().surface().hole_cells() > 0);
     refiner.reset_to_roots();
     if (build_whole) refiner.build_from_roots();
   } else {
@@ -240,7 +240,8 @@ Result<std::unique_ptr<RoamView>> RoamView::create(std::shared_ptr<const Landsca
   } catch (const std::bad_alloc& e) {
     return impl.out_of_memory(e);
   }
-  impl.changes.mark_synced(v->landscape_->terrain().edit_version());
+  impl.changes.mark_synced(v->landscape_->terrain().edit_version(),
+                           v->landscape_->terrain().surface().hole_cells() > 0);
   return v;
 }
 

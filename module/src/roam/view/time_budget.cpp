@@ -255,9 +255,9 @@ float TimeBudget::run(Refiner& r, Deadline& deadline, double threshold, std::uin
   const QueueItem* s = top_split();
   const float left = std::max({r.worst_failing(), s ? s->first : 0.0f, held_back});
   last_operations_ = (stats.splits - splits_before) + (stats.merges - merges_before);
-  // Under a cap, the splits that end the mesh on the data's border are forced, as crack fixes
+  // Under a cap, the splits that end the mesh on the data's border or a hole's edge are forced, as crack fixes
   // are: every one the cap held back is made now, past the cap (docs/roam.md).
-  if (cap != 0 && r.may_pad() && !deadline.out_of_time()) r.split_border_diamonds(scratch);
+  if (cap != 0 && r.may_hide() && !deadline.out_of_time()) r.split_border_diamonds(scratch);
   return left;
 }
 
