@@ -166,6 +166,8 @@ T.case("heights over a rectangle: get, set, errors", function()
   T.eq(t2, nil); T.truthy(err:find("pass the stored 1025 x 1025", 1, true), err)
   T.raises("field 'heights': 2 values for 3 x 2 samples", r.set_heights, r,
            {i0 = 0, j0 = 0, width = 3, height = 2, heights = {1, 2}})
+  T.raises("field 'heights': 7 values for 3 x 2 samples", r.set_heights, r,
+           {i0 = 0, j0 = 0, width = 3, height = 2, heights = {1, 2, 3, 4, 5, 6, 7}})
   T.raises("field 'heights': value 2 is not a number", r.set_heights, r,
            {i0 = 0, j0 = 0, width = 2, height = 1, heights = {1, "x"}})
   T.raises("field 'width': whole number >= 0 expected", r.get_heights, r,

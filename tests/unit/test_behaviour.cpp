@@ -26,13 +26,17 @@ std::shared_ptr<Terrain> noise_terrain(std::uint32_t n, std::uint32_t seed = 133
       .value();
 }
 
-// 83 x 57 samples, 2 m apart: neither a power of two plus one nor square, so the last column and
-// row of patches extend past the samples (padding that is not terrain).
-std::shared_ptr<Terrain> padded_terrain() {
+// 83 x 57 samples, 2 m apart (along z `spacing_z`), the first at `origin`: neither a power of
+// two plus one nor square, so the last column and row of patches extend past the samples
+// (padding that is not terrain).
+std::shared_ptr<Terrain> padded_terrain(double spacing_z = 2.0, glm::dvec2 origin = {0, 0}) {
   HeightfieldDesc d;
   d.width = 83;
   d.height = 57;
-  d.spacing_x = d.spacing_z = 2.0;
+  d.spacing_x = 2.0;
+  d.spacing_z = spacing_z;
+  d.origin_x = origin.x;
+  d.origin_z = origin.y;
   std::vector<float> h(std::size_t(d.width) * d.height);
   for (std::uint32_t j = 0; j < d.height; ++j)
     for (std::uint32_t i = 0; i < d.width; ++i)
@@ -142,6 +146,23 @@ TEST(Behaviour, CompactionOnAPaddedFieldKeepsTheTrianglesOverThePadding) {
   EXPECT_GT(compacted, 20u) << "the flight must empty the patches the dives filled";
   EXPECT_EQ(view->mesh_hash(), fresh_mesh_hash(*terrain, k, settings, cam))
       << "after the flight the mesh differs from a fresh view's";
+}
+
+// ---- output over unequal spacings ------------------------------------------------------------
+
+// Cells 2 m along x and 0.75 m along z, placed away from the origin: every corner a view draws
+// lies on the surface the queries see (each axis of the output takes its own spacing).
+TEST(Behaviour, AViewOverUnequalSpacingsDrawsOnTheSurface) {
+  auto terrain = padded_terrain(0.75, {-40, 300});
+  auto land = Landscape::create(terrain, {.patch_exponent = 4}).value();
+  auto view = RoamView::create(land, {.threshold = 0.5}).value();
+  ASSERT_TRUE(view->update(camera_at({0, 30, 310}, {60, 0, 330})));
+  EXPECT_EQ(view->check_invariants(), "") << "the mesh over cells 2 m x 0.75 m is inconsistent";
+  const DrawnCheck drawn = check_drawn_on_surface(*view, *terrain);
+  EXPECT_GT(drawn.corners, 1000u);
+  EXPECT_EQ(drawn.off, 0u) << drawn.off << " of " << drawn.corners
+                           << " drawn corners are not on the surface (cells 2 m x 0.75 m), first "
+                           << drawn.first;
 }
 
 // ---- a triangle cap while the camera climbs ----------------------------------------------------
@@ -255,7 +276,7 @@ TEST(Behaviour, AViewThatPullsAMergedChangeEqualsAFreshView) {
   ASSERT_GT(terrain->edit_version(), kChangeLogCapacity);
   ASSERT_TRUE(terrain->changes_since(0).trimmed);
   ASSERT_TRUE(view->update(cam));
-  ASSERT_EQ(view->check_invariants(), "");
+  EXPECT_EQ(view->check_invariants(), "") << "the mesh over cells 2 m x 0.75 m is inconsistent";
   const DrawnCheck drawn = check_drawn_on_surface(*view, *terrain);
   EXPECT_GT(drawn.corners, 1000u);
   EXPECT_EQ(drawn.off, 0u) << drawn.off << " of " << drawn.corners

@@ -581,8 +581,9 @@ TEST(ChangeLog, IsBoundedAndMergesWhatItNoLongerHolds) {
   ASSERT_EQ(t->edit_version(), n);
   // The last kChangeLogCapacity changes one by one.
   const TerrainChanges recent = t->changes_since(n - kChangeLogCapacity);
-  EXPECT_FALSE(recent.trimmed);
-  ASSERT_EQ(recent.changes.size(), kChangeLogCapacity);
+  EXPECT_FALSE(recent.trimmed) << "the last kChangeLogCapacity changes came back merged";
+  ASSERT_EQ(recent.changes.size(), kChangeLogCapacity)
+      << "the last kChangeLogCapacity changes are not listed one by one";
   for (std::size_t k = 0; k < kChangeLogCapacity; ++k) {
     EXPECT_EQ(recent.changes[k].version, n - kChangeLogCapacity + k + 1);
     EXPECT_EQ(recent.changes[k].box.min, boxes[n - kChangeLogCapacity + k].min);

@@ -30,7 +30,8 @@ TEST(IoRoundTrip, RawU16AndF32AreLittleEndian) {
   write_bytes(p16, u16);
   auto a = io::load_raw(p16, {2, 2, io::RawType::kU16}, options());
   ASSERT_TRUE(a) << a.error().message;
-  EXPECT_EQ(locals(*a), (std::vector<float>{4660, 0, 65535, 1}));
+  EXPECT_EQ(locals(*a), (std::vector<float>{4660, 0, 65535, 1}))
+      << "16-bit raw samples are little-endian: bytes 34 12 are 0x1234";
 
   const std::vector<float> f = {1.5f, -2.25f, 9.9e4f, 0.1f, -0.0f, 7.0f};
   std::vector<char> f32;

@@ -466,7 +466,8 @@ TEST(World, SeveralFilesMakeOneSeamlessWorld) {
     io::RawFormat format{t, t, io::RawType::kU16};
     auto joined = io::load_tiles(files, lo, io::TileLayout{2, 2, shared}, &format);
     ASSERT_TRUE(joined) << joined.error().message;
-    ASSERT_EQ(joined->width(), n);
+    ASSERT_EQ(joined->width(), n) << "2 x 2 files with " << (shared ? "shared" : "abutting")
+                                  << " edges joined into the wrong width";
     auto from_files = Terrain::create(std::move(*joined)).value();
     auto from_one = Terrain::create(generated(n, n, 9)).value();
     EXPECT_EQ(from_files->info().content_hash, from_one->info().content_hash)

@@ -24,10 +24,13 @@ TEST(Landscape, BoundsAreNestedAndHonest) {
   for (std::uint32_t root = 0; root < l->root_count(); ++root) {
     for (std::uint64_t h = 1; h < (std::uint64_t{1} << l->max_level()); ++h) {
       const float b = l->bound(root, h);
-      EXPECT_GE(b, test::exact_error(*l, root, h));
+      EXPECT_GE(b, test::exact_error(*l, root, h))
+          << "root " << root << " node " << h << ": the bound is below the triangle's exact error";
       if (2 * h + 1 < (std::uint64_t{1} << l->max_level())) {
-        EXPECT_GE(b, l->bound(root, 2 * h));
-        EXPECT_GE(b, l->bound(root, 2 * h + 1));
+        EXPECT_GE(b, l->bound(root, 2 * h))
+            << "root " << root << " node " << h << ": the bound is below its first child's";
+        EXPECT_GE(b, l->bound(root, 2 * h + 1))
+            << "root " << root << " node " << h << ": the bound is below its second child's";
       }
     }
   }
