@@ -74,6 +74,8 @@ TEST(WorldFile, PagesOutsideTheGridAreRefused) {
     const std::string name = "page (" + std::to_string(k.level) + ", " + std::to_string(k.px) +
                              ", " + std::to_string(k.pz) + ")";
     EXPECT_FALSE(st) << name << " lies outside the 3 x 2 grid but loaded (another page's data)";
-    if (!st) EXPECT_NE(st.message().find("no page"), std::string::npos) << st.message();
+    if (!st) {
+      EXPECT_NE(st.message().find("no page"), std::string::npos) << st.message();
+    }
   }
 }
