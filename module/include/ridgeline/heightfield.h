@@ -35,12 +35,18 @@ enum class FillPolicy {
   kHole,
 };
 
+/// Sample spacings a terrain accepts, metres: below a micrometre the lattice's positions vanish
+/// next to the origin in the float coordinates views and meshes use; above 1,000 km they no longer
+/// describe ground.
+inline constexpr double kMinSpacing = 1e-6;
+inline constexpr double kMaxSpacing = 1e6;
+
 /// Everything needed to turn raw sample values into a placed heightfield. Defaults are sane.
 struct HeightfieldDesc {
   std::uint32_t width = 0;       ///< samples along x (image columns), >= 2
   std::uint32_t height = 0;      ///< samples along z (image rows), >= 2
-  double spacing_x = 1.0;        ///< metres between samples along x; finite, > 0
-  double spacing_z = 1.0;        ///< metres between samples along z; finite, > 0
+  double spacing_x = 1.0;        ///< metres between samples along x; kMinSpacing .. kMaxSpacing
+  double spacing_z = 1.0;        ///< metres between samples along z; kMinSpacing .. kMaxSpacing
   double origin_x = 0.0;         ///< world x of sample (0, 0), metres; finite
   double origin_z = 0.0;         ///< world z of sample (0, 0), metres; finite
   double height_scale = 1.0;     ///< height = height_offset + height_scale * value; finite, > 0

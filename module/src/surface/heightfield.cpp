@@ -7,6 +7,7 @@
 #include <deque>
 #include <limits>
 #include <sstream>
+#include <utility>
 
 #include "format.h"
 
@@ -34,6 +35,11 @@ Status validate_heightfield_desc(const HeightfieldDesc& d) {
   };
   if (auto s = positive(d.spacing_x, "spacing x"); !s) return s;
   if (auto s = positive(d.spacing_z, "spacing z"); !s) return s;
+  for (const auto& [v, what] : {std::pair{d.spacing_x, "x"}, std::pair{d.spacing_z, "z"}})
+    if (v < kMinSpacing || v > kMaxSpacing)
+      return Error{fmt("%s: spacing %s is %s m; need %s .. %s m (HeightfieldDesc::spacing_%s)",
+                       n.c_str(), what, num(v).c_str(), num(kMinSpacing).c_str(),
+                       num(kMaxSpacing).c_str(), what)};
   if (auto s = positive(d.height_scale, "height scale"); !s) return s;
   if (auto s = finite(d.height_offset, "height offset"); !s) return s;
   if (auto s = finite(d.origin_x, "origin x"); !s) return s;
