@@ -142,6 +142,15 @@ Result<std::shared_ptr<const PageSource>> WorldSource::open(const std::string& p
   d.max_samples = ~std::uint64_t{0};
   d.name = s->name_;
   if (!in.ok() || fmt_byte > 1) return Error{fmt("%s: its index is corrupted", s->name_.c_str())};
+  // The tessellator settings the bounds were baked for, as Landscape::create checks a request.
+  const BakedRecords& br = s->baked_;
+  if ((br.patch_exponent != 0 && (br.patch_exponent < 2 || br.patch_exponent > 10)) ||
+      !(br.morph_window >= 0.0 && br.morph_window <= 4.0) ||
+      !(br.morph_delay >= 0.0 && br.morph_delay <= 1.0))
+    return Error{fmt("%s: its baked tessellator settings are corrupted (patch exponent %u, morph "
+                     "window %s, delay %s)",
+                     s->name_.c_str(), br.patch_exponent, detail::num(br.morph_window).c_str(),
+                     detail::num(br.morph_delay).c_str())};
   if (auto st2 = validate_heightfield_desc(d); !st2) return Error{st2.message()};
   if (!std::isfinite(w.min_local) || !std::isfinite(w.max_local) || w.min_local > w.max_local)
     return Error{fmt("%s: its height range is corrupted", s->name_.c_str())};
