@@ -118,6 +118,7 @@ nlohmann::json bake_if_missing(const Options& o, std::uint32_t n, const std::str
   j["generate_seconds"] = generate_s;
   j["bake_seconds"] = r->seconds;
   j["bounds_seconds"] = r->bounds_seconds;
+  j["pages_seconds"] = r->pages_seconds;
   j["samples_per_second"] = double(r->samples) / r->seconds;
   j["bytes"] = r->bytes;
   j["bytes_per_sample"] = double(r->bytes) / double(r->samples);

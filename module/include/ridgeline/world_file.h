@@ -49,7 +49,7 @@ struct BakeOptions {
   /// Threads, 1..256; 0: every hardware thread.
   std::uint32_t threads = 0;
   /// Deflate level, 1..12 (libdeflate): 1 fastest, 6 the TIFF writers' usual.
-  int compression_level = 2;
+  int compression_level = 1;
   /// Called now and then with the fraction done (0..1) and the stage's name, from the baking
   /// thread; return false to cancel (the bake then stops, removes its temporary file and fails
   /// with "cancelled").
@@ -63,6 +63,7 @@ struct BakeReport {
   std::uint64_t pages = 0;        ///< pages of every level
   double seconds = 0;             ///< wall time of the whole bake
   double bounds_seconds = 0;      ///< of which computing the tessellator's bounds
+  double pages_seconds = 0;       ///< of which compressing and writing the pages
   SampleFormat format = SampleFormat::kU16;  ///< how the heights were stored
   double max_error_m = 0;         ///< largest |stored - input| height (0 when kept exactly)
   std::uint64_t content_hash = 0; ///< the world's WorldInfo::content_hash

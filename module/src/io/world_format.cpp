@@ -48,10 +48,13 @@ std::vector<std::uint8_t> deflate(std::span<const std::uint8_t> in, int level) {
     c.reset(libdeflate_alloc_compressor(level));
     c_level = level;
   }
-  std::vector<std::uint8_t> out(libdeflate_zlib_compress_bound(c.get(), in.size()));
-  const std::size_t n = libdeflate_zlib_compress(c.get(), in.data(), in.size(), out.data(), out.size());
-  out.resize(n);
-  return out;
+  // Compressed into a scratch buffer kept per thread, then copied at its size (a fresh buffer of
+  // the bound's size would be zeroed, fresh pages from the system, for every tile).
+  thread_local std::vector<std::uint8_t> scratch;
+  const std::size_t bound = libdeflate_zlib_compress_bound(c.get(), in.size());
+  if (scratch.size() < bound) scratch.resize(bound);
+  const std::size_t n = libdeflate_zlib_compress(c.get(), in.data(), in.size(), scratch.data(), bound);
+  return std::vector<std::uint8_t>(scratch.begin(), scratch.begin() + std::ptrdiff_t(n));
 }
 
 bool inflate(std::span<const std::uint8_t> in, std::span<std::uint8_t> out) {

@@ -1,7 +1,7 @@
 // The bake (world_file.h): samples in memory to a world file (world_format.h). Stages: the
 // samples (checked, or quantised to a tolerance), the page summaries, the tessellator's coarse
-// bounds (records.h, from every sample), the pages of every level (cut, compressed and written
-// in parallel, in order), then the index, the TIFF directories and the locator; flushed and
+// bounds (records.h, from every sample), the pages of every level (cut and compressed by workers
+// while this thread writes them in order), then the index, the TIFF directories and the locator; flushed and
 // renamed.
 #include <fcntl.h>
 #include <unistd.h>
@@ -10,6 +10,8 @@
 #include <atomic>
 #include <cerrno>
 #include <chrono>
+#include <condition_variable>
+#include <mutex>
 #include <cmath>
 #include <cstring>
 #include <unordered_map>
@@ -112,6 +114,10 @@ struct CompressedPage {
   // corner sample (xz), each as a whole TIFF tile; empty when the page has no such neighbour.
   std::vector<std::uint8_t> edge_x, edge_z, edge_xz;
   std::uint64_t hash = 0;  // the content hash's page hash (level 0)
+  // The four parts joined as the file holds them, their sizes and checksum.
+  std::vector<std::uint8_t> all;
+  std::vector<std::uint32_t> sizes;
+  std::uint64_t checksum = 0;
 };
 
 }  // namespace
@@ -289,6 +295,7 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
     report(0.35, "pages");
 
     // ---- pages ------------------------------------------------------------------------------
+    const auto tp = std::chrono::steady_clock::now();
     Output out(path);
     if (auto s = out.open(); !s) return Error{s.message()};
     {
@@ -313,7 +320,12 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
         const std::int64_t j = std::clamp<std::int64_t>(j0 + (std::int64_t(b) << ls), 0, grid.last_j);
         return std::size_t(i) + std::size_t(j) * info.width;
       };
-      auto s = std::make_shared<world::PageSamples>();
+      // The page's samples and the tile's buffers are kept per thread (allocations this size
+      // would be fresh, zeroed pages from the system for every page).
+      thread_local std::shared_ptr<world::PageSamples> keep;
+      if (!keep || keep.use_count() != 1) keep = std::make_shared<world::PageSamples>();
+      const std::shared_ptr<world::PageSamples>& s = keep;
+      s->u16.clear(), s->f32.clear(), s->materials.clear();
       if (store_u16)
         s->u16.resize(kPageEntries);
       else
@@ -339,7 +351,9 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
       if (k == 0) cp.hash = world::hash_page(page, grid, mats);
       // The tile (its 256 x 256 entries) with TIFF's predictor, and the ring around it.
       if (store_u16) {
-        std::vector<std::uint16_t> tile(kTileSamples), ring;
+        thread_local std::vector<std::uint16_t> tile, ring;
+        tile.resize(kTileSamples);
+        ring.clear();
         ring.reserve(kApronSamples);
         for (std::int32_t b = -kPageApron; b <= kPageCells + kPageApron; ++b)
           for (std::int32_t a = -kPageApron; a <= kPageCells + kPageApron; ++a) {
@@ -355,7 +369,9 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
         cp.apron = deflate({reinterpret_cast<const std::uint8_t*>(ring.data()), ring.size() * 2},
                            o.compression_level);
       } else {
-        std::vector<float> tile(kTileSamples), ring;
+        thread_local std::vector<float> tile, ring;
+        tile.resize(kTileSamples);
+        ring.clear();
         ring.reserve(kApronSamples);
         for (std::int32_t b = -kPageApron; b <= kPageCells + kPageApron; ++b)
           for (std::int32_t a = -kPageApron; a <= kPageCells + kPageApron; ++a) {
@@ -416,35 +432,88 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
     };
     // Offsets and sizes of the TIFF-only edge tiles, by the page they follow.
     std::unordered_map<std::size_t, std::pair<std::uint64_t, std::uint64_t>> edge_x, edge_z, edge_xz;
-    const std::size_t batch = std::max<std::size_t>(threads * 4, 8);
-    for (std::size_t first = 0; first < total_pages; first += batch) {
-      const std::size_t count = std::min(batch, total_pages - first);
-      std::vector<CompressedPage> done(count);
-      parallel_for(count, threads, [&](std::size_t k) { make_page(first + k, done[k]); });
-      for (std::size_t k = 0; k < count; ++k) {
-        CompressedPage& cp = done[k];
-        PageEntry& e = entries[first + k];
+    // `threads` workers make the pages (cut, compressed, joined and checksummed) at most
+    // `window` ahead of this thread, which writes them in order as they come.
+    {
+      const std::size_t window = std::max<std::size_t>(std::size_t(threads) * 4, 8);
+      std::vector<CompressedPage> ring(window);
+      std::vector<std::uint8_t> ready(window, 0);
+      std::mutex mu;
+      std::condition_variable made, freed;
+      std::size_t next = 0, written = 0;
+      bool stop = false;
+      std::vector<std::thread> workers;
+      // Stops and joins the workers however this block is left (an error, a cancellation).
+      struct Join {
+        std::vector<std::thread>& w;
+        std::mutex& mu;
+        bool& stop;
+        std::condition_variable& freed;
+        ~Join() {
+          {
+            std::lock_guard lock(mu);
+            stop = true;
+          }
+          freed.notify_all();
+          for (auto& t : w) t.join();
+        }
+      } join{workers, mu, stop, freed};
+      for (unsigned t = 0; t < std::max(1u, threads); ++t)
+        workers.emplace_back([&] {
+          for (;;) {
+            std::size_t k;
+            {
+              std::unique_lock lock(mu);
+              freed.wait(lock, [&] { return stop || next >= total_pages || next < written + window; });
+              if (stop || next >= total_pages) return;
+              k = next++;
+            }
+            CompressedPage cp;
+            make_page(k, cp);
+            cp.all.reserve(cp.tile.size() + cp.apron.size() + cp.materials.size() + cp.records.size());
+            for (auto* part : {&cp.tile, &cp.apron, &cp.materials, &cp.records}) {
+              cp.all.insert(cp.all.end(), part->begin(), part->end());
+              cp.sizes.push_back(std::uint32_t(part->size()));
+              std::vector<std::uint8_t>().swap(*part);
+            }
+            cp.checksum = checksum(cp.all.data(), cp.all.size());
+            {
+              std::lock_guard lock(mu);
+              ring[k % window] = std::move(cp);
+              ready[k % window] = 1;
+            }
+            made.notify_all();
+          }
+        });
+      for (std::size_t k = 0; k < total_pages; ++k) {
+        CompressedPage cp;
+        {
+          std::unique_lock lock(mu);
+          made.wait(lock, [&] { return ready[k % window] != 0; });
+          cp = std::move(ring[k % window]);
+          ready[k % window] = 0;
+          written = k + 1;
+        }
+        freed.notify_all();
+        PageEntry& e = entries[k];
         e.offset = out.size();
-        e.tile = std::uint32_t(cp.tile.size()), e.apron = std::uint32_t(cp.apron.size());
-        e.materials = std::uint32_t(cp.materials.size());
-        e.records = std::uint32_t(cp.records.size());
-        std::vector<std::uint8_t> all;
-        all.reserve(e.bytes());
-        for (const auto* part : {&cp.tile, &cp.apron, &cp.materials, &cp.records})
-          all.insert(all.end(), part->begin(), part->end());
-        e.checksum = checksum(all.data(), all.size());
-        if (auto s = out.write(all.data(), all.size()); !s) return Error{s.message()};
+        e.tile = cp.sizes[0], e.apron = cp.sizes[1], e.materials = cp.sizes[2], e.records = cp.sizes[3];
+        e.checksum = cp.checksum;
+        if (auto s = out.write(cp.all.data(), cp.all.size()); !s) return Error{s.message()};
         // The TIFF-only edge tiles, after the page's bytes (outside its checksum and the index).
         for (auto [part, sink] : {std::pair{&cp.edge_x, &edge_x}, std::pair{&cp.edge_z, &edge_z},
                                   std::pair{&cp.edge_xz, &edge_xz}}) {
           if (part->empty()) continue;
-          (*sink)[first + k] = {out.size(), part->size()};
+          (*sink)[k] = {out.size(), part->size()};
           if (auto s = out.write(part->data(), part->size()); !s) return Error{s.message()};
         }
-        if (first + k < grid.count(0)) page_hashes[first + k] = cp.hash;
+        if (k < grid.count(0)) page_hashes[k] = cp.hash;
+        if ((k + 1) % window == 0 || k + 1 == total_pages)
+          report(0.35 + 0.6 * double(k + 1) / double(total_pages), "pages");
       }
-      report(0.35 + 0.6 * double(first + count) / double(total_pages), "pages");
     }
+    rep.pages_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - tp).count();
     info.content_hash = world::combine_hashes(world::hash_header(info), page_hashes);
     rep.content_hash = info.content_hash;
     rep.pages = total_pages;

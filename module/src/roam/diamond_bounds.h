@@ -5,12 +5,19 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
+#include <cstddef>
+#include <utility>
 #include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <limits>
 #include <vector>
+
+#if defined(__SSE2__) || defined(_M_X64)
+#include <emmintrin.h>
+#endif
 
 #include "ridgeline/detail.h"
 #include "ridgeline/log.h"
@@ -39,7 +46,7 @@ template <class H>
 void read_row(const H& h, std::int64_t z, std::int64_t lo, std::int64_t hi, float* out) {
   for (std::int64_t x = lo; x <= hi; ++x) out[x - lo] = h(x, z);
 }
-inline void read_row(const Heights& h, std::int64_t z, std::int64_t lo, std::int64_t hi, float* out) {
+[[gnu::always_inline]] inline void read_row(const Heights& h, std::int64_t z, std::int64_t lo, std::int64_t hi, float* out) {
   if ((h.f32 == nullptr && h.u16 == nullptr) || z < 0 || z > h.last_j || lo < 0 ||
       hi > h.last_i) {
     for (std::int64_t x = lo; x <= hi; ++x) out[x - lo] = h(x, z);
@@ -124,6 +131,114 @@ inline const SmallTriangles& small_triangles() {
   return table;
 }
 
+// The rows of the bintree's triangles of legs up to 64 cells (axis-aligned or diagonal, the
+// right angle at the apex), relative to the apex: each row's first sample and count, and the
+// three edge functions at its first sample; exact_triangle()'s spans and integers, found once per
+// shape instead of per row (the edge functions do not change when the triangle moves).
+struct RowShapes {
+  struct Row {
+    std::int32_t dz, dlo, n;
+    std::int64_t e0, e1, e2;  // A -> L, L -> R, R -> A at (lo, z), made >= 0 inside
+  };
+  struct Shape {
+    std::int64_t c0 = 0, c1 = 0, c2 = 0;  // the edge functions' x coefficients
+    double aw = 1;
+    std::vector<Row> rows;
+  };
+  static constexpr int kSizes = 7;  // legs 1 .. 64
+  Shape shapes[kSizes][8][2];
+
+  // The shape's slot for legs L - A = (ux, uz) and R - A = (ux, uz) turned (left: by +90
+  // degrees), or null when the legs are not an axis or a diagonal of a power of two <= 64.
+  static bool slot(std::int64_t ux, std::int64_t uz, int& size, int& dir) noexcept {
+    const std::int64_t ax = ux < 0 ? -ux : ux, az = uz < 0 ? -uz : uz;
+    const std::int64_t m = std::max(ax, az);
+    if (m == 0 || m > 64 || (m & (m - 1)) != 0 || (ax != 0 && ax != m) || (az != 0 && az != m))
+      return false;
+    size = std::countr_zero(std::uint64_t(m));
+    dir = (ux > 0 ? 2 : ux < 0 ? 0 : 1) + 3 * (uz > 0 ? 2 : uz < 0 ? 0 : 1);  // 0 .. 8 but 4
+    dir = dir > 4 ? dir - 1 : dir;
+    return true;
+  }
+  RowShapes() {
+    for (int a = 0; a < kSizes; ++a)
+      for (int sx = -1; sx <= 1; ++sx)
+        for (int sz = -1; sz <= 1; ++sz)
+          for (const bool left : {false, true}) {
+            if (sx == 0 && sz == 0) continue;
+            const std::int64_t ux = std::int64_t(sx) << a, uz = std::int64_t(sz) << a;
+            const std::int64_t vx = left ? -uz : uz, vz = left ? ux : -ux;  // R - A
+            int size, dir;
+            slot(ux, uz, size, dir);
+            Shape& sh = shapes[size][dir][left ? 1 : 0];
+            const std::int64_t w = ux * vz - uz * vx;
+            const std::int64_t sgn = w > 0 ? 1 : -1;
+            sh.aw = double(w * sgn);
+            // Edges as exact_triangle() takes them: k = 0 A -> L, 1 L -> R, 2 R -> A.
+            const std::int64_t ex[3][2] = {{0, 0}, {ux, uz}, {vx, vz}};
+            const int from[3] = {0, 1, 2}, to[3] = {1, 2, 0};
+            const std::int64_t x0 = std::min({std::int64_t{0}, ux, vx}), x1 = std::max({std::int64_t{0}, ux, vx});
+            const std::int64_t z0 = std::min({std::int64_t{0}, uz, vz}), z1 = std::max({std::int64_t{0}, uz, vz});
+            std::int64_t coef[3] = {};
+            for (std::int64_t z = z0; z <= z1; ++z) {
+              std::int64_t lo = x0, hi = x1, off[3];
+              for (int k = 0; k < 3; ++k) {
+                const std::int64_t px = ex[from[k]][0], pz = ex[from[k]][1];
+                const std::int64_t eux = ex[to[k]][0] - px, euz = ex[to[k]][1] - pz;
+                const std::int64_t ca = -euz * sgn, cc = (eux * (z - pz) + euz * px) * sgn;
+                coef[k] = ca, off[k] = cc;
+                if (ca > 0)
+                  lo = std::max(lo, -floor_div(cc, ca));
+                else if (ca < 0)
+                  hi = std::min(hi, floor_div(cc, -ca));
+                else if (cc < 0)
+                  lo = hi + 1;
+              }
+              if (lo > hi) continue;
+              sh.rows.push_back({std::int32_t(z), std::int32_t(lo), std::int32_t(hi - lo + 1),
+                                 coef[0] * lo + off[0], coef[1] * lo + off[1], coef[2] * lo + off[2]});
+            }
+            sh.c0 = coef[0], sh.c1 = coef[1], sh.c2 = coef[2];
+          }
+  }
+};
+
+inline const RowShapes& row_shapes() {
+  static const RowShapes table;
+  return table;
+}
+
+// max |row[x] aw - (S x + T)| over x in [0, n): two lanes of SSE2 where there is SSE2 (every
+// x86-64), one elsewhere; the same values either way (each lane rounds as the scalar code does).
+[[gnu::always_inline]] inline double row_worst(const float* row, std::int64_t n, double aw, double S, double T) noexcept {
+  std::int64_t x = 0;
+  double worst = 0.0;
+#if defined(__SSE2__) || defined(_M_X64)
+  const __m128d sign = _mm_set1_pd(-0.0), vaw = _mm_set1_pd(aw), vS = _mm_set1_pd(S),
+                vT = _mm_set1_pd(T), step = _mm_set1_pd(4.0);
+  __m128d x01 = _mm_set_pd(1.0, 0.0), x23 = _mm_set_pd(3.0, 2.0);
+  __m128d m01 = _mm_setzero_pd(), m23 = _mm_setzero_pd();
+  for (; x + 3 < n; x += 4) {
+    const __m128 r = _mm_loadu_ps(row + x);
+    const __m128d h01 = _mm_cvtps_pd(r), h23 = _mm_cvtps_pd(_mm_movehl_ps(r, r));
+    const __m128d d01 = _mm_sub_pd(_mm_mul_pd(h01, vaw), _mm_add_pd(_mm_mul_pd(vS, x01), vT));
+    const __m128d d23 = _mm_sub_pd(_mm_mul_pd(h23, vaw), _mm_add_pd(_mm_mul_pd(vS, x23), vT));
+    m01 = _mm_max_pd(m01, _mm_andnot_pd(sign, d01));
+    m23 = _mm_max_pd(m23, _mm_andnot_pd(sign, d23));
+    x01 = _mm_add_pd(x01, step), x23 = _mm_add_pd(x23, step);
+  }
+  double lanes[4];
+  _mm_storeu_pd(lanes, m01);
+  _mm_storeu_pd(lanes + 2, m23);
+  worst = std::max({lanes[0], lanes[1], lanes[2], lanes[3]});
+#endif
+  for (; x < n; ++x) {
+    const double d = std::abs(double(row[x]) * aw - (S * double(x) + T));
+    worst = d > worst ? d : worst;
+  }
+  return worst;
+}
+
 // Exact error against the stored lattice of a triangle in stored coordinates: the largest
 // |height - plane| over the samples inside it (edge functions in integer arithmetic, the span of
 // each row found exactly). Heights past the data repeat the edge (the accessor clamps). The
@@ -154,6 +269,23 @@ float exact_triangle(const H& h, const LatticeTriangle& t) {
   thread_local std::vector<float> row;
   if (row.size() < std::size_t(x1 - x0 + 1)) row.resize(std::size_t(x1 - x0 + 1));
   double worst = 0.0;
+  int size, dir;
+  if (RowShapes::slot(t.lx - t.ax, t.lz - t.az, size, dir)) {
+    const std::int64_t ux = t.lx - t.ax, uz = t.lz - t.az;
+    const bool left = t.rx - t.ax == -uz && t.rz - t.az == ux;
+    if (left || (t.rx - t.ax == uz && t.rz - t.az == -ux)) {
+      // The same spans and values as the rows below give, from the shape's table.
+      const RowShapes::Shape& sh = row_shapes().shapes[size][dir][left ? 1 : 0];
+      const double S = double(sh.c1) * ha + double(sh.c2) * hl + double(sh.c0) * hr;
+      for (const RowShapes::Row& r : sh.rows) {
+        const double T = double(r.e1) * ha + double(r.e2) * hl + double(r.e0) * hr;
+        const std::int64_t lo = t.ax + r.dlo;
+        read_row(h, t.az + r.dz, lo, lo + r.n - 1, row.data());
+        worst = std::max(worst, row_worst(row.data(), r.n, sh.aw, S, T));
+      }
+      return round_up(worst / aw);
+    }
+  }
   const std::int64_t ex[3][2] = {{t.ax, t.az}, {t.lx, t.lz}, {t.rx, t.rz}};
   const int from[3] = {0, 1, 2}, to[3] = {1, 2, 0};
   for (std::int64_t z = z0; z <= z1; ++z) {
@@ -179,19 +311,7 @@ float exact_triangle(const H& h, const LatticeTriangle& t) {
                      double(coef[0] * lo + off[0]) * hr;
     read_row(h, z, lo, hi, row.data());
     const std::int64_t n = hi - lo + 1;
-    double m0 = 0.0, m1 = 0.0;
-    std::int64_t x = 0;
-    for (; x + 1 < n; x += 2) {
-      const double d0 = std::abs(double(row[std::size_t(x)]) * aw - (S * double(x) + T));
-      const double d1 = std::abs(double(row[std::size_t(x + 1)]) * aw - (S * double(x + 1) + T));
-      m0 = d0 > m0 ? d0 : m0;
-      m1 = d1 > m1 ? d1 : m1;
-    }
-    if (x < n) {
-      const double d0 = std::abs(double(row[std::size_t(x)]) * aw - (S * double(x) + T));
-      m0 = d0 > m0 ? d0 : m0;
-    }
-    worst = std::max(worst, std::max(m0, m1));
+    worst = std::max(worst, row_worst(row.data(), n, aw, S, T));
   }
   return round_up(worst / aw);  // never below the double error
 }
@@ -298,12 +418,95 @@ DiamondBound edge_of(const RecordConfig& c, const H& h, std::int64_t i, std::int
 }
 
 
+// The fixed shape of the t <= 1 diamonds of one kind and orientation, as offsets from the centre
+// in a dense block of stride n: the samples of its two triangles with their edge functions (the
+// small-triangle table's, so the arithmetic is exact_triangle()'s), and its four children. For a
+// diamond wholly inside the data, its bound is then bound_of()'s, bit for bit, without the
+// per-diamond classification and table lookups (most of every world's diamonds are these).
+struct SmallStencil {
+  struct Tri {
+    std::ptrdiff_t a = 0, l = 0, r = 0;  // apex, left, right
+    double aw = 1;
+    std::vector<std::ptrdiff_t> at;
+    std::vector<std::array<double, 3>> w;  // wa, wl, wr
+  };
+  Tri tri[2];
+  std::ptrdiff_t child[4] = {};
+  double cdx[4] = {}, cdz[4] = {};
+  int children = 0;
+
+  // From the representative diamond (ri, rj) of the kind (a patch exponent of 10: never a top).
+  SmallStencil(std::int64_t ri, std::int64_t rj, std::int64_t n) {
+    const Diamond d = diamond_at(ri, rj, 10);
+    std::int64_t hx0, hz0, hx1, hz1, ax0, az0, ax1, az1;
+    d.hypotenuse(hx0, hz0, hx1, hz1);
+    d.apexes(ax0, az0, ax1, az1);
+    const std::int64_t apex[2][2] = {{ax0, az0}, {ax1, az1}};
+    auto off = [&](std::int64_t x, std::int64_t z) { return std::ptrdiff_t((x - ri) + (z - rj) * n); };
+    const SmallTriangles& small = small_triangles();
+    for (int k = 0; k < 2; ++k) {
+      const LatticeTriangle t{apex[k][0], apex[k][1], hx0, hz0, hx1, hz1};
+      const int e = small.find(t);
+      RIDGELINE_ASSERT(e >= 0);
+      const std::int64_t w = (t.lx - t.ax) * (t.rz - t.az) - (t.lz - t.az) * (t.rx - t.ax);
+      Tri& q = tri[k];
+      q.a = off(t.ax, t.az), q.l = off(t.lx, t.lz), q.r = off(t.rx, t.rz);
+      q.aw = double(w > 0 ? w : -w);
+      for (const SmallTriangles::Sample& sm : small.samples[e]) {
+        q.at.push_back(off(t.ax + sm.dx, t.az + sm.dz));
+        q.w.push_back({double(sm.wa), double(sm.wl), double(sm.wr)});
+      }
+    }
+    if (d.has_children())
+      for (int k = 0; k < 4; ++k, ++children) {
+        std::int64_t ci, cj;
+        d.child(k, ci, cj);
+        child[k] = off(ci, cj), cdx[k] = double(ci - ri), cdz[k] = double(cj - rj);
+      }
+  }
+
+  // bound_of() of the diamond whose centre is entry `c0` of `p` (its triangles and children
+  // inside the data and the block), children's bounds read from `out` at the same entries.
+  DiamondBound bound(const RecordConfig& c, const float* p, const DiamondBound* out,
+                     std::ptrdiff_t c0) const noexcept {
+    double err = 0;
+    for (const Tri& q : tri) {
+      const double ha = p[c0 + q.a], hl = p[c0 + q.l], hr = p[c0 + q.r];
+      double worst = 0.0;
+      for (std::size_t k = 0; k < q.at.size(); ++k) {
+        const double d = std::abs(double(p[c0 + q.at[k]]) * q.aw -
+                                  (q.w[k][0] * ha + q.w[k][1] * hl + q.w[k][2] * hr));
+        worst = d > worst ? d : worst;
+      }
+      err = std::max(err, double(round_up(worst / q.aw)));
+    }
+    double morph = err, radius = 0;
+    bool straddles = false;
+    const double hv = p[c0];
+    for (int k = 0; k < children; ++k) {
+      const DiamondBound& cb = out[c0 + child[k]];
+      const double dx = cdx[k] * c.spacing_x, dz = cdz[k] * c.spacing_z;
+      const double dy = double(p[c0 + child[k]]) - hv;
+      const double dist = std::sqrt(dx * dx + dz * dz + dy * dy);
+      err = std::max(err, double(cb.error));
+      morph = std::max(morph, c.growth * double(cb.morph));
+      radius = std::max(radius, double(cb.radius) + dist);
+      straddles |= cb.radius >= FLT_MAX;
+    }
+    if (straddles) radius = FLT_MAX;
+    return quantized(
+        {round_up(err), round_up(morph), radius >= FLT_MAX ? FLT_MAX : round_up(radius)});
+  }
+};
+
 // The bounds of every t <= 1 diamond whose descendants lie in the block of samples
 // [i0, i0 + n) x [j0, j0 + n) (or past the padded extent, where they do not exist), finest
 // first, into out[(i - i0) + (j - j0) n]; other entries are left as they are. `h`: the block's
 // heights. The level-0 blocks and the bake's t = 1 squares both come from here, so both hold
 // the same values.
-inline void small_bounds(const RecordConfig& c, const DenseBlock& h, std::vector<DiamondBound>& out) {
+// `stencils` false computes every diamond with bound_of() (what the tests compare against).
+inline void small_bounds(const RecordConfig& c, const DenseBlock& h, std::vector<DiamondBound>& out,
+                         bool stencils = true) {
   const std::int64_t i0 = h.i0, j0 = h.j0, n = h.n;
   out.resize(std::size_t(n * n));
   auto at = [&](std::int64_t i, std::int64_t j) -> DiamondBound {
@@ -324,6 +527,23 @@ inline void small_bounds(const RecordConfig& c, const DenseBlock& h, std::vector
                                     {0, true, 2, 1, {1, 0}, {1, 0}},
                                     {1, false, 4, 2, {2, 0}, {0, 2}},
                                     {1, true, 4, 1, {2, 0}, {2, 0}}};
+  // The stencils of this block's stride: t = 0 square (main, other diagonal), t = 1 edge
+  // (horizontal, vertical), t = 1 square (main, other).
+  struct Stencils {
+    std::int64_t n = -1;
+    std::vector<SmallStencil> v;
+  };
+  thread_local Stencils st;
+  if (st.n != n) {
+    st.v.clear();
+    for (const auto& [ri, rj] : {std::pair{1, 1}, std::pair{3, 1}, std::pair{2, 4}, std::pair{4, 2},
+                                 std::pair{2, 2}, std::pair{6, 2}})
+      st.v.emplace_back(ri, rj, n);
+    st.n = n;
+  }
+  // The fast path: no detail, no holes, and the diamond's triangles inside the data (so none
+  // straddles its border) and its top never reached (t <= 1 < patch_log2 - 1).
+  const bool fast = stencils && c.L == 0 && c.holes == nullptr && c.patch_log2 > 2;
   for (const Kind& k : kinds) {
     const std::int64_t r = (k.square ? 3 : 2) << k.t;
     for (int v = 0; v < k.count; ++v) {
@@ -335,7 +555,28 @@ inline void small_bounds(const RecordConfig& c, const DenseBlock& h, std::vector
         for (std::int64_t i = first(i0, k.ri[v]); i < i0 + n; i += k.m) {
           if (i < 0 || i > c.pad_i || !within(i, r, i0, i0 + n - 1, c.pad_i)) continue;
           // The residues make (i, j) a diamond of this kind (t <= 1 < patch_log2: never a corner).
-          out[std::size_t((i - i0) + (j - j0) * n)] = bound_of(c, h, i, j, at);
+          const std::size_t e = std::size_t((i - i0) + (j - j0) * n);
+          const std::int64_t s = std::int64_t{1} << k.t;
+          if (fast && i - s >= std::max<std::int64_t>(0, i0) && j - s >= std::max<std::int64_t>(0, j0) &&
+              i + s <= std::min(c.last_i, i0 + n - 1) && j + s <= std::min(c.last_j, j0 + n - 1)) {
+            if (k.t == 0 && !k.square) {
+              // edge_bound_of() inside the data: the centre's offset from the hypotenuse's
+              // midpoint as error and morph bound, no sphere.
+              const std::ptrdiff_t o = (i & 1) != 0 ? 1 : std::ptrdiff_t(n);
+              const float err = round_up(
+                  std::abs(double(h.p[e]) - 0.5 * (double(h.p[e - o]) + double(h.p[e + o]))));
+              out[e] = quantized({err, err, 0.0f});
+            } else {
+              // Which stencil: the diagonal rule of squares (diamond.h), the hypotenuse's
+              // direction of edges.
+              const bool other = k.square ? ((((i - s) >> (k.t + 1)) + ((j - s) >> (k.t + 1))) & 1) != 0
+                                          : ((i >> k.t) & 1) == 0;
+              const int which = (k.t == 0 ? 0 : (k.square ? 4 : 2)) + (other ? 1 : 0);
+              out[e] = st.v[std::size_t(which)].bound(c, h.p, out.data(), std::ptrdiff_t(e));
+            }
+            continue;
+          }
+          out[e] = bound_of(c, h, i, j, at);
         }
       }
     }

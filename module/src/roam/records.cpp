@@ -281,12 +281,14 @@ void build_all(const RecordConfig& config, const world::PageGrid& grid, const He
                  0, 0, c.pad_i, c.pad_j, threads);
   }
   // Level >= 1 blocks, then level 0 (from the pages alone).
+  std::vector<PageKey> coarse;
   for (std::uint32_t k = 1; k < grid.levels; ++k)
     for (std::int32_t pz = 0; pz < grid.pz[k]; ++pz)
-      for (std::int32_t px = 0; px < grid.px[k]; ++px) {
-        const PageKey key{k, px, pz};
-        out(key, slice(c, grids, grid.levels, key));
-      }
+      for (std::int32_t px = 0; px < grid.px[k]; ++px) coarse.push_back({k, px, pz});
+  parallel_rows(std::int64_t(coarse.size()), threads, [&](std::int64_t r) {
+    const PageKey& key = coarse[std::size_t(r)];
+    out(key, slice(c, grids, grid.levels, key));
+  });
   if (!level0) return;
   const std::int64_t n0 = std::int64_t(grid.count(0));
   parallel_rows(n0, threads, [&](std::int64_t r) {

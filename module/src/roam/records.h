@@ -59,8 +59,7 @@ inline std::uint32_t up12(float v) noexcept {
   if (!(v < 1.0e30f)) return kInfinity;
   const std::uint32_t bits = std::bit_cast<std::uint32_t>(v);
   std::int32_t e = std::int32_t(bits >> 23) - 127 + kBias;
-  std::uint32_t m = (bits & 0x7fffffu) >> 17;
-  if ((bits & 0x1ffffu) != 0) ++m;
+  std::uint32_t m = ((bits & 0x7fffffu) >> 17) + std::uint32_t((bits & 0x1ffffu) != 0);
   if (m == 64) m = 0, ++e;
   if (e < 1) return 1u << 6;  // the smallest positive value
   const std::uint32_t c = (std::uint32_t(e) << 6) | m;
@@ -74,6 +73,13 @@ inline float down12(std::uint32_t c) noexcept {
 inline const std::array<float, 256> kRatio = [] {
   std::array<float, 256> r{};
   for (int c = 0; c < 256; ++c) r[std::size_t(c)] = float(std::exp2(double(c) / 64.0));
+  return r;
+}();
+// floor(64 log2(1 + m / 256)) for the top 8 mantissa bits m: pack()'s first guess of the morph
+// code (then corrected against kRatio exactly), instead of a log2 per bound.
+inline const std::array<std::uint8_t, 256> kLog2Mantissa = [] {
+  std::array<std::uint8_t, 256> r{};
+  for (int m = 0; m < 256; ++m) r[std::size_t(m)] = std::uint8_t(std::floor(64.0 * std::log2(1.0 + m / 256.0)));
   return r;
 }();
 inline DiamondBound unpack(std::uint32_t v) noexcept {
@@ -90,7 +96,15 @@ inline std::uint32_t pack(const DiamondBound& b) noexcept {
       ce = kInfinity, e = down12(ce);
     } else {
       if (!(e * kRatio[255] >= morph)) ce = up12(morph / kRatio[255] * (1.0f + 0x1p-12f)), e = down12(ce);
-      int c = std::clamp(int(std::ceil(64.0 * std::log2(double(morph) / double(e)))), 0, 255);
+      // The smallest c with e 2^(c/64) >= morph: a guess from the ratio's bits within a step or
+      // two, then the exact search below (any start gives the same c).
+      const std::uint32_t rb = std::bit_cast<std::uint32_t>(morph / e);
+      // The guess g is floor(64 log2(morph / e)) or one below, and kRatio's rounding moves the
+      // answer by at most one more: it is g - 1 plus how many of the four codes from g - 1 fall
+      // short (the test is monotonic in c; four independent comparisons); the loops only confirm.
+      const int g = std::clamp((int(rb >> 23) - 127) * 64 + kLog2Mantissa[(rb >> 15) & 0xffu] - 1, 0, 251);
+      int c = g;
+      for (int k = 0; k < 4; ++k) c += int(e * kRatio[std::size_t(g + k)] < morph);
       while (c > 0 && e * kRatio[std::size_t(c - 1)] >= morph) --c;
       while (c < 255 && e * kRatio[std::size_t(c)] < morph) ++c;
       cm = std::uint32_t(c);

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <vector>
 
+#include "roam/diamond_bounds.h"
 #include "roam/records.h"
 
 using namespace ridgeline;
@@ -71,4 +72,66 @@ TEST(Records, PackedBoundsNeverComeBackBelowWhatTheyStore) {
   EXPECT_EQ(quantized({0.0f, 0.0f, 0.0f}).error, 0.0f);
   EXPECT_TRUE(std::isinf(quantized({FLT_MAX, FLT_MAX, FLT_MAX}).error));
   EXPECT_TRUE(std::isinf(quantized({1.0f, 1.0f, FLT_MAX}).radius));
+}
+
+// The bounds of the small diamonds (t <= 1: most of every world's) come from fixed stencils where
+// a diamond lies inside the data, and from the general diamond_bound() elsewhere: both must give
+// the same bounds bit for bit, or a baked world's level-0 blocks and the in-memory ones, and the
+// pages near a border and the others, would disagree. Blocks placed over every border case (the
+// world's first samples, its last ones, padding past them), rough heights, odd spacings.
+TEST(Records, SmallDiamondStencilsGiveTheGeneralBoundsBitForBit) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> height(-40.0f, 40.0f);
+  std::size_t compared = 0, differing = 0;
+  for (int round = 0; round < 24; ++round) {
+    RecordConfig c;
+    c.patch_log2 = 3 + round % 4;
+    c.growth = 1.0 + 0.25 * (round % 3);
+    c.last_i = 37 + round, c.last_j = 29 + 2 * round;
+    const std::int64_t P = std::int64_t{1} << c.patch_log2;
+    c.pad_i = ((c.last_i + P - 1) / P) * P, c.pad_j = ((c.last_j + P - 1) / P) * P;
+    c.spacing_x = 0.7 + 0.1 * round, c.spacing_z = 1.9 - 0.05 * round;
+    const std::int64_t n = 24;
+    const std::int64_t i0 = (round % 3 == 0) ? -6 : (round % 3 == 1 ? c.last_i - 14 : 5);
+    const std::int64_t j0 = (round % 2 == 0) ? -6 : c.last_j - 10;
+    std::vector<float> block(std::size_t(n * n));
+    for (float& v : block) v = (round % 5 == 0) ? std::round(height(rng)) : height(rng);
+    const bounds::DenseBlock h{block.data(), i0, j0, n};
+    std::vector<DiamondBound> fast, general;
+    bounds::small_bounds(c, h, fast, true);
+    bounds::small_bounds(c, h, general, false);
+    ASSERT_EQ(fast.size(), general.size());
+    for (std::size_t e = 0; e < fast.size(); ++e) {
+      ++compared;
+      const bool same = std::bit_cast<std::uint32_t>(fast[e].error) == std::bit_cast<std::uint32_t>(general[e].error) &&
+                        std::bit_cast<std::uint32_t>(fast[e].morph) == std::bit_cast<std::uint32_t>(general[e].morph) &&
+                        std::bit_cast<std::uint32_t>(fast[e].radius) == std::bit_cast<std::uint32_t>(general[e].radius);
+      if (!same && ++differing <= 5)
+        ADD_FAILURE() << "round " << round << ", sample (" << i0 + std::int64_t(e) % n << ", "
+                      << j0 + std::int64_t(e) / n << "): stencil error " << fast[e].error << " morph "
+                      << fast[e].morph << " radius " << fast[e].radius << ", general "
+                      << general[e].error << " / " << general[e].morph << " / " << general[e].radius;
+    }
+  }
+  EXPECT_EQ(differing, 0u);
+  EXPECT_GT(compared, 10000u);
+}
+
+// The morph code's search: pack() keeps the smallest ratio step 2^(c/64) that covers the morph
+// bound over the packed error, whatever its first guess.
+TEST(Records, PackedMorphRatioIsTheSmallestStepThatCovers) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> mant(1.0f, 2.0f);
+  std::uniform_real_distribution<float> ratio(1.0f, 20.0f);
+  for (int k = 0; k < 200000; ++k) {
+    const float e = std::ldexp(mant(rng), int(k % 40) - 20);
+    const float m = e * ratio(rng);
+    const std::uint32_t v = packed::pack({e, m, 0.0f});
+    const float pe = packed::down12(v & 0xfffu);
+    const std::uint32_t c = v >> 24;
+    ASSERT_GE(pe * packed::kRatio[c], m) << "the packed morph bound is below the one it bounds";
+    if (c > 0) {
+      ASSERT_LT(pe * packed::kRatio[c - 1], m) << "a smaller ratio step would cover it";
+    }
+  }
 }
