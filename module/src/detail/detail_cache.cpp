@@ -12,6 +12,7 @@
 #include <unordered_map>
 
 #include "format.h"
+#include "platform/thread_priority.h"
 #include "ridgeline/detail.h"
 #include "ridgeline/log.h"
 
@@ -220,6 +221,7 @@ Result<std::unique_ptr<DetailCache>> DetailCache::create(std::shared_ptr<const D
       State* raw = s.get();
       std::weak_ptr<State> weak = s;
       s->workers.emplace_back([raw, weak] {
+        detail::lower_this_thread();
         for (;;) {
           {
             std::unique_lock<std::mutex> lock(raw->mu);

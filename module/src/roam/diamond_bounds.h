@@ -15,7 +15,7 @@
 #include <limits>
 #include <vector>
 
-#if defined(__SSE2__) || defined(_M_X64)
+#if !defined(RIDGELINE_PORTABLE) && (defined(__SSE2__) || defined(_M_X64))
 #include <emmintrin.h>
 #endif
 
@@ -209,11 +209,11 @@ inline const RowShapes& row_shapes() {
 }
 
 // max |row[x] aw - (S x + T)| over x in [0, n): two lanes of SSE2 where there is SSE2 (every
-// x86-64), one elsewhere; the same values either way (each lane rounds as the scalar code does).
+// x86-64; not with RIDGELINE_PORTABLE), one elsewhere; the same values either way (each lane rounds as the scalar code does).
 [[gnu::always_inline]] inline double row_worst(const float* row, std::int64_t n, double aw, double S, double T) noexcept {
   std::int64_t x = 0;
   double worst = 0.0;
-#if defined(__SSE2__) || defined(_M_X64)
+#if !defined(RIDGELINE_PORTABLE) && (defined(__SSE2__) || defined(_M_X64))
   const __m128d sign = _mm_set1_pd(-0.0), vaw = _mm_set1_pd(aw), vS = _mm_set1_pd(S),
                 vT = _mm_set1_pd(T), step = _mm_set1_pd(4.0);
   __m128d x01 = _mm_set_pd(1.0, 0.0), x23 = _mm_set_pd(3.0, 2.0);

@@ -7,6 +7,7 @@
 // without a lock. A page's missing ancestors are loaded with it, coarsest first (the
 // tessellator reads a diamond's coarser ancestors before it).
 #include "world/page_store.h"
+#include "platform/thread_priority.h"
 #include "world/page_cache.h"
 
 #include <algorithm>
@@ -172,6 +173,7 @@ Result<std::shared_ptr<PageStore>> PageStore::open(std::shared_ptr<const PageSou
     PageStore* raw = s.get();
     for (std::uint32_t t = 0; t < desc.worker_threads; ++t)
       c->workers.emplace_back([raw] {
+        detail::lower_this_thread();
         Cache& cc = *raw->cache_;
         for (;;) {
           PageKey key;
