@@ -117,12 +117,6 @@ int run_bake(const BakeArgs& a) {
     io::LoadReport lr;
     auto hf = a.terrain.load_heightfield(&lr);
     if (!hf) return report_error(hf.error().message);
-    // A world's pages hold heights and materials only; its holes would be lost.
-    if (!hf->hole_cells().empty())
-      return report_error("bake: --fill hole made " + std::to_string(hf->hole_cells().size()) +
-                          " cells holes, and a baked world does not hold holes yet; bake with "
-                          "--fill nearest and make the holes with hole edits (saved with the "
-                          "edits, docs/deformation.md)");
     rep = io::bake_world(*hf, a.out, o);
   }
   if (bar) std::fprintf(stderr, "\n");
@@ -141,6 +135,7 @@ int run_bake(const BakeArgs& a) {
       {"seconds", rep->seconds},
       {"bounds_seconds", rep->bounds_seconds},
       {"pages_seconds", rep->pages_seconds},
+      {"hole_cells", rep->hole_cells},
       {"samples_per_second", double(rep->samples) / std::max(rep->seconds, 1e-9)},
       {"patch_exponent", rep->patch_exponent},
       {"content_hash", hash},

@@ -96,7 +96,19 @@ Result<std::shared_ptr<Terrain>> Terrain::open(std::shared_ptr<const PageSource>
                                                const WorldCacheDesc& cache) {
   auto store = world::PageStore::open(std::move(source), cache);
   if (!store) return store.error();
-  return std::shared_ptr<Terrain>(new Terrain(std::move(*store), nullptr, nullptr));
+  // The world's own holes, as take_holes() makes a field's: the terrain's first hole mask, and
+  // the one its baked bounds were made around.
+  std::shared_ptr<HoleMask> holes;
+  for (const HoleRun& r : (*store)->hole_runs()) {
+    if (!holes) holes = std::make_shared<HoleMask>();
+    holes->set_run(r.j, r.i0, r.i1);
+  }
+  std::shared_ptr<Terrain> t(new Terrain(std::move(*store), nullptr, nullptr));
+  if (holes) {
+    t->surface_.edits_->set_baked_holes(holes);
+    t->surface_.publish_holes(holes);  // immutable: shared, not copied
+  }
+  return t;
 }
 
 std::shared_ptr<Terrain> Terrain::clone() const {

@@ -348,7 +348,9 @@ TEST(World, DamagedTruncatedNewerAndForeignFilesAreRefused) {
   {
     std::vector<std::uint8_t> b = good;
     b[16 + 8] = 9;  // the locator's version
-    EXPECT_NE(refused(b, "format version 9; this build reads version"), "opened");
+    EXPECT_NE(refused(b, "format version 9; this build reads versions 3 to 4"), "opened");
+    b[16 + 8] = 2;  // older than any this build reads
+    EXPECT_NE(refused(b, "format version 2; this build reads versions 3 to 4"), "opened");
   }
   {
     std::vector<std::uint8_t> b = good;
@@ -588,4 +590,83 @@ TEST(World, HolesOnABakedWorldAreTheMapsHoles) {
   EXPECT_EQ(before_view->mesh_hash(), converged_mesh(memory, cam, &cracks));
   EXPECT_EQ(cracks, "");
   EXPECT_EQ(converged_mesh(world, cam), converged_mesh(memory, cam));
+}
+
+// The map's own holes (no-data samples with FillPolicy::kHole) are baked with the world: a world
+// opened from the file has the same hole cells as the terrain made in memory from the map, the
+// same answers to queries (no ground over a hole), the same converged mesh (its baked bounds made
+// around the holes), crack-free; a fill edit gives the ground back on both. A hole list that
+// leaves the cells is refused when the file is opened.
+TEST(World, TheMapsOwnHolesAreBakedWithTheWorld) {
+  const std::string path = tmp_path("w.tif");
+  auto holed = [] {
+    const Heightfield g = generated(513, 385);
+    std::vector<float> h(g.local_heights().begin(), g.local_heights().end());
+    for (std::int64_t j = 0; j < 385; ++j)
+      for (std::int64_t i = 0; i < 513; ++i) {
+        const double a = double(i - 300), b = double(j - 200);
+        if (a * a + 0.5 * b * b < 40.0 * 40.0 || (i >= 40 && i < 44 && j >= 30 && j < 300))
+          h[std::size_t(i) + std::size_t(j) * 513] = -9999.0f;
+      }
+    HeightfieldDesc d;
+    d.width = 513, d.height = 385;
+    d.spacing_x = 2.0, d.spacing_z = 1.5;
+    d.origin_x = 1000.0, d.origin_z = -3000.0;
+    d.height_offset = 120.0;
+    d.height_scale = scenes::kWorldHeightScale;
+    d.nodata = -9999.0;
+    d.fill = FillPolicy::kHole;
+    return Heightfield::create(d, std::move(h)).value();
+  };
+  const Heightfield map = holed();
+  ASSERT_GT(map.hole_cells().size(), 3000u);
+  auto baked = io::bake_world(map, path);
+  ASSERT_TRUE(baked) << baked.error().message;
+  EXPECT_EQ(baked->hole_cells, map.hole_cells().size());
+  auto memory = Terrain::create(holed()).value();
+  auto world = open_baked(path);
+  ASSERT_EQ(world->surface().hole_cells(), memory->surface().hole_cells());
+  ASSERT_EQ(world->surface().hole_cells(), map.hole_cells().size());
+  EXPECT_EQ(world->info().content_hash, memory->info().content_hash);
+  const WorldInfo& w = memory->info();
+  std::size_t none = 0;
+  for (const glm::dvec2& p : points(w, 4000, 21)) {
+    const auto a = memory->sample(p.x, p.y), b = world->sample(p.x, p.y);
+    ASSERT_EQ(a.has_value(), b.has_value()) << p.x << ", " << p.y;
+    none += !a;
+    if (a) EXPECT_EQ(a->height, b->height) << p.x << ", " << p.y;
+  }
+  EXPECT_GT(none, 100u) << "no point fell in a hole: the test misses its subject";
+  const double hx = w.origin_x + 300 * 2.0 + 0.5, hz = w.origin_z + 200 * 1.5 + 0.5;
+  EXPECT_FALSE(world->height(hx, hz));
+  for (const auto& f : {std::pair{0.45, 0.35}, std::pair{0.05, 0.1}}) {
+    std::string cracks;
+    const Camera cam = looking_over(*memory, f.first, f.second);
+    EXPECT_EQ(converged_mesh(world, cam, &cracks), converged_mesh(memory, cam))
+        << "the baked world's converged mesh differs from the map's";
+    EXPECT_EQ(cracks, "");
+  }
+  for (auto* t : {memory.get(), world.get()})
+    ASSERT_TRUE(t->apply_edit({.brush = Brush::kFillHole, .x = hx, .z = hz, .radius = 100}));
+  EXPECT_EQ(world->surface().hole_cells(), memory->surface().hole_cells());
+  EXPECT_TRUE(world->height(hx, hz));
+  EXPECT_EQ(world->height(hx, hz), memory->height(hx, hz));
+
+  // A hole run past the cells: refused at the open, naming the file.
+  struct Lying : PageSource {
+    std::shared_ptr<const PageSource> inner;
+    const WorldInfo& info() const noexcept override { return inner->info(); }
+    Status summaries(std::vector<PageSummary>& out) const override { return inner->summaries(out); }
+    Status load(const PageKey& k, PageData& out) const override { return inner->load(k, out); }
+    Status holes(std::vector<HoleRun>& out) const override {
+      out = {{10, 500, 512}};  // cell 512 of a 512-cell row
+      return {};
+    }
+  };
+  auto lying = std::make_shared<Lying>();
+  lying->inner = io::open_world(path).value();
+  auto refused = Terrain::open(lying, {});
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().message.find("lies outside its 512 x 384 cells"), std::string::npos)
+      << refused.error().message;
 }

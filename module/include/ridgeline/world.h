@@ -91,6 +91,13 @@ struct BakedRecords {
   double morph_delay = 0.1;
 };
 
+/// Cells i0 .. i1 (inclusive) of row j of stored cells (cell (i, j) lies between samples i, i + 1
+/// and j, j + 1) without ground: a world's holes (docs/deformation.md, "Holes").
+struct HoleRun {
+  std::uint32_t j = 0, i0 = 0, i1 = 0;
+  friend bool operator==(const HoleRun&, const HoleRun&) = default;
+};
+
 /// One page as a PageSource delivers it.
 struct PageData {
   /// kPageEntries heights, row-major (entry (a, b) at (a + 6) + (b + 6) * kPageStride): u16 for
@@ -121,6 +128,14 @@ class PageSource {
   /// Fills `out` with page `key`. An error (unreadable, corrupt: named in the message) leaves the
   /// page missing: views keep their coarser mesh there and queries answer "no data".
   virtual Status load(const PageKey& key, PageData& out) const = 0;
+  /// The world's own holes (cells without ground from its input: no-data values, an alpha
+  /// channel), read once when the world is opened; Terrain::open makes them its first hole mask,
+  /// as Terrain::create does with a Heightfield's. Resident for the whole world: one bit per hole
+  /// cell in blocks of 32 x 32 cells. Default: none.
+  virtual Status holes(std::vector<HoleRun>& out) const {
+    out.clear();
+    return {};
+  }
 };
 
 /// How a terrain opened from a PageSource keeps its pages.

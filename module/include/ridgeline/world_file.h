@@ -35,6 +35,10 @@ struct BakeSamples {
   const std::uint16_t* u16 = nullptr;
   const float* f32 = nullptr;
   const std::uint8_t* materials = nullptr;
+  /// Cells without ground (index i + j (width - 1), as Heightfield::hole_cells() gives them):
+  /// stored with the world (PageSource::holes) and its bounds made around them, as a terrain in
+  /// memory makes them. Empty: none.
+  std::span<const std::uint64_t> hole_cells;
 };
 
 /// How to bake.
@@ -68,6 +72,7 @@ struct BakeReport {
   double max_error_m = 0;         ///< largest |stored - input| height (0 when kept exactly)
   std::uint64_t content_hash = 0; ///< the world's WorldInfo::content_hash
   std::uint32_t patch_exponent = 0;  ///< the baked bounds' configuration
+  std::uint64_t hole_cells = 0;      ///< cells without ground stored with the world
 };
 
 /// Bakes `samples` into the world file `path`: written to a temporary file beside it, flushed and
@@ -79,8 +84,8 @@ Result<BakeReport> bake_world(const BakeSamples& samples, const std::string& pat
                               const BakeOptions& options = {});
 
 /// Bakes a Heightfield (16-bit when every sample is an integer times its height scale, floats
-/// otherwise, as Terrain::create stores it): the world's surface equals the terrain's
-/// Terrain::create(heightfield) makes, bit for bit, and so does its content hash.
+/// otherwise, as Terrain::create stores it) with its holes: the world's surface equals the
+/// terrain's Terrain::create(heightfield) makes, bit for bit, and so does its content hash.
 Result<BakeReport> bake_world(const Heightfield& heightfield, const std::string& path,
                               const BakeOptions& options = {});
 

@@ -12,6 +12,8 @@
 //   apron      the ring of entries around the tile (kPageEntries - 256^2 samples), Deflate
 //   materials  kPageEntries material ids, Deflate (empty when the world has none)
 //   records    the tessellator's baked bounds of the page (levels >= 1), Deflate (roam/records.h)
+// The index ends with the world's holes (version 4): their count, then (j, i0, i1) per run of
+// hole cells along a row of cells.
 // A level whose size is 2^k + 1 samples has one column and row past its pages' tiles: the TIFF
 // gets extra tiles for them (after the last page of each row and column, outside the index), so
 // that its tile grid covers the image; Ridgeline reads those samples from the pages' aprons.
@@ -31,7 +33,9 @@
 namespace ridgeline::io::world_file {
 
 inline constexpr char kMagic[8] = {'R', 'I', 'D', 'G', 'E', 'W', 'L', 'D'};
-inline constexpr std::uint32_t kVersion = 3;  // 2: six-entry aprons; 3: 4-byte bounds
+inline constexpr std::uint32_t kVersion = 4;  // 2: six-entry aprons; 3: 4-byte bounds; 4: holes
+/// The oldest version this build reads (3: as 4 without holes).
+inline constexpr std::uint32_t kOldestVersion = 3;
 /// Bytes 16 .. 79 of the file: the locator.
 inline constexpr std::size_t kLocatorAt = 16;
 inline constexpr std::size_t kLocatorBytes = 64;

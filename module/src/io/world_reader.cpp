@@ -31,6 +31,10 @@ class WorldSource final : public PageSource {
     return {};
   }
   Status load(const PageKey& key, PageData& out) const override;
+  Status holes(std::vector<HoleRun>& out) const override {
+    out = holes_;
+    return {};
+  }
 
   static Result<std::shared_ptr<const PageSource>> open(const std::string& path);
 
@@ -45,6 +49,7 @@ class WorldSource final : public PageSource {
   std::vector<PageSummary> summaries_;
   std::vector<std::size_t> level_first_;  // index of each level's first page
   std::vector<PageEntry> pages_;
+  std::vector<HoleRun> holes_;
 };
 
 Status WorldSource::read_at(std::uint64_t offset, void* into, std::size_t n) const {
@@ -90,9 +95,9 @@ Result<std::shared_ptr<const PageSource>> WorldSource::open(const std::string& p
   const auto index_sum = lr.get<std::uint64_t>();
   const auto data_end = lr.get<std::uint64_t>();
   const auto loc_sum = lr.get<std::uint64_t>();
-  if (version != kVersion)
-    return Error{fmt("%s: format version %u; this build reads version %u (bake it again)",
-                     s->name_.c_str(), version, kVersion)};
+  if (version < kOldestVersion || version > kVersion)
+    return Error{fmt("%s: format version %u; this build reads versions %u to %u (bake it again)",
+                     s->name_.c_str(), version, kOldestVersion, kVersion)};
   if (loc_sum != checksum(loc, 48))
     return Error{fmt("%s: its header is corrupted (checksum mismatch)", s->name_.c_str())};
   if (data_end > s->file_bytes_)
@@ -183,6 +188,22 @@ Result<std::shared_ptr<const PageSource>> WorldSource::open(const std::string& p
     e.checksum = in.get<std::uint64_t>();
     if (in.ok() && (e.offset < kDataStart || e.offset + e.bytes() > data_end))
       return Error{fmt("%s: a page lies outside the file (corrupted)", s->name_.c_str())};
+  }
+  if (version >= 4) {
+    // The holes: runs along rows of cells, inside the cells, in order and apart.
+    const auto runs = in.get<std::uint64_t>();
+    if (!in.ok() || runs > (index.size() - std::min(in.at, index.size())) / 12)
+      return Error{fmt("%s: its hole list is corrupted", s->name_.c_str())};
+    s->holes_.resize(std::size_t(runs));
+    for (std::size_t k = 0; k < s->holes_.size(); ++k) {
+      HoleRun& r = s->holes_[k];
+      r.j = in.get<std::uint32_t>(), r.i0 = in.get<std::uint32_t>(), r.i1 = in.get<std::uint32_t>();
+      const bool after = k == 0 || r.j > s->holes_[k - 1].j ||
+                         (r.j == s->holes_[k - 1].j && r.i0 > s->holes_[k - 1].i1 + 1);
+      if (!in.ok() || r.i0 > r.i1 || r.i1 + 1 >= w.width || r.j + 1 >= w.height || !after)
+        return Error{fmt("%s: hole run %zu is corrupted (row %u, cells %u .. %u of %u x %u)",
+                         s->name_.c_str(), k, r.j, r.i0, r.i1, w.width - 1, w.height - 1)};
+    }
   }
   if (!in.ok() || in.at != index.size())
     return Error{fmt("%s: its index has %s bytes (corrupted)", s->name_.c_str(),

@@ -23,6 +23,7 @@
 #include "io/world_tiff.h"
 #include "ridgeline/world_file.h"
 #include "roam/records.h"
+#include "surface/hole_mask.h"
 #include "world/page.h"
 
 namespace ridgeline::io {
@@ -148,6 +149,29 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
   if (o.tolerance && !(std::isfinite(*o.tolerance) && *o.tolerance > 0))
     return Error{fmt("%s: tolerance %s m; need a finite value > 0 (--tolerance)", what.c_str(),
                      num(o.tolerance.value_or(0)).c_str())};
+  // The holes: checked, as runs along rows (what the index stores) and as the mask the bounds
+  // are made around.
+  std::vector<HoleRun> hole_runs;
+  std::shared_ptr<HoleMask> holes;
+  if (!in.hole_cells.empty()) {
+    const std::uint64_t cx = info.width - 1, cells = cx * std::uint64_t(info.height - 1);
+    std::vector<std::uint64_t> sorted(in.hole_cells.begin(), in.hole_cells.end());
+    std::sort(sorted.begin(), sorted.end());
+    sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
+    if (sorted.back() >= cells)
+      return Error{fmt("%s: hole cell %llu is outside the %u x %u cells", what.c_str(),
+                       static_cast<unsigned long long>(sorted.back()), info.width - 1,
+                       info.height - 1)};
+    holes = std::make_shared<HoleMask>();
+    for (const std::uint64_t c : sorted) {
+      const auto i = std::uint32_t(c % cx), j = std::uint32_t(c / cx);
+      if (!hole_runs.empty() && hole_runs.back().j == j && hole_runs.back().i1 + 1 == i)
+        hole_runs.back().i1 = i;
+      else
+        hole_runs.push_back({j, i, i});
+    }
+    for (const HoleRun& r : hole_runs) holes->set_run(r.j, r.i0, r.i1);
+  }
   const unsigned threads =
       o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
   const std::size_t n = std::size_t(info.width) * info.height;
@@ -274,6 +298,9 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
     const std::int64_t P = std::int64_t{1} << exponent;
     rc.pad_i = ((rc.last_i + P - 1) / P) * P, rc.pad_j = ((rc.last_j + P - 1) / P) * P;
     rc.spacing_x = info.spacing_x, rc.spacing_z = info.spacing_z;
+    // Around the holes as a terrain in memory makes them (records.h: the diamonds over a hole's
+    // edge split to the finest level).
+    if (holes) rc.hole_source = [holes] { return std::shared_ptr<const HoleMask>(holes); };
     std::vector<std::size_t> level_first;
     std::size_t total_pages = 0;
     for (std::uint32_t k = 0; k < grid.levels; ++k) {
@@ -292,6 +319,7 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
     rep.bounds_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - tb).count();
     rep.patch_exponent = exponent;
+    rep.hole_cells = holes ? holes->cells() : 0;
     report(0.35, "pages");
 
     // ---- pages ------------------------------------------------------------------------------
@@ -538,6 +566,9 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
       w.put(e.offset), w.put(e.tile), w.put(e.apron), w.put(e.materials), w.put(e.records);
       w.put(e.checksum);
     }
+    // Version 4: the holes as runs of cells along rows.
+    w.put(std::uint64_t(hole_runs.size()));
+    for (const HoleRun& r : hole_runs) w.put(r.j), w.put(r.i0), w.put(r.i1);
     const std::uint64_t index_at = out.size();
     if (auto s = out.write(w.bytes.data(), w.bytes.size()); !s) return Error{s.message()};
 
@@ -654,6 +685,7 @@ Result<BakeReport> bake_world(const Heightfield& hf, const std::string& path,
     s.info.format = SampleFormat::kF32;
     s.f32 = hf.local_heights().data();
   }
+  s.hole_cells = hf.hole_cells();
   std::vector<std::uint8_t> mats;
   if (hf.has_materials()) {
     mats.resize(std::size_t(hf.width()) * hf.height());

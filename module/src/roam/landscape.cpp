@@ -511,9 +511,29 @@ Result<std::shared_ptr<const Landscape>> Landscape::create(std::shared_ptr<const
                                       std::min(j0 + kPageCells, store.grid().last_j)),
                         true);
     }
-    // So do the holes (records.h): remade around every block of them.
-    if (const auto holes = c.hole_source())
-      for (const auto& [k, bits] : holes->sorted_blocks()) {
+    // So do the holes (records.h): remade around every block of them that differs from the
+    // holes the world was baked with (none when the terrain's mask is still the world's own).
+    const std::shared_ptr<const HoleMask> holes = c.hole_source();
+    const std::shared_ptr<const HoleMask>& baked =
+        detail::SurfaceAccess::edits(surface).baked_holes();
+    if (holes != baked) {
+      std::vector<std::pair<std::uint64_t, HoleMask::Bits>> now, then;
+      if (holes) now = holes->sorted_blocks();
+      if (baked) then = baked->sorted_blocks();
+      // Both in ascending key order: the keys held by one only, or with other bits.
+      std::vector<std::uint64_t> differ;
+      std::size_t a = 0, b = 0;
+      while (a < now.size() || b < then.size()) {
+        if (b == then.size() || (a < now.size() && now[a].first < then[b].first)) {
+          differ.push_back(now[a++].first);
+        } else if (a == now.size() || then[b].first < now[a].first) {
+          differ.push_back(then[b++].first);
+        } else {
+          if (now[a].second != then[b].second) differ.push_back(now[a].first);
+          ++a, ++b;
+        }
+      }
+      for (const std::uint64_t k : differ) {
         const std::int64_t i0 = std::int64_t(k & 0xffffffffu) << HoleMask::kShift;
         const std::int64_t j0 = std::int64_t(k >> 32) << HoleMask::kShift;
         store.set_records(
@@ -522,6 +542,7 @@ Result<std::shared_ptr<const Landscape>> Landscape::create(std::shared_ptr<const
                           std::min(j0 + HoleMask::kBlock, store.grid().last_j)),
             true);
       }
+    }
   }
   store.set_records(m.slot, blocks);
   l->build_ms_ =

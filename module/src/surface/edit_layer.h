@@ -24,7 +24,8 @@ namespace ridgeline {
 class EditLayer {
  public:
   EditLayer() = default;
-  EditLayer(const EditLayer& o) : originals_(o.originals_), holes_(o.hole_snapshot()) {}
+  EditLayer(const EditLayer& o)
+      : originals_(o.originals_), holes_(o.hole_snapshot()), baked_holes_(o.baked_holes_) {}
   EditLayer& operator=(const EditLayer&) = delete;
 
   static constexpr std::uint32_t kChunkShift = 5;
@@ -59,6 +60,10 @@ class EditLayer {
     std::lock_guard lock(holes_mu_);
     return holes_;
   }
+  /// The holes a baked world's bounds were made around (its own, from the open), or null: a
+  /// Landscape remakes bounds only where the mask differs from them.
+  const std::shared_ptr<const HoleMask>& baked_holes() const noexcept { return baked_holes_; }
+  void set_baked_holes(std::shared_ptr<const HoleMask> m) { baked_holes_ = std::move(m); }
   /// Publishes a new mask (null or empty: no holes). Exclusive access (an edit).
   void set_holes(std::shared_ptr<const HoleMask> m) {
     if (m != nullptr && m->empty()) m.reset();
@@ -70,6 +75,7 @@ class EditLayer {
   std::unordered_map<std::uint64_t, std::vector<float>> originals_;
   mutable std::mutex holes_mu_;
   std::shared_ptr<const HoleMask> holes_;
+  std::shared_ptr<const HoleMask> baked_holes_;
 };
 
 }  // namespace ridgeline

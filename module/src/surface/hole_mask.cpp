@@ -3,6 +3,7 @@
 #include "surface/hole_mask.h"
 
 #include <algorithm>
+#include <bit>
 
 namespace ridgeline {
 
@@ -24,6 +25,23 @@ bool HoleMask::set(std::int64_t i, std::int64_t j, bool hole) {
   ++blk.count;
   ++cells_;
   return true;
+}
+
+void HoleMask::set_run(std::int64_t j, std::int64_t i0, std::int64_t i1) {
+  const std::int64_t row = j & (kBlock - 1);
+  for (std::int64_t bx = i0 >> kShift; bx <= (i1 >> kShift); ++bx) {
+    const std::int64_t a = std::max(i0, bx << kShift) & (kBlock - 1);
+    const std::int64_t b = std::min(i1, (bx << kShift) + kBlock - 1) & (kBlock - 1);
+    // The row's 32 bits are one half of word row / 2 (kBlock = 32).
+    const std::uint64_t run = ((std::uint64_t{1} << (b - a + 1)) - 1) << a;
+    const std::uint64_t m = run << (32 * (row & 1));
+    Block& blk = blocks_[key(bx, j >> kShift)];
+    std::uint64_t& w = blk.bits[std::size_t(row >> 1)];
+    const auto added = std::uint32_t(std::popcount(m & ~w));
+    w |= m;
+    blk.count += added;
+    cells_ += added;
+  }
 }
 
 bool HoleMask::any_in(std::int64_t i0, std::int64_t j0, std::int64_t i1, std::int64_t j1) const {

@@ -45,6 +45,9 @@ class HoleMask {
   bool empty() const noexcept { return cells_ == 0; }
   /// Makes cell (i, j) (i, j >= 0) a hole or solid; true when that changed it.
   bool set(std::int64_t i, std::int64_t j, bool hole);
+  /// Makes cells i0 .. i1 of row j holes (0 <= i0 <= i1, j >= 0): a block's row at a time (a
+  /// baked world's holes at its open).
+  void set_run(std::int64_t j, std::int64_t i0, std::int64_t i1);
   /// Calls f(i, j) for every hole cell in [i0, i1] x [j0, j1] (inclusive), block by block.
   template <class F>
   void for_each_in(std::int64_t i0, std::int64_t j0, std::int64_t i1, std::int64_t j1,

@@ -127,6 +127,15 @@ Result<std::shared_ptr<PageStore>> PageStore::open(std::shared_ptr<const PageSou
   if (s->summaries_.size() != s->grid_.count(0))
     return Error{fmt("%s: %zu page summaries; need %zu", info.name.c_str(), s->summaries_.size(),
                      s->grid_.count(0))};
+  {
+    // The world's own holes, inside the cells.
+    if (auto st = s->source_->holes(s->hole_runs_); !st) return Error{st.message()};
+    for (const HoleRun& r : s->hole_runs_)
+      if (r.i0 > r.i1 || std::uint64_t(r.i1) + 1 >= info.width ||
+          std::uint64_t(r.j) + 1 >= info.height)
+        return Error{fmt("%s: a hole run (row %u, cells %u .. %u) lies outside its %u x %u cells",
+                         info.name.c_str(), r.j, r.i0, r.i1, info.width - 1, info.height - 1)};
+  }
   s->rebuild_upper(0, 0, s->grid_.px[0] - 1, s->grid_.pz[0] - 1);
   auto c = std::make_shared<Cache>();
   c->budget = desc.budget_bytes;
@@ -205,6 +214,7 @@ std::shared_ptr<PageStore> PageStore::clone() const {
   s->grid_ = grid_;
   s->source_ = source_;
   s->baked_ = baked_;
+  s->hole_runs_ = hole_runs_;
   s->summaries_ = summaries_;
   s->upper_ = upper_;
   auto c = std::make_shared<Cache>();

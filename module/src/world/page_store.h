@@ -75,6 +75,9 @@ class PageStore {
   const PageGrid& grid() const noexcept { return grid_; }
   bool paged() const noexcept { return source_ != nullptr; }
   const PageSource* source() const noexcept { return source_.get(); }
+  /// The world's own holes (PageSource::holes, checked to lie inside the cells), which its baked
+  /// bounds were made around; empty without any (and for a store made in memory).
+  const std::vector<HoleRun>& hole_runs() const noexcept { return hole_runs_; }
 
   /// The current snapshot (a shared_ptr copy under a small lock).
   std::shared_ptr<const PageTable> snapshot() const;
@@ -157,6 +160,7 @@ class PageStore {
   PageGrid grid_;
   std::shared_ptr<const PageSource> source_;
   BakedRecords baked_;
+  std::vector<HoleRun> hole_runs_;
   std::vector<PageSummary> summaries_;
   std::vector<RayLevel> upper_;
   // The record makers by slot (Landscapes add and remove theirs while workers make pages):
