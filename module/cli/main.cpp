@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "process_memory.h"
 #include "cli_util.h"
 #include "commands.h"
 #include "io/oiio_lsan_suppressions.h"
@@ -47,6 +48,7 @@ std::string unknown_subcommand(const CLI::App& app, int argc, char** argv) {
 
 int main(int argc, char** argv) {
   using namespace ridgeline::cli;
+  keep_page_buffers_out_of_arenas();
   CLI::App app{"ridge: the Ridgeline terrain tool (heightmap info, queries, profiles, benchmarks)",
                "ridge"};
   // Before the subcommands are added: they copy it.

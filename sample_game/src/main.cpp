@@ -20,6 +20,10 @@
 #include <string>
 #include <vector>
 
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
 #include "game.h"
 #include "gl_context.h"
 #include "panel.h"
@@ -400,6 +404,11 @@ int run(const Args& a) {
 }  // namespace
 
 int main(int argc, char** argv) {
+#if defined(__GLIBC__)
+  // Page-sized buffers of a baked world (--world) stay in mmap rather than fragmenting glibc's
+  // per-thread arenas (docs/worlds.md, "Memory").
+  (void)::mallopt(M_MMAP_THRESHOLD, 96 * 1024);
+#endif
   CLI::App app{"Ridgeline sample game: vehicles on deformable terrain, driven by Lua"};
   Args a;
   app.add_flag("--headless", a.headless, "simulation only, no OpenGL");

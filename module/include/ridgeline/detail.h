@@ -234,7 +234,8 @@ struct DetailCacheDesc {
   /// (about 73 KB each). Default 256 MiB.
   std::size_t budget_bytes = std::size_t{256} << 20;
   /// Worker threads of the cache's own pool, 0..64. 0 means synchronous: request() generates
-  /// the tile (and its missing ancestors) before returning. Ignored when `executor` is set.
+  /// the tile (and its missing ancestors) before returning. Ignored when `executor` is set. On
+  /// Linux they run 10 nice levels below the thread that made the cache.
   std::uint32_t worker_threads = 2;
   /// Optional job system of the embedding engine: called from request(), after the cache's lock
   /// is released, with a job to run once on any thread (it may also run it inline). The job is

@@ -145,7 +145,8 @@ struct WorldCacheDesc {
   /// budget below them is exceeded by them. >= 4 MiB; default 192 MiB.
   std::size_t budget_bytes = std::size_t{192} << 20;
   /// Worker threads of the cache's own pool, 0..64. 0: synchronous (a request loads at once).
-  /// Ignored when `executor` is set.
+  /// Ignored when `executor` is set. On Linux they run 10 nice levels below the thread that
+  /// opened the terrain, so that streaming never takes a core from the frame.
   std::uint32_t worker_threads = 2;
   /// Optional job system of the embedding engine: called with a job to run once on any thread
   /// (as DetailCacheDesc::executor).

@@ -461,11 +461,11 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
     // Offsets and sizes of the TIFF-only edge tiles, by the page they follow.
     std::unordered_map<std::size_t, std::pair<std::uint64_t, std::uint64_t>> edge_x, edge_z, edge_xz;
     // `threads` workers make the pages (cut, compressed, joined and checksummed) at most
-    // `window` ahead of this thread, which writes them in order as they come.
+    // `ahead` pages ahead of this thread, which writes them in order as they come.
     {
-      const std::size_t window = std::max<std::size_t>(std::size_t(threads) * 4, 8);
-      std::vector<CompressedPage> ring(window);
-      std::vector<std::uint8_t> ready(window, 0);
+      const std::size_t ahead = std::max<std::size_t>(std::size_t(threads) * 4, 8);
+      std::vector<CompressedPage> ring(ahead);
+      std::vector<std::uint8_t> ready(ahead, 0);
       std::mutex mu;
       std::condition_variable made, freed;
       std::size_t next = 0, written = 0;
@@ -492,7 +492,7 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
             std::size_t k;
             {
               std::unique_lock lock(mu);
-              freed.wait(lock, [&] { return stop || next >= total_pages || next < written + window; });
+              freed.wait(lock, [&] { return stop || next >= total_pages || next < written + ahead; });
               if (stop || next >= total_pages) return;
               k = next++;
             }
@@ -507,8 +507,8 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
             cp.checksum = checksum(cp.all.data(), cp.all.size());
             {
               std::lock_guard lock(mu);
-              ring[k % window] = std::move(cp);
-              ready[k % window] = 1;
+              ring[k % ahead] = std::move(cp);
+              ready[k % ahead] = 1;
             }
             made.notify_all();
           }
@@ -517,9 +517,9 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
         CompressedPage cp;
         {
           std::unique_lock lock(mu);
-          made.wait(lock, [&] { return ready[k % window] != 0; });
-          cp = std::move(ring[k % window]);
-          ready[k % window] = 0;
+          made.wait(lock, [&] { return ready[k % ahead] != 0; });
+          cp = std::move(ring[k % ahead]);
+          ready[k % ahead] = 0;
           written = k + 1;
         }
         freed.notify_all();
@@ -536,7 +536,7 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
           if (auto s = out.write(part->data(), part->size()); !s) return Error{s.message()};
         }
         if (k < grid.count(0)) page_hashes[k] = cp.hash;
-        if ((k + 1) % window == 0 || k + 1 == total_pages)
+        if ((k + 1) % ahead == 0 || k + 1 == total_pages)
           report(0.35 + 0.6 * double(k + 1) / double(total_pages), "pages");
       }
     }

@@ -1,9 +1,10 @@
 // Private: background threads below the engine's own. The page and detail caches' loaders call
 // lower_this_thread() as they start, so that streaming never takes a core from the thread that
 // updates the view or answers a query (on two cores a loader at the same priority delays the
-// frame by whole scheduler slices). Linux: a nice value 10 above the process's for this thread
-// alone. Elsewhere, and with RIDGELINE_PORTABLE, nothing (an engine that wants more passes its
-// own executor: WorldCacheDesc::executor, DetailCacheDesc::executor).
+// frame by whole scheduler slices). Linux: a nice value 10 above the one it inherited from the
+// thread that made the cache, for this thread alone. Elsewhere, and with RIDGELINE_PORTABLE,
+// nothing (an engine that wants more passes its own executor: WorldCacheDesc::executor,
+// DetailCacheDesc::executor).
 #pragma once
 
 #if !defined(RIDGELINE_PORTABLE) && defined(__linux__)

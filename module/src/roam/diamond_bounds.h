@@ -168,7 +168,7 @@ struct RowShapes {
             if (sx == 0 && sz == 0) continue;
             const std::int64_t ux = std::int64_t(sx) << a, uz = std::int64_t(sz) << a;
             const std::int64_t vx = left ? -uz : uz, vz = left ? ux : -ux;  // R - A
-            int size, dir;
+            int size = 0, dir = 0;
             slot(ux, uz, size, dir);
             Shape& sh = shapes[size][dir][left ? 1 : 0];
             const std::int64_t w = ux * vz - uz * vx;
@@ -269,7 +269,7 @@ float exact_triangle(const H& h, const LatticeTriangle& t) {
   thread_local std::vector<float> row;
   if (row.size() < std::size_t(x1 - x0 + 1)) row.resize(std::size_t(x1 - x0 + 1));
   double worst = 0.0;
-  int size, dir;
+  int size = 0, dir = 0;
   if (RowShapes::slot(t.lx - t.ax, t.lz - t.az, size, dir)) {
     const std::int64_t ux = t.lx - t.ax, uz = t.lz - t.az;
     const bool left = t.rx - t.ax == -uz && t.rz - t.az == ux;

@@ -514,12 +514,12 @@ Result<std::shared_ptr<const Landscape>> Landscape::create(std::shared_ptr<const
     // So do the holes (records.h): remade around every block of them that differs from the
     // holes the world was baked with (none when the terrain's mask is still the world's own).
     const std::shared_ptr<const HoleMask> holes = c.hole_source();
-    const std::shared_ptr<const HoleMask>& baked =
+    const std::shared_ptr<const HoleMask>& world_holes =
         detail::SurfaceAccess::edits(surface).baked_holes();
-    if (holes != baked) {
+    if (holes != world_holes) {
       std::vector<std::pair<std::uint64_t, HoleMask::Bits>> now, then;
       if (holes) now = holes->sorted_blocks();
-      if (baked) then = baked->sorted_blocks();
+      if (world_holes) then = world_holes->sorted_blocks();
       // Both in ascending key order: the keys held by one only, or with other bits.
       std::vector<std::uint64_t> differ;
       std::size_t a = 0, b = 0;
