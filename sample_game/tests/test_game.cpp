@@ -23,6 +23,9 @@ std::unique_ptr<Game> make_game(bool tessellate = false) {
   o.assets_dir = RIDGELINE_GAME_ASSETS;
   o.scripts_dir = kScripts;
   o.tessellate = tessellate;
+  // Tiles arrive before each mesh is judged: the meshes the tests compare do not depend on when
+  // the detail cache's workers (below the test's priority) get a core.
+  o.prefill_detail = tessellate;
   o.instruction_limit = 2'000'000;
   auto g = Game::create(o);
   EXPECT_TRUE(g.ok()) << (g.ok() ? "" : g.error().message);
