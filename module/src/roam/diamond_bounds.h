@@ -131,6 +131,29 @@ inline const SmallTriangles& small_triangles() {
   return table;
 }
 
+// The samples [lo, hi] of row z inside the triangle with corners ex (A, L, R), and its three edge
+// functions e_k(x) = coef[k] x + off[k] on that row (k = 0 A -> L, 1 L -> R, 2 R -> A; made >= 0
+// inside by sgn, the sign of the doubled area): [lo, hi] narrows to each edge's inner side, and
+// comes back empty (lo > hi) for a row outside. exact_triangle() and RowShapes both use it.
+inline void row_span(const std::int64_t (&ex)[3][2], std::int64_t sgn, std::int64_t z,
+                     std::int64_t& lo, std::int64_t& hi, std::int64_t (&coef)[3],
+                     std::int64_t (&off)[3]) noexcept {
+  static constexpr int from[3] = {0, 1, 2}, to[3] = {1, 2, 0};
+  for (int k = 0; k < 3; ++k) {
+    const std::int64_t px = ex[from[k]][0], pz = ex[from[k]][1];
+    const std::int64_t ux = ex[to[k]][0] - px, uz = ex[to[k]][1] - pz;
+    // e(x) = ux * (z - pz) - uz * (x - px) = a * x + c.
+    const std::int64_t a = -uz * sgn, c = (ux * (z - pz) + uz * px) * sgn;
+    coef[k] = a, off[k] = c;
+    if (a > 0)
+      lo = std::max(lo, -floor_div_fast(c, a));  // x >= ceil(-c / a)
+    else if (a < 0)
+      hi = std::min(hi, floor_div_fast(c, -a));  // x <= floor(c / -a)
+    else if (c < 0)
+      lo = hi + 1;  // edge parallel to x, row outside
+  }
+}
+
 // The rows of the bintree's triangles of legs up to 64 cells (axis-aligned or diagonal, the
 // right angle at the apex), relative to the apex: each row's first sample and count, and the
 // three edge functions at its first sample; exact_triangle()'s spans and integers, found once per
@@ -176,24 +199,12 @@ struct RowShapes {
             sh.aw = double(w * sgn);
             // Edges as exact_triangle() takes them: k = 0 A -> L, 1 L -> R, 2 R -> A.
             const std::int64_t ex[3][2] = {{0, 0}, {ux, uz}, {vx, vz}};
-            const int from[3] = {0, 1, 2}, to[3] = {1, 2, 0};
             const std::int64_t x0 = std::min({std::int64_t{0}, ux, vx}), x1 = std::max({std::int64_t{0}, ux, vx});
             const std::int64_t z0 = std::min({std::int64_t{0}, uz, vz}), z1 = std::max({std::int64_t{0}, uz, vz});
             std::int64_t coef[3] = {};
             for (std::int64_t z = z0; z <= z1; ++z) {
               std::int64_t lo = x0, hi = x1, off[3];
-              for (int k = 0; k < 3; ++k) {
-                const std::int64_t px = ex[from[k]][0], pz = ex[from[k]][1];
-                const std::int64_t eux = ex[to[k]][0] - px, euz = ex[to[k]][1] - pz;
-                const std::int64_t ca = -euz * sgn, cc = (eux * (z - pz) + euz * px) * sgn;
-                coef[k] = ca, off[k] = cc;
-                if (ca > 0)
-                  lo = std::max(lo, -floor_div(cc, ca));
-                else if (ca < 0)
-                  hi = std::min(hi, floor_div(cc, -ca));
-                else if (cc < 0)
-                  lo = hi + 1;
-              }
+              row_span(ex, sgn, z, lo, hi, coef, off);
               if (lo > hi) continue;
               sh.rows.push_back({std::int32_t(z), std::int32_t(lo), std::int32_t(hi - lo + 1),
                                  coef[0] * lo + off[0], coef[1] * lo + off[1], coef[2] * lo + off[2]});
@@ -287,23 +298,10 @@ float exact_triangle(const H& h, const LatticeTriangle& t) {
     }
   }
   const std::int64_t ex[3][2] = {{t.ax, t.az}, {t.lx, t.lz}, {t.rx, t.rz}};
-  const int from[3] = {0, 1, 2}, to[3] = {1, 2, 0};
   for (std::int64_t z = z0; z <= z1; ++z) {
     std::int64_t lo = x0, hi = x1;
     std::int64_t coef[3], off[3];
-    for (int k = 0; k < 3; ++k) {
-      const std::int64_t px = ex[from[k]][0], pz = ex[from[k]][1];
-      const std::int64_t ux = ex[to[k]][0] - px, uz = ex[to[k]][1] - pz;
-      // e(x) = ux * (z - pz) - uz * (x - px) = a * x + c, made >= 0 inside by the sign.
-      const std::int64_t a = -uz * sgn, c = (ux * (z - pz) + uz * px) * sgn;
-      coef[k] = a, off[k] = c;
-      if (a > 0)
-        lo = std::max(lo, -floor_div_fast(c, a));  // x >= ceil(-c / a)
-      else if (a < 0)
-        hi = std::min(hi, floor_div_fast(c, -a));  // x <= floor(c / -a)
-      else if (c < 0)
-        lo = hi + 1;  // edge parallel to x, row outside
-    }
+    row_span(ex, sgn, z, lo, hi, coef, off);
     if (lo > hi) continue;
     // plane(x) * |w| = e_lr(x) ha + e_ra(x) hl + e_ab(x) hr = S x + T, with x relative to lo.
     const double S = double(coef[1]) * ha + double(coef[2]) * hl + double(coef[0]) * hr;
