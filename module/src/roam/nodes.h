@@ -165,7 +165,11 @@ class NodePool {
     ::new (&base_[c + 1]) Node{};
     return c;
   }
+  /// Frees a pair. Freed nodes read as interior nodes without an entry, so that a node index
+  /// left in a policy's queue (a split or merge candidate whose parent merged since it was
+  /// queued) is never taken for a leaf to split or a diamond to merge.
   void free_pair(std::uint32_t first) {
+    base_[first] = base_[first + 1] = Node{};  // interior (slot kInterior), no entry
     base_[first].parent = free_;
     free_ = first;
   }

@@ -113,8 +113,8 @@ std::uint8_t Refiner::test_new_entry(std::uint32_t e) {
 // ---- candidates ---------------------------------------------------------------------------------
 
 bool Refiner::split_candidate(std::uint32_t n) const {
-  if (!nodes_[n].leaf()) return false;
   const std::uint32_t e = nodes_[n].entry();
+  if (!nodes_[n].leaf() || e == kNoEntry) return false;  // interior, freed, or finest
   return !front_.split(e) && (front_.result(e) & kActive);
 }
 
