@@ -354,7 +354,7 @@ nlohmann::json run_size(const Options& o, std::uint32_t n) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  ridgeline::cli::keep_page_buffers_out_of_arenas();
+  ridgeline::cli::keep_page_buffers_in_one_arena();
   CLI::App app{
       "ridge bench world: bakes the project's generated worlds, then measures open to first mesh, "
       "convergence and a real-time flight under a cache budget (JSON; docs/worlds.md)"};

@@ -48,7 +48,7 @@ std::string unknown_subcommand(const CLI::App& app, int argc, char** argv) {
 
 int main(int argc, char** argv) {
   using namespace ridgeline::cli;
-  keep_page_buffers_out_of_arenas();
+  keep_page_buffers_in_one_arena();
   CLI::App app{"ridge: the Ridgeline terrain tool (heightmap info, queries, profiles, benchmarks)",
                "ridge"};
   // Before the subcommands are added: they copy it.

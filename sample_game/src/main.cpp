@@ -405,9 +405,10 @@ int run(const Args& a) {
 
 int main(int argc, char** argv) {
 #if defined(__GLIBC__)
-  // Page-sized buffers of a baked world (--world) stay in mmap rather than fragmenting glibc's
-  // per-thread arenas (docs/worlds.md, "Memory").
-  (void)::mallopt(M_MMAP_THRESHOLD, 96 * 1024);
+  // Page-sized buffers of a baked world (--world), made on loader threads and freed on others,
+  // are reused from one arena rather than fragmenting glibc's per-thread arenas (docs/worlds.md,
+  // "Memory"). Before any thread starts.
+  (void)::mallopt(M_ARENA_MAX, 1);
 #endif
   CLI::App app{"Ridgeline sample game: vehicles on deformable terrain, driven by Lua"};
   Args a;
