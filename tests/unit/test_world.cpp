@@ -340,6 +340,17 @@ TEST(World, DamagedTruncatedNewerAndForeignFilesAreRefused) {
     EXPECT_NE(r.error().message.find(what), std::string::npos) << r.error().message;
     return r.error().message;
   };
+  // A damaged file that open_world() accepts, opened as a terrain (loads on this thread).
+  auto open_damaged = [&](const std::vector<std::uint8_t>& bytes,
+                          const std::string& leaf) -> Result<std::shared_ptr<Terrain>> {
+    const std::string p = tmp_path(leaf);
+    write_file(p, bytes);
+    auto source = io::open_world(p);
+    if (!source) return Error{"open_world: " + source.error().message};
+    WorldCacheDesc cache;
+    cache.worker_threads = 0;
+    return Terrain::open(*source, cache);
+  };
   for (std::size_t cut : {std::size_t{0}, std::size_t{10}, std::size_t{100}, good.size() / 2,
                           good.size() - 1}) {
     std::vector<std::uint8_t> b(good.begin(), good.begin() + std::ptrdiff_t(cut));
@@ -349,9 +360,9 @@ TEST(World, DamagedTruncatedNewerAndForeignFilesAreRefused) {
   {
     std::vector<std::uint8_t> b = good;
     b[16 + 8] = 9;  // the locator's version
-    EXPECT_NE(refused(b, "format version 9; this build reads versions 3 to 4"), "opened");
+    EXPECT_NE(refused(b, "format version 9; this build reads versions 3 to 5"), "opened");
     b[16 + 8] = 2;  // older than any this build reads
-    EXPECT_NE(refused(b, "format version 2; this build reads versions 3 to 4"), "opened");
+    EXPECT_NE(refused(b, "format version 2; this build reads versions 3 to 5"), "opened");
   }
   {
     std::vector<std::uint8_t> b = good;
@@ -365,6 +376,17 @@ TEST(World, DamagedTruncatedNewerAndForeignFilesAreRefused) {
     ASSERT_LT(index_at + 100, b.size());
     b[index_at + 60] ^= 0x01;  // inside the index
     EXPECT_NE(refused(b, "index is corrupted"), "opened");
+    // The page entries lie in chunks just before the index, each checked when first read: the
+    // open (which reads no entry) succeeds, the first load of a page of a damaged chunk fails
+    // naming it; nothing is loaded from it.
+    b = good;
+    b[index_at - 5] ^= 0x01;
+    auto t = open_damaged(b, "chunk.tif");
+    ASSERT_FALSE(t) << "a world whose only entry chunk is damaged opened";
+    EXPECT_EQ(t.error().message.find("open_world"), std::string::npos) << t.error().message;
+    EXPECT_NE(t.error().message.find("page entry chunk 0 is corrupted (checksum mismatch)"),
+              std::string::npos)
+        << t.error().message;
   }
   {
     std::vector<std::uint8_t> b = good;
@@ -378,14 +400,9 @@ TEST(World, DamagedTruncatedNewerAndForeignFilesAreRefused) {
     // A damaged page: found by its checksum when loaded; the world works around it.
     std::vector<std::uint8_t> b = good;
     b[1024 + 333] ^= 0xff;  // early in the first page written
-    const std::string p = tmp_path("page.tif");
-    write_file(p, b);
-    auto source = io::open_world(p);
-    ASSERT_TRUE(source) << source.error().message;
-    WorldCacheDesc cache;
-    cache.worker_threads = 0;
-    auto t = Terrain::open(*source, cache);
+    auto t = open_damaged(b, "page.tif");
     if (!t) {
+      ASSERT_EQ(t.error().message.find("open_world"), std::string::npos) << t.error().message;
       // The damaged page was one of the coarse levels read at open: refused, naming it.
       EXPECT_NE(t.error().message.find("corrupted"), std::string::npos) << t.error().message;
       return;
@@ -635,7 +652,9 @@ TEST(World, TheMapsOwnHolesAreBakedWithTheWorld) {
     const auto a = memory->sample(p.x, p.y), b = world->sample(p.x, p.y);
     ASSERT_EQ(a.has_value(), b.has_value()) << p.x << ", " << p.y;
     none += !a;
-    if (a) EXPECT_EQ(a->height, b->height) << p.x << ", " << p.y;
+    if (a) {
+      EXPECT_EQ(a->height, b->height) << p.x << ", " << p.y;
+    }
   }
   EXPECT_GT(none, 100u) << "no point fell in a hole: the test misses its subject";
   const double hx = w.origin_x + 300 * 2.0 + 0.5, hz = w.origin_z + 200 * 1.5 + 0.5;

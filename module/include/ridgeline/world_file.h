@@ -21,9 +21,11 @@ namespace ridgeline::io {
 
 /// Opens a baked world: reads and checks its locator and index (magic, version, checksums, sizes:
 /// a truncated, corrupt, foreign or newer file is refused with a message naming the file and the
-/// fault), reads nothing proportional to the world but the page table (32 bytes a page) and the
-/// page summaries (16 bytes per 65,536 samples). Each page is checked (checksum, sizes) when it is
-/// loaded. The returned source may be used from any number of threads; it keeps the file open.
+/// fault), reads nothing proportional to the world but the page summaries (16 bytes per 65,536
+/// samples). A page's entry (32 bytes) is read with its chunk of 1,024 when a page of the chunk is
+/// first loaded; chunks and pages are checked (checksum, sizes) when read. Worlds of format
+/// versions 3 and 4 hold the entries in the index, read whole here. The returned source may be
+/// used from any number of threads; it keeps the file open.
 Result<std::shared_ptr<const PageSource>> open_world(const std::string& path);
 
 /// Samples to bake, held in memory: width x height values, row-major, either 16-bit values

@@ -13,7 +13,11 @@
 //   materials  kPageEntries material ids, Deflate (empty when the world has none)
 //   records    the tessellator's baked bounds of the page (levels >= 1), Deflate (roam/records.h)
 // The index ends with the world's holes (version 4): their count, then (j, i0, i1) per run of
-// hole cells along a row of cells.
+// hole cells along a row of cells. From version 5 the page entries are not in the index: they lie
+// in chunks of kChunkEntries before it, and the index holds each chunk's offset and checksum, so
+// that opening reads the index (the header, the page summaries, the chunk table, the holes) and
+// nothing per page; a chunk is read and checked when a page of its is first loaded. Versions 3
+// and 4 hold the entries in the index.
 // A level whose size is 2^k + 1 samples has one column and row past its pages' tiles: the TIFF
 // gets extra tiles for them (after the last page of each row and column, outside the index), so
 // that its tile grid covers the image; Ridgeline reads those samples from the pages' aprons.
@@ -33,7 +37,8 @@
 namespace ridgeline::io::world_file {
 
 inline constexpr char kMagic[8] = {'R', 'I', 'D', 'G', 'E', 'W', 'L', 'D'};
-inline constexpr std::uint32_t kVersion = 4;  // 2: six-entry aprons; 3: 4-byte bounds; 4: holes
+/// 2: six-entry aprons; 3: 4-byte bounds; 4: holes; 5: page entries in chunks outside the index.
+inline constexpr std::uint32_t kVersion = 5;
 /// The oldest version this build reads (3: as 4 without holes).
 inline constexpr std::uint32_t kOldestVersion = 3;
 /// Bytes 16 .. 79 of the file: the locator.
@@ -45,6 +50,10 @@ inline constexpr std::uint32_t kTile = 256;
 inline constexpr std::size_t kTileSamples = std::size_t(kTile) * kTile;
 inline constexpr std::size_t kApronSamples = kPageEntries - kTileSamples;
 
+/// Bytes of a page's entry (offset, the four sizes, checksum).
+inline constexpr std::size_t kEntryBytes = 32;
+/// Page entries a chunk (version 5): 32 KiB, read and checked when a page of its is first loaded.
+inline constexpr std::size_t kChunkEntries = 1024;
 /// Where one page's parts lie (offset of the tile; the others follow it).
 struct PageEntry {
   std::uint64_t offset = 0;

@@ -547,6 +547,19 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
     rep.pages = total_pages;
     report(0.95, "index");
 
+    // ---- page entries, in chunks read when a page of theirs is first loaded -----------------
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> chunks;  // offset, checksum
+    for (std::size_t c0 = 0; c0 < entries.size(); c0 += kChunkEntries) {
+      Writer cw;
+      for (std::size_t k = c0; k < std::min(entries.size(), c0 + kChunkEntries); ++k) {
+        const PageEntry& e = entries[k];
+        cw.put(e.offset), cw.put(e.tile), cw.put(e.apron), cw.put(e.materials), cw.put(e.records);
+        cw.put(e.checksum);
+      }
+      chunks.emplace_back(out.size(), checksum(cw.bytes.data(), cw.bytes.size()));
+      if (auto st = out.write(cw.bytes.data(), cw.bytes.size()); !st) return Error{st.message()};
+    }
+
     // ---- index ------------------------------------------------------------------------------
     Writer w;
     w.bytes.insert(w.bytes.end(), {'R', 'W', 'I', 'N', 'D', 'E', 'X', '1'});
@@ -562,10 +575,8 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
     w.put(grid.levels);
     for (std::uint32_t k = 0; k < grid.levels; ++k) w.put(grid.px[k]), w.put(grid.pz[k]);
     for (const PageSummary& s : summaries) w.put(s.lo), w.put(s.hi), w.put(s.lo8), w.put(s.hi8);
-    for (const PageEntry& e : entries) {
-      w.put(e.offset), w.put(e.tile), w.put(e.apron), w.put(e.materials), w.put(e.records);
-      w.put(e.checksum);
-    }
+    // Version 5: where the chunks of page entries lie (kChunkEntries a chunk) and their checksums.
+    for (const auto& [at, sum] : chunks) w.put(at), w.put(sum);
     // Version 4: the holes as runs of cells along rows.
     w.put(std::uint64_t(hole_runs.size()));
     for (const HoleRun& r : hole_runs) w.put(r.j), w.put(r.i0), w.put(r.i1);
