@@ -1,5 +1,5 @@
-// The game's Bullet world: default collision configuration, dynamic AABB tree broadphase,
-// sequential impulse solver; the ground is Ridgeline::bullet's TerrainShape on a static rigid
+// The game's Bullet world: Ridgeline::bullet's DynamicsWorld (default collision configuration,
+// dynamic AABB tree broadphase, sequential impulse solver); the ground is Ridgeline::bullet's TerrainShape on a static rigid
 // body (a rigid body, not a plain collision object, because btRaycastVehicle's raycasters only
 // report rigid bodies), followed through TerrainSync.
 #include "physics.h"
@@ -11,15 +11,13 @@
 #include <optional>
 
 #include "materials.h"
+#include "ridgeline/bullet/dynamics_world.h"
 
 namespace game {
 
 struct Physics::Parts {
-  btDefaultCollisionConfiguration config;
-  btCollisionDispatcher dispatcher{&config};
-  btDbvtBroadphase broadphase;
-  btSequentialImpulseConstraintSolver solver;
-  btDiscreteDynamicsWorld world{&dispatcher, &broadphase, &solver, &config};
+  ridgeline::bullet::DynamicsWorld dynamics;
+  btDiscreteDynamicsWorld& world = dynamics.world();
   std::unique_ptr<btRigidBody> ground;
   std::optional<ridgeline::bullet::TerrainSync> sync;
 };
@@ -59,7 +57,6 @@ ridgeline::Result<std::unique_ptr<Physics>> Physics::create(
   p->shape_ = std::move(*shape);
   p->parts_ = std::make_unique<Parts>();
   Parts& parts = *p->parts_;
-  parts.world.setGravity(btVector3(0, -9.81f, 0));
   btRigidBody::btRigidBodyConstructionInfo info(0, nullptr, p->shape_.get());
   info.m_friction = 0.9f;
   info.m_rollingFriction = 1.0f;
@@ -109,7 +106,7 @@ void for_pair(btDispatcher& d, const btCollisionObject* a, const btCollisionObje
 
 double Physics::penetration(const btCollisionObject* a, const btCollisionObject* b) const {
   double deepest = 0;
-  for_pair(parts_->dispatcher, a, b, [&](const btManifoldPoint& p) {
+  for_pair(parts_->dynamics.dispatcher(), a, b, [&](const btManifoldPoint& p) {
     deepest = std::max(deepest, -double(p.getDistance()));
   });
   return deepest;
@@ -117,7 +114,7 @@ double Physics::penetration(const btCollisionObject* a, const btCollisionObject*
 
 bool Physics::touching(const btCollisionObject* a, const btCollisionObject* b) const {
   bool touch = false;
-  for_pair(parts_->dispatcher, a, b,
+  for_pair(parts_->dynamics.dispatcher(), a, b,
            [&](const btManifoldPoint& p) { touch = touch || p.getDistance() < 0.01f; });
   return touch;
 }

@@ -388,7 +388,7 @@ TEST(BulletShape, AScriptedRunIsDeterministic) {
       (void)sync.update();
       w.world.stepSimulation(1.0f / 60.0f, 0);
     }
-    for (const auto& b : w.bodies) {
+    for (const btRigidBody* b : w.bodies()) {
       const btTransform& t = b->getWorldTransform();
       const btVector3 p = t.getOrigin(), v = b->getLinearVelocity(), a = b->getAngularVelocity();
       const btQuaternion q = t.getRotation();

@@ -86,8 +86,7 @@ TEST(BulletPaged, ThePagesUnderTheBodiesStayResidentWhileTheWorldPagesAround) {
 
   // Bodies gone: nothing pinned, the pages go back to the cache.
   const std::size_t pinned = terrain->world_stats().pinned_pages;
-  for (auto& body : w.bodies) w.world.removeRigidBody(body.get());
-  w.bodies.clear();
+  w.dynamics.remove_bodies();
   const auto last = sync.update();
   EXPECT_TRUE(last.residency_changed);
   EXPECT_EQ(last.pinned_pages, 0u);

@@ -35,6 +35,7 @@
 
 #include "ridgeline/bench/clock.h"
 #include "ridgeline/bench/stats.h"
+#include "ridgeline/bullet/dynamics_world.h"
 #include "ridgeline/bullet/terrain_shape.h"
 #include "ridgeline/bullet/terrain_sync.h"
 #include "ridgeline/detail.h"
@@ -45,6 +46,7 @@ namespace {
 
 using ridgeline::bench::Clock;
 using ridgeline::bench::ms_since;
+using ridgeline::bullet::DynamicsWorld;
 using ridgeline::bullet::TerrainShape;
 
 std::string load_average() {
@@ -110,19 +112,12 @@ Field make_field(const std::string& which) {
 
 // One Bullet world with the ground (either shape) and bodies.
 struct World {
-  btDefaultCollisionConfiguration config;
-  btCollisionDispatcher dispatcher{&config};
-  btDbvtBroadphase broadphase;
-  btSequentialImpulseConstraintSolver solver;
-  btDiscreteDynamicsWorld world{&dispatcher, &broadphase, &solver, &config};
+  DynamicsWorld dynamics;
+  btDiscreteDynamicsWorld& world = dynamics.world();
   std::unique_ptr<btCollisionShape> ground_shape;
   btCollisionObject ground;
-  std::vector<std::unique_ptr<btCollisionShape>> shapes;
-  std::vector<std::unique_ptr<btDefaultMotionState>> states;
-  std::vector<std::unique_ptr<btRigidBody>> bodies;
 
   World(const Field& f, bool ridgeline_shape) {
-    world.setGravity(btVector3(0, -9.81f, 0));
     const ridgeline::WorldInfo& hf = f.terrain->info();
     btTransform t;
     t.setIdentity();
@@ -145,28 +140,15 @@ struct World {
                              btBroadphaseProxy::AllFilter ^ btBroadphaseProxy::StaticFilter);
   }
   ~World() {
-    for (auto& b : bodies) world.removeRigidBody(b.get());
+    dynamics.remove_bodies();
     world.removeCollisionObject(&ground);
   }
   void add(std::unique_ptr<btCollisionShape> s, const btVector3& p, double mass) {
-    btVector3 inertia(0, 0, 0);
-    s->calculateLocalInertia(btScalar(mass), inertia);
-    states.push_back(
-        std::make_unique<btDefaultMotionState>(btTransform(btQuaternion::getIdentity(), p)));
-    btRigidBody::btRigidBodyConstructionInfo info(btScalar(mass), states.back().get(), s.get(),
-                                                  inertia);
-    info.m_friction = 0.6f;
-    bodies.push_back(std::make_unique<btRigidBody>(info));
-    bodies.back()->setActivationState(DISABLE_DEACTIVATION);  // measure contacts, not sleep
-    shapes.push_back(std::move(s));
-    world.addRigidBody(bodies.back().get());
+    btRigidBody* b =
+        dynamics.add_body(std::move(s), btTransform(btQuaternion::getIdentity(), p), mass, 0.6);
+    b->setActivationState(DISABLE_DEACTIVATION);  // measure contacts, not sleep
   }
-  std::size_t contact_points() const {
-    std::size_t n = 0;
-    for (int k = 0; k < dispatcher.getNumManifolds(); ++k)
-      n += std::size_t(dispatcher.getManifoldByIndexInternal(k)->getNumContacts());
-    return n;
-  }
+  std::size_t contact_points() const { return dynamics.contact_points(); }
 };
 
 // The same bodies for both shapes: half spheres, half boxes, over the middle 400 m of the field,
@@ -237,14 +219,14 @@ std::string bodies_run(const Field& f, bool ridgeline_shape, int n, int steps) {
   const PhaseResult resting = measure(w, steps);
   std::mt19937 rng(99);
   std::uniform_real_distribution<float> angle(0, 6.2831853f);
-  for (auto& b : w.bodies) {
+  for (btRigidBody* b : w.dynamics.bodies()) {
     const float a = angle(rng);
     b->setLinearVelocity(btVector3(6 * std::cos(a), 0, 6 * std::sin(a)));
   }
   const PhaseResult sliding = measure(w, steps);
   // Where the bodies ended: above the ground (none fell through).
   int below = 0;
-  for (auto& b : w.bodies) {
+  for (btRigidBody* b : w.dynamics.bodies()) {
     const btVector3 p = b->getWorldTransform().getOrigin();
     const auto h = f.terrain->height(c.x + p.x(), c.z + p.z());
     if (h && double(p.y()) + c.y < *h - 0.5) ++below;
