@@ -115,7 +115,7 @@ std::vector<std::pair<std::uint64_t, HoleMask::Bits>> HoleMask::sorted_blocks() 
 
 void HoleMask::set_block(std::uint64_t k, const Bits& bits) {
   std::uint32_t n = 0;
-  for (const std::uint64_t w : bits) n += std::uint32_t(__builtin_popcountll(w));
+  for (const std::uint64_t w : bits) n += std::uint32_t(std::popcount(w));
   if (const auto it = blocks_.find(k); it != blocks_.end()) {
     cells_ -= it->second.count;
     blocks_.erase(it);

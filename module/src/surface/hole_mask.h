@@ -7,6 +7,7 @@
 #pragma once
 
 #include <array>
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <unordered_map>
@@ -100,7 +101,7 @@ void HoleMask::for_each_in(std::int64_t i0, std::int64_t j0, std::int64_t i1, st
     for (std::size_t w = 0; w < kWords; ++w) {
       std::uint64_t word = b.bits[w];
       while (word != 0) {
-        const std::size_t k = w * 64 + std::size_t(__builtin_ctzll(word));
+        const std::size_t k = w * 64 + std::size_t(std::countr_zero(word));
         word &= word - 1;
         const std::int64_t i = ci0 + std::int64_t(k & std::size_t(kBlock - 1));
         const std::int64_t j = cj0 + std::int64_t(k >> kShift);

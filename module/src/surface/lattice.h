@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <memory>
 
+#include "platform/memory_hints.h"
 #include "ridgeline/surface.h"
 #include "surface/hole_mask.h"
 #include "surface/surface_eval.h"
@@ -98,8 +99,8 @@ struct StoredLattice {
                                                std::int32_t(j - (std::int64_t(k.pz) << 8)));
       const char* a = p->f32 ? reinterpret_cast<const char*>(p->f32 + e)
                              : reinterpret_cast<const char*>(p->u16 + e);
-      __builtin_prefetch(a);
-      __builtin_prefetch(a + (p->f32 ? 4 : 2) * kPageStride);
+      detail::prefetch(a);
+      detail::prefetch(a + (p->f32 ? 4 : 2) * kPageStride);
     }
   }
   // What vertex_normal() (surface_eval.h) reads.
