@@ -12,6 +12,7 @@
 // the index and page decoding; the others are written as they are.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -40,29 +41,49 @@ void put(std::string& b, std::size_t at, T v) {
   std::memcpy(b.data() + at, &v, sizeof v);
 }
 
-// Recomputes the checksums the reader checks, where the layout can be followed: each page entry
-// (the last 32 bytes per page of the index: offset, four part sizes, checksum), then the index's
-// and the locator's (world_format.h).
+// Recomputes the checksums the reader checks, where the layout can be followed: each page's (in
+// its entry: offset, four part sizes, checksum), each chunk of entries' (version 5: the chunks
+// lie before the index, their offsets in the index after the summaries; versions 3 and 4: the
+// entries lie in the index after the summaries), then the index's and the locator's
+// (world_format.h).
 void fix_checksums(std::string& b) {
   namespace wf = ridgeline::io::world_file;
   const std::size_t loc = wf::kLocatorAt;
   if (b.size() < wf::kDataStart || std::memcmp(b.data() + loc, wf::kMagic, 8) != 0) return;
+  const auto version = get<std::uint32_t>(b, loc + 8);
   const auto index_at = get<std::uint64_t>(b, loc + 16), index_bytes = get<std::uint64_t>(b, loc + 24);
   if (index_at > b.size() || index_bytes > b.size() - index_at || index_bytes < 16) return;
+  auto fix_entry = [&](std::size_t e) {  // the page checksum of the entry at byte e
+    const auto off = get<std::uint64_t>(b, e);
+    const std::uint64_t n = std::uint64_t(get<std::uint32_t>(b, e + 8)) +
+                            get<std::uint32_t>(b, e + 12) + get<std::uint32_t>(b, e + 16) +
+                            get<std::uint32_t>(b, e + 20);
+    if (off <= b.size() && n <= b.size() - off)
+      put(b, e + 24, wf::checksum(b.data() + off, std::size_t(n)));
+  };
   const auto width = get<std::uint32_t>(b, index_at + 8), height = get<std::uint32_t>(b, index_at + 12);
-  if (width >= 2 && height >= 2 && width <= (1u << 20) && height <= (1u << 20)) {
+  // The header's fixed part (world_writer.cpp): magic, size, six doubles, format, range,
+  // materials, filled, hash; then the name, the baked settings, the levels.
+  std::size_t at = index_at + 8 + 8 + 48 + 1 + 8 + 1 + 8 + 8;
+  const std::size_t end = index_at + index_bytes;
+  if (width >= 2 && height >= 2 && width <= (1u << 20) && height <= (1u << 20) && at + 4 <= end) {
+    at += 4 + std::size_t(get<std::uint32_t>(b, at));
+    at += 4 + 8 + 8;
     const auto grid = ridgeline::world::PageGrid::of(width, height);
     std::size_t pages = 0;
     for (std::uint32_t k = 0; k < grid.levels; ++k) pages += grid.count(k);
-    if (pages * 32 <= index_bytes) {
-      for (std::size_t e = index_at + index_bytes - pages * 32; e < index_at + index_bytes; e += 32) {
-        const auto off = get<std::uint64_t>(b, e);
-        const std::uint64_t n = std::uint64_t(get<std::uint32_t>(b, e + 8)) +
-                                get<std::uint32_t>(b, e + 12) + get<std::uint32_t>(b, e + 16) +
-                                get<std::uint32_t>(b, e + 20);
-        if (off <= b.size() && n <= b.size() - off)
-          put(b, e + 24, wf::checksum(b.data() + off, std::size_t(n)));
+    at += 4 + 8 * std::size_t(grid.levels) + 16 * grid.count(0);  // levels, summaries
+    if (version >= 5) {
+      const std::size_t chunks = (pages + wf::kChunkEntries - 1) / wf::kChunkEntries;
+      for (std::size_t c = 0; c < chunks && at + 16 * (c + 1) <= end; ++c) {
+        const auto chunk_at = get<std::uint64_t>(b, at + 16 * c);
+        const std::size_t n = wf::kEntryBytes * std::min(wf::kChunkEntries, pages - c * wf::kChunkEntries);
+        if (chunk_at > b.size() || n > b.size() - chunk_at) continue;
+        for (std::size_t e = chunk_at; e < chunk_at + n; e += wf::kEntryBytes) fix_entry(e);
+        put(b, at + 16 * c + 8, wf::checksum(b.data() + chunk_at, n));
       }
+    } else if (at <= end && pages * wf::kEntryBytes <= end - at) {
+      for (std::size_t e = at; e < at + pages * wf::kEntryBytes; e += wf::kEntryBytes) fix_entry(e);
     }
   }
   put(b, loc + 32, wf::checksum(b.data() + index_at, std::size_t(index_bytes)));
