@@ -66,6 +66,40 @@ Status check_summary(const WorldInfo& info, const PageKey& key, const PageData& 
   return {};
 }
 
+// A level-0 page's entries outside the data (past the world's first or last row or column) hold
+// copies of the nearest sample inside it, as the writer makes them and as every reader of the
+// surface assumes (summaries, rays and bounds are made with indices clamped into the data). A
+// source whose page holds anything else there is not trusted: those entries are set from the
+// nearest entry inside the data, which a level-0 page always holds.
+void clamp_outside_data(const PageGrid& g, const PageKey& key, PageData& d) {
+  const std::int64_t i0 = std::int64_t(key.px) << 8, j0 = std::int64_t(key.pz) << 8;
+  auto inside = [](std::int64_t v, std::int64_t base, std::int64_t last) {
+    return std::int32_t(std::clamp<std::int64_t>(base + v, 0, last) - base);
+  };
+  for (std::int32_t b = -kPageApron; b <= kPageCells + kPageApron; ++b) {
+    const std::int32_t cb = inside(b, j0, g.last_j);
+    for (std::int32_t a = -kPageApron; a <= kPageCells + kPageApron; ++a) {
+      const std::int32_t ca = inside(a, i0, g.last_i);
+      if (ca == a && cb == b) continue;
+      const std::size_t e = entry_index(a, b), from = entry_index(ca, cb);
+      if (!d.u16.empty()) d.u16[e] = d.u16[from];
+      if (!d.f32.empty()) d.f32[e] = d.f32[from];
+      if (!d.materials.empty()) d.materials[e] = d.materials[from];
+    }
+  }
+}
+
+// What every page a source delivers goes through before it is made resident: its sizes and
+// values checked, a level-0 page's entries outside the data made copies of the data's edge, and
+// its heights held against its summary (summary: the page's, for level 0).
+Status accept_page(const WorldInfo& info, const PageGrid& g, const PageKey& key, PageData& d,
+                   const PageSummary& summary) {
+  if (auto st = check_page_data(info, key, d); !st) return st;
+  if (key.level != 0) return {};
+  clamp_outside_data(g, key, d);
+  return check_summary(info, key, d, summary);
+}
+
 }  // namespace
 
 // ---- creation ---------------------------------------------------------------------------------
@@ -165,10 +199,8 @@ Result<std::shared_ptr<PageStore>> PageStore::open(std::shared_ptr<const PageSou
         }
         PageData d;
         if (auto st = s->source_->load(key, d); !st) return Error{st.message()};
-        if (auto st = check_page_data(info, key, d); !st) return Error{st.message()};
-        if (k == 0)
-          if (auto st = check_summary(info, key, d, s->summary(px, pz)); !st)
-            return Error{st.message()};
+        if (auto st = accept_page(info, s->grid_, key, d, s->summary(px, pz)); !st)
+          return Error{st.message()};
         top.push_back(s->make_page(key, std::move(d)));
       }
   }
@@ -334,8 +366,7 @@ std::vector<std::shared_ptr<const Page>> PageStore::load_chain(const PageKey& ke
   for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
     PageData d;
     Status st = source_->load(*it, d);
-    if (st) st = check_page_data(info_, *it, d);
-    if (st && it->level == 0) st = check_summary(info_, *it, d, summary(it->px, it->pz));
+    if (st) st = accept_page(info_, grid_, *it, d, summary(it->px, it->pz));
     if (!st) {
       error = st.message();
       std::lock_guard lock(cache_->mu);
