@@ -1,10 +1,8 @@
 // The bake (world_file.h): samples in memory to a world file (world_format.h). Stages: the
 // samples (checked, or quantised to a tolerance), the page summaries, the tessellator's coarse
 // bounds (records.h, from every sample), the pages of every level (cut and compressed by workers
-// while this thread writes them in order), then the index, the TIFF directories and the locator; flushed and
-// renamed.
-#include <fcntl.h>
-#include <unistd.h>
+// while this thread writes them in order), then the end of the file (world_file_end.cpp: the
+// entry chunks, the index, the TIFF directories and the locator); flushed and renamed.
 
 #include <algorithm>
 #include <atomic>
@@ -20,7 +18,7 @@
 #include "format.h"
 #include "io/durable_file.h"
 #include "io/world_format.h"
-#include "io/world_tiff.h"
+#include "io/world_output.h"
 #include "ridgeline/world_file.h"
 #include "roam/records.h"
 #include "surface/hole_mask.h"
@@ -35,61 +33,6 @@ using namespace world_file;
 namespace {
 
 struct Cancelled {};
-
-// The output file: a temporary beside the target, removed unless committed.
-class Output {
- public:
-  explicit Output(std::string path) : path_(std::move(path)) {
-    tmp_ = path_ + ".tmp." + std::to_string(::getpid());
-  }
-  ~Output() {
-    if (fd_ >= 0) ::close(fd_);
-    if (!committed_) ::unlink(tmp_.c_str());
-  }
-  Status open() {
-    fd_ = ::open(tmp_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd_ < 0)
-      return Error{fmt("bake '%s': cannot create '%s' (%s)", path_.c_str(), tmp_.c_str(),
-                       std::strerror(errno))};
-    return {};
-  }
-  std::uint64_t size() const noexcept { return at_; }
-  Status write(const void* data, std::size_t n) { return pwrite(at_, data, n, true); }
-  Status pwrite(std::uint64_t offset, const void* data, std::size_t n, bool advance = false) {
-    const auto* p = static_cast<const std::uint8_t*>(data);
-    std::size_t done = 0;
-    while (done < n) {
-      const ssize_t w = ::pwrite(fd_, p + done, n - done, off_t(offset + done));
-      if (w < 0 && errno == EINTR) continue;
-      if (w <= 0) {
-        const int err = w < 0 ? errno : ENOSPC;
-        return Error{fmt("bake '%s': writing failed (%s); nothing was written to '%s'",
-                         path_.c_str(), std::strerror(err), path_.c_str())};
-      }
-      done += std::size_t(w);
-    }
-    if (advance) at_ = std::max(at_, offset + n);
-    return {};
-  }
-  Status commit() {
-    // Closed here; flushed, renamed and the folder flushed by io/durable_file.h.
-    const int err = ::close(fd_) != 0 ? errno : 0;
-    fd_ = -1;
-    Status s = err != 0 ? Status{Error{fmt("flushing failed (%s)", std::strerror(err))}}
-                        : durable::put_in_place(tmp_, path_);
-    if (!s)
-      return Error{fmt("bake '%s': %s; nothing was written to '%s'", path_.c_str(),
-                       s.message().c_str(), path_.c_str())};
-    committed_ = true;
-    return {};
-  }
-
- private:
-  std::string path_, tmp_;
-  int fd_ = -1;
-  std::uint64_t at_ = 0;
-  bool committed_ = false;
-};
 
 // Runs fn(k) for k in [0, n) on `threads` threads.
 template <class Fn>
@@ -459,7 +402,7 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
       }
     };
     // Offsets and sizes of the TIFF-only edge tiles, by the page they follow.
-    std::unordered_map<std::size_t, std::pair<std::uint64_t, std::uint64_t>> edge_x, edge_z, edge_xz;
+    EdgeTiles edge_x, edge_z, edge_xz;
     // `threads` workers make the pages (cut, compressed, joined and checksummed) at most
     // `ahead` pages ahead of this thread, which writes them in order as they come.
     {
@@ -547,121 +490,11 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
     rep.pages = total_pages;
     report(0.95, "index");
 
-    // ---- page entries, in chunks read when a page of theirs is first loaded -----------------
-    std::vector<std::pair<std::uint64_t, std::uint64_t>> chunks;  // offset, checksum
-    for (std::size_t c0 = 0; c0 < entries.size(); c0 += kChunkEntries) {
-      Writer cw;
-      for (std::size_t k = c0; k < std::min(entries.size(), c0 + kChunkEntries); ++k) {
-        const PageEntry& e = entries[k];
-        cw.put(e.offset), cw.put(e.tile), cw.put(e.apron), cw.put(e.materials), cw.put(e.records);
-        cw.put(e.checksum);
-      }
-      chunks.emplace_back(out.size(), checksum(cw.bytes.data(), cw.bytes.size()));
-      if (auto st = out.write(cw.bytes.data(), cw.bytes.size()); !st) return Error{st.message()};
-    }
-
-    // ---- index ------------------------------------------------------------------------------
-    Writer w;
-    w.bytes.insert(w.bytes.end(), {'R', 'W', 'I', 'N', 'D', 'E', 'X', '1'});
-    w.put(info.width), w.put(info.height);
-    w.put(info.spacing_x), w.put(info.spacing_z), w.put(info.origin_x), w.put(info.origin_z);
-    w.put(info.height_offset), w.put(info.height_scale);
-    w.put(std::uint8_t(store_u16 ? 0 : 1));
-    w.put(info.min_local), w.put(info.max_local);
-    w.put(std::uint8_t(mats ? 1 : 0));
-    w.put(info.filled_samples), w.put(info.content_hash);
-    w.put_string(info.name);
-    w.put(exponent), w.put(window), w.put(delay);
-    w.put(grid.levels);
-    for (std::uint32_t k = 0; k < grid.levels; ++k) w.put(grid.px[k]), w.put(grid.pz[k]);
-    for (const PageSummary& s : summaries) w.put(s.lo), w.put(s.hi), w.put(s.lo8), w.put(s.hi8);
-    // Version 5: where the chunks of page entries lie (kChunkEntries a chunk) and their checksums.
-    for (const auto& [at, sum] : chunks) w.put(at), w.put(sum);
-    // Version 4: the holes as runs of cells along rows.
-    w.put(std::uint64_t(hole_runs.size()));
-    for (const HoleRun& r : hole_runs) w.put(r.j), w.put(r.i0), w.put(r.i1);
-    const std::uint64_t index_at = out.size();
-    if (auto s = out.write(w.bytes.data(), w.bytes.size()); !s) return Error{s.message()};
-
-    // ---- TIFF directories: the heights and their overviews, GeoTIFF tags on the first ---------
-    std::uint64_t first_ifd = 0, prev_next_at = 0;
-    for (std::uint32_t k = 0; k < grid.levels; ++k) {
-      const int ls = world::level_shift(k);
-      const std::uint32_t iw = std::uint32_t(((info.width - 1) >> ls) + 1);
-      const std::uint32_t ih = std::uint32_t(((info.height - 1) >> ls) + 1);
-      // Tiles row by row: the pages' own, then past the last page column / row the edge tiles.
-      const std::uint32_t tx = (iw + kTile - 1) / kTile, tz = (ih + kTile - 1) / kTile;
-      std::vector<std::uint64_t> offsets, counts;
-      for (std::uint32_t z = 0; z < tz; ++z)
-        for (std::uint32_t x = 0; x < tx; ++x) {
-          const std::uint32_t px = std::min<std::uint32_t>(x, std::uint32_t(grid.px[k]) - 1);
-          const std::uint32_t pz = std::min<std::uint32_t>(z, std::uint32_t(grid.pz[k]) - 1);
-          const std::size_t p = level_first[k] + px + std::size_t(pz) * std::size_t(grid.px[k]);
-          const bool past_x = x >= std::uint32_t(grid.px[k]), past_z = z >= std::uint32_t(grid.pz[k]);
-          std::pair<std::uint64_t, std::uint64_t> t{entries[p].offset, entries[p].tile};
-          if (past_x || past_z) {
-            auto& m = past_x && past_z ? edge_xz : past_x ? edge_x : edge_z;
-            const auto it = m.find(p);
-            if (it == m.end())
-              return Error{fmt("bake: internal error: no edge tile for page %zu of level %u", p, k)};
-            t = it->second;
-          }
-          offsets.push_back(t.first);
-          counts.push_back(t.second);
-        }
-      std::vector<TiffEntry> tags = {
-          entry<std::uint32_t>(254, kLong, {k == 0 ? 0u : 1u}),
-          entry<std::uint32_t>(256, kLong, {iw}),
-          entry<std::uint32_t>(257, kLong, {ih}),
-          entry<std::uint16_t>(258, kShort, {std::uint16_t(store_u16 ? 16 : 32)}),
-          entry<std::uint16_t>(259, kShort, {8}),
-          entry<std::uint16_t>(262, kShort, {1}),
-          entry<std::uint16_t>(277, kShort, {1}),
-          entry<std::uint16_t>(284, kShort, {1}),
-          entry<std::uint16_t>(317, kShort, {std::uint16_t(store_u16 ? 2 : 3)}),
-          entry<std::uint32_t>(322, kLong, {kTile}),
-          entry<std::uint32_t>(323, kLong, {kTile}),
-          entry<std::uint64_t>(324, kLong8, offsets),
-          entry<std::uint64_t>(325, kLong8, counts),
-          entry<std::uint16_t>(339, kShort, {std::uint16_t(store_u16 ? 1 : 3)}),
-      };
-      if (k == 0) {
-        // World x is easting and z is -northing (io.h, FilePlacement): the model's y is -z.
-        tags.push_back(entry<double>(33550, kDouble, {info.spacing_x, info.spacing_z, 0.0}));
-        tags.push_back(entry<double>(33922, kDouble,
-                                     {0.0, 0.0, 0.0, info.origin_x, -info.origin_z, 0.0}));
-        // Projected, user-defined, metres; samples at pixel centres (PixelIsPoint).
-        tags.push_back(entry<std::uint16_t>(34735, kShort,
-                                            {1, 1, 0, 4, 1024, 0, 1, 1, 1025, 0, 1, 2, 3072, 0,
-                                             1, 32767, 3076, 0, 1, 9001}));
-      }
-      std::uint64_t next_at = 0;
-      auto at = write_ifd(out, std::move(tags), next_at);
-      if (!at) return at.error();
-      if (k == 0)
-        first_ifd = *at;
-      else if (auto s = out.pwrite(prev_next_at, &*at, 8); !s)
-        return Error{s.message()};
-      prev_next_at = next_at;
-    }
-
-    // ---- header and locator -------------------------------------------------------------------
-    Writer hdr;
-    hdr.bytes.insert(hdr.bytes.end(), {'I', 'I', 43, 0, 8, 0, 0, 0});
-    hdr.put(first_ifd);
-    if (auto s = out.pwrite(0, hdr.bytes.data(), hdr.bytes.size()); !s) return Error{s.message()};
-    Writer loc;
-    loc.bytes.insert(loc.bytes.end(), kMagic, kMagic + 8);
-    loc.put(kVersion);
-    loc.put(std::uint32_t(0));
-    loc.put(index_at);
-    loc.put(std::uint64_t(w.bytes.size()));
-    loc.put(checksum(w.bytes.data(), w.bytes.size()));
-    loc.put(out.size());
-    loc.put(checksum(loc.bytes.data(), 48));
-    loc.bytes.resize(kLocatorBytes, 0);
-    if (auto s = out.pwrite(kLocatorAt, loc.bytes.data(), loc.bytes.size()); !s)
-      return Error{s.message()};
+    if (auto st = write_file_end(out, {info, store_u16, mats, exponent, window, delay, grid,
+                                       level_first, summaries, entries, hole_runs, edge_x, edge_z,
+                                       edge_xz});
+        !st)
+      return Error{st.message()};
     rep.bytes = out.size();
     if (auto s = out.commit(); !s) return Error{s.message()};
     report(1.0, "done");
