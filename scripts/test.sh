@@ -97,10 +97,7 @@ asan() {
 # that stage did not run), each run for FUZZ_SECONDS on a copy of its committed corpus. A crash
 # fails the stage; the input is kept in build/asan/crashes/ (commit it under tests/fuzz/corpus/
 # with the fix).
-# fuzz_world is not in the default list yet: each of its runs of a minute or more has found a new
-# fault in the world reader so far (docs/reliability.md); run it with
-# FUZZ_TARGETS="fuzz_world" STAGES=fuzz scripts/test.sh. Its corpus is replayed in every build.
-read -r -a FUZZ_TARGETS <<< "${FUZZ_TARGETS:-fuzz_raw fuzz_camera_path fuzz_image fuzz_edit_json fuzz_edit_state fuzz_lua}"
+read -r -a FUZZ_TARGETS <<< "${FUZZ_TARGETS:-fuzz_raw fuzz_camera_path fuzz_image fuzz_edit_json fuzz_edit_state fuzz_lua fuzz_world}"
 fuzz() {
   local dir=build/asan t rc=0 secs=${FUZZ_SECONDS:-30}
   mkdir -p "$dir/crashes"
