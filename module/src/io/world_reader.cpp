@@ -330,14 +330,26 @@ Status WorldSource::load(const PageKey& key, PageData& out) const {
   if (e.offset < kDataStart || e.offset > data_end_ || e.bytes() > data_end_ - e.offset)
     return Error{fmt("%s: page (%u, %d, %d) lies outside the file (corrupted)", name_.c_str(),
                      key.level, key.px, key.pz)};
-  std::vector<std::uint8_t> bytes(e.bytes());
+  // A page's four parts compressed: at most about 0.7 MB (float heights and bounds that do not
+  // compress at all); more is a damaged entry.
+  constexpr std::uint64_t kMaxPageBytes = std::uint64_t{4} << 20;
+  if (e.bytes() > kMaxPageBytes)
+    return Error{fmt("%s: page (%u, %d, %d) claims %llu bytes (corrupted)", name_.c_str(),
+                     key.level, key.px, key.pz, static_cast<unsigned long long>(e.bytes()))};
+  // The page's bytes and its decompressed tile and apron are read into buffers kept per loading
+  // thread: fresh buffers of this size were zeroed, then faulted in from the system, on every
+  // load.
+  thread_local std::vector<std::uint8_t> bytes, tile, apron;
+  thread_local std::vector<float> tile_f32;
+  bytes.resize(e.bytes());
   if (auto r = read_at(e.offset, bytes.data(), bytes.size()); !r) return r;
   if (checksum(bytes.data(), bytes.size()) != e.checksum)
     return Error{fmt("%s: page (%u, %d, %d) is corrupted (checksum mismatch)", name_.c_str(),
                      key.level, key.px, key.pz)};
   const bool u16 = info_.format == SampleFormat::kU16;
   const std::size_t sample_bytes = u16 ? 2 : 4;
-  std::vector<std::uint8_t> tile(kTileSamples * sample_bytes), apron(kApronSamples * sample_bytes);
+  tile.resize(kTileSamples * sample_bytes);
+  apron.resize(kApronSamples * sample_bytes);
   const std::uint8_t* p = bytes.data();
   auto bad = [&](const char* part) {
     return Error{fmt("%s: page (%u, %d, %d): its %s does not decompress (corrupted)",
@@ -366,7 +378,8 @@ Status WorldSource::load(const PageKey& key, PageData& out) const {
     out.f32.clear();
     place(out.u16.data(), t, reinterpret_cast<const std::uint16_t*>(apron.data()));
   } else {
-    std::vector<float> t(kTileSamples);
+    std::vector<float>& t = tile_f32;
+    t.resize(kTileSamples);
     decode_f32(tile.data(), t.data());
     out.f32.resize(kPageEntries);
     out.u16.clear();
