@@ -1,6 +1,5 @@
 // The baked world's reader (world_file.h, world_format.h): a PageSource over a world file.
 #include <fcntl.h>
-#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -22,45 +21,6 @@ using detail::fmt;
 using namespace world_file;
 
 namespace {
-
-// A buffer of `n` bytes whose pages the kernel maps at once (Linux: MAP_POPULATE), so that
-// filling it costs no page fault per 4 KiB page: on a virtual machine each fault is an exit to
-// the host, and the 3.3 MB index of a 65537^2 world took 15-25 ms to read into fresh memory, 2 ms
-// into memory already mapped. A plain allocation where that is not available.
-class PopulatedBuffer {
- public:
-  explicit PopulatedBuffer(std::size_t n) : n_(n) {
-#if defined(MAP_POPULATE)
-    if (n >= (std::size_t{1} << 20)) {
-      void* p = ::mmap(nullptr, n, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE,
-                       -1, 0);
-      if (p != MAP_FAILED) {
-        data_ = static_cast<std::uint8_t*>(p);
-        mapped_ = true;
-        return;
-      }
-    }
-#endif
-    data_ = new std::uint8_t[n];
-  }
-  ~PopulatedBuffer() {
-#if defined(MAP_POPULATE)
-    if (mapped_) {
-      ::munmap(data_, n_);
-      return;
-    }
-#endif
-    delete[] data_;
-  }
-  PopulatedBuffer(const PopulatedBuffer&) = delete;
-  PopulatedBuffer& operator=(const PopulatedBuffer&) = delete;
-  std::uint8_t* data() const noexcept { return data_; }
-
- private:
-  std::uint8_t* data_ = nullptr;
-  std::size_t n_ = 0;
-  bool mapped_ = false;
-};
 
 class WorldSource final : public PageSource {
  public:
@@ -92,8 +52,7 @@ class WorldSource final : public PageSource {
   std::vector<std::size_t> level_first_;  // index of each level's first page
   // The index as read (its checksum checked at the open). The page summaries and the page
   // entries are read from it when asked for: the open does nothing per page but the checksum.
-  std::unique_ptr<PopulatedBuffer> index_;
-  std::size_t index_bytes_ = 0;
+  std::unique_ptr<std::uint8_t[]> index_;
   std::size_t summaries_at_ = 0, entries_at_ = 0;  // where they start in index_
   std::size_t page_count_ = 0;
   std::uint64_t data_end_ = 0;
@@ -163,11 +122,11 @@ Result<std::shared_ptr<const PageSource>> WorldSource::open(const std::string& p
   if (index_at < kDataStart || index_bytes > (std::uint64_t{1} << 34) ||
       index_at + index_bytes > data_end)
     return Error{fmt("%s: its index lies outside the file (corrupted)", s->name_.c_str())};
-  s->index_ = std::make_unique<PopulatedBuffer>(std::size_t(index_bytes));
-  s->index_bytes_ = std::size_t(index_bytes);
+  // Not value-initialised: the read fills it.
+  s->index_.reset(new std::uint8_t[std::size_t(index_bytes)]);
   s->data_end_ = data_end;
-  const std::span<const std::uint8_t> index(s->index_->data(), s->index_bytes_);
-  if (auto r = s->read_at(index_at, s->index_->data(), index.size()); !r)
+  const std::span<const std::uint8_t> index(s->index_.get(), std::size_t(index_bytes));
+  if (auto r = s->read_at(index_at, s->index_.get(), index.size()); !r)
     return Error{r.message()};
   if (checksum(index.data(), index.size()) != index_sum)
     return Error{fmt("%s: its index is corrupted (checksum mismatch)", s->name_.c_str())};
@@ -283,7 +242,7 @@ Result<std::shared_ptr<const PageSource>> WorldSource::open(const std::string& p
 }
 
 Result<const std::uint8_t*> WorldSource::entry_bytes(std::size_t slot) const {
-  if (chunks_.empty()) return index_->data() + entries_at_ + kEntryBytes * slot;
+  if (chunks_.empty()) return index_.get() + entries_at_ + kEntryBytes * slot;
   const std::size_t c = slot / kChunkEntries;
   std::lock_guard lock(chunks_mu_);
   Chunk& ch = chunks_[c];
@@ -302,7 +261,7 @@ Result<const std::uint8_t*> WorldSource::entry_bytes(std::size_t slot) const {
 Status WorldSource::summaries(std::vector<PageSummary>& out) const {
   const std::size_t n = grid_.count(0);
   out.resize(n);
-  Reader in{std::span<const std::uint8_t>(index_->data() + summaries_at_, 16 * n)};
+  Reader in{std::span<const std::uint8_t>(index_.get() + summaries_at_, 16 * n)};
   for (PageSummary& m : out) {
     m.lo = in.get<float>(), m.hi = in.get<float>(), m.lo8 = in.get<float>(), m.hi8 = in.get<float>();
     if (!(m.lo <= m.hi) || !(m.lo8 <= m.hi8))

@@ -73,6 +73,9 @@ Status check_summary(const WorldInfo& info, const PageKey& key, const PageData& 
 // nearest entry inside the data, which a level-0 page always holds.
 void clamp_outside_data(const PageGrid& g, const PageKey& key, PageData& d) {
   const std::int64_t i0 = std::int64_t(key.px) << 8, j0 = std::int64_t(key.pz) << 8;
+  if (i0 - kPageApron >= 0 && j0 - kPageApron >= 0 && i0 + kPageCells + kPageApron <= g.last_i &&
+      j0 + kPageCells + kPageApron <= g.last_j)
+    return;  // every entry inside the data (all pages but those on the world's border)
   auto inside = [](std::int64_t v, std::int64_t base, std::int64_t last) {
     return std::int32_t(std::clamp<std::int64_t>(base + v, 0, last) - base);
   };
