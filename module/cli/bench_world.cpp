@@ -11,6 +11,8 @@
 //      cache's bytes and the whole process's resident memory sampled every second.
 // The program links the core and Ridgeline::world only (no OpenImageIO): its memory is what an
 // engine streaming a baked world pays.
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 #include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
@@ -21,6 +23,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <random>
 #include <string>
 #include <thread>
@@ -73,8 +76,24 @@ struct Options {
   int width = 1280, height = 720;
   std::size_t budget_mb = 128;  // the process stays under 256 MB at 16385^2 (docs/worlds.md)
   std::uint32_t workers = 2, teleports = 5, bake_threads = 0;
+  bool in_memory = false;  // also fly each size over the terrain made in memory
   double clearance = 120;
 };
+
+// The generated world's 16-bit samples, `n` a side, made on every core.
+std::vector<std::uint16_t> generate(const Options& o, std::uint32_t n) {
+  std::vector<std::uint16_t> raw(std::size_t(n) * n);
+  std::vector<std::thread> pool;
+  const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+  for (unsigned t = 0; t < threads; ++t)
+    pool.emplace_back([&, t] {
+      for (std::uint32_t j0 = 64 * t; j0 < n; j0 += 64 * threads)
+        scenes::generated_world_rows(n, j0, std::min(n, j0 + 64), o.seed,
+                                     raw.data() + std::size_t(j0) * n);
+    });
+  for (auto& th : pool) th.join();
+  return raw;
+}
 
 // Bakes the generated world of `n` samples a side into `path` unless a world this build reads is
 // there (one of an older format version is baked again).
@@ -88,18 +107,7 @@ nlohmann::json bake_if_missing(const Options& o, std::uint32_t n, const std::str
   }
   std::filesystem::create_directories(std::filesystem::path(path).parent_path());
   const auto t0 = Clock::now();
-  std::vector<std::uint16_t> raw(std::size_t(n) * n);
-  {
-    std::vector<std::thread> pool;
-    const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
-    for (unsigned t = 0; t < threads; ++t)
-      pool.emplace_back([&, t] {
-        for (std::uint32_t j0 = 64 * t; j0 < n; j0 += 64 * threads)
-          scenes::generated_world_rows(n, j0, std::min(n, j0 + 64), o.seed,
-                                       raw.data() + std::size_t(j0) * n);
-      });
-    for (auto& th : pool) th.join();
-  }
+  const std::vector<std::uint16_t> raw = generate(o, n);
   const double generate_s = ms_between(t0, Clock::now()) / 1000;
   io::BakeSamples s;
   s.info.width = s.info.height = n;
@@ -155,30 +163,56 @@ struct Flight {
   }
 };
 
-nlohmann::json run_size(const Options& o, std::uint32_t n) {
+// One size over the baked world (`memory` false) or over the terrain made in memory from the same
+// samples (`memory` true: the open is the generation, the heightfield and Terrain::create; no
+// clone is timed, since a clone of it is the same as the paged one's).
+nlohmann::json run_size(const Options& o, std::uint32_t n, bool memory) {
   nlohmann::json out;
   out["size"] = n;
   out["samples"] = double(n) * n;
   const std::string path =
       o.dir + "/generated_" + std::to_string(n) + "_s" + std::to_string(o.seed) + ".tif";
-  out["world"] = path;
-  out["bake"] = bake_if_missing(o, n, path);
-  std::fprintf(stderr, "size %u: baked (%s)\n", n, out["bake"].dump().c_str());
+  out["path"] = memory ? "memory" : "paged";
+  if (!memory) {
+    out["world"] = path;
+    out["bake"] = bake_if_missing(o, n, path);
+    std::fprintf(stderr, "size %u: baked (%s)\n", n, out["bake"].dump().c_str());
+  }
 
   // ---- open to first mesh ------------------------------------------------------------------
   reset_peak_rss();
   const std::size_t rss_before = status_bytes("VmRSS");
   const auto t0 = Clock::now();
-  auto source = io::open_world(path);
-  if (!source) {
-    std::fprintf(stderr, "ridge-bench-world: %s\n", source.error().message.c_str());
-    std::exit(1);
+  Result<std::shared_ptr<const PageSource>> source = Error{"in memory"};
+  std::optional<Heightfield> samples;
+  if (memory) {
+    const std::vector<std::uint16_t> raw = generate(o, n);
+    HeightfieldDesc d;
+    d.width = d.height = n;
+    d.spacing_x = d.spacing_z = 1.0;
+    d.height_scale = scenes::kWorldHeightScale;
+    d.max_samples = ~std::uint64_t{0};
+    d.name = "generated world " + std::to_string(n);
+    auto hf = Heightfield::create(d, std::vector<float>(raw.begin(), raw.end()));
+    if (!hf) {
+      std::fprintf(stderr, "ridge-bench-world: %s\n", hf.error().message.c_str());
+      std::exit(1);
+    }
+    samples.emplace(std::move(*hf));
+  } else {
+    source = io::open_world(path);
+    if (!source) {
+      std::fprintf(stderr, "ridge-bench-world: %s\n", source.error().message.c_str());
+      std::exit(1);
+    }
   }
   const auto t1 = Clock::now();
   WorldCacheDesc cache;
   cache.budget_bytes = o.budget_mb << 20;
   cache.worker_threads = o.workers;
-  auto terrain = Terrain::open(*source, cache).value();
+  auto terrain = memory ? Terrain::create(std::move(*samples)).value()
+                        : Terrain::open(*source, cache).value();
+  samples.reset();
   const auto t2 = Clock::now();
   auto landscape = Landscape::create(terrain).value();
   const auto t3 = Clock::now();
@@ -193,8 +227,8 @@ nlohmann::json run_size(const Options& o, std::uint32_t n) {
   Camera cam = flight.camera(*terrain, 0, o);
   auto first = view->update(cam);
   const auto t5 = Clock::now();
-  out["open"] = {{"open_world_ms", ms_between(t0, t1)},
-                 {"terrain_open_ms", ms_between(t1, t2)},
+  out["open"] = {{memory ? "generate_and_heightfield_ms" : "open_world_ms", ms_between(t0, t1)},
+                 {memory ? "terrain_create_ms" : "terrain_open_ms", ms_between(t1, t2)},
                  {"landscape_create_ms", ms_between(t2, t3)},
                  {"view_create_ms", ms_between(t3, t4)},
                  {"first_update_ms", ms_between(t4, t5)},
@@ -203,7 +237,7 @@ nlohmann::json run_size(const Options& o, std::uint32_t n) {
                  {"rss_growth_bytes", status_bytes("VmRSS") - std::min(rss_before, status_bytes("VmRSS"))}};
 
   // ---- a snapshot for another thread (Terrain::clone), before and after edits ----------------
-  {
+  if (!memory) {
     // On a terrain of its own over the same world (its edits stay out of the flight).
     auto scratch = Terrain::open(*source, cache).value();
     auto time_clone = [&] {
@@ -381,6 +415,10 @@ int main(int argc, char** argv) {
   app.add_option("--teleports", o.teleports, "Teleports timed after the open (default 5)")
       ->check(CLI::Range(0, 1000));
   app.add_option("--bake-threads", o.bake_threads, "Bake threads (default 0: every core)");
+  app.add_flag("--in-memory", o.in_memory,
+               "Also fly each size over the terrain made in memory from the same samples (after "
+               "the baked world's run; it needs about 12 bytes a sample while made, and sizes that would "
+               "not fit in memory are reported as skipped)");
   app.add_option("--json", json_path, "Write the JSON to FILE instead of standard output");
   CLI11_PARSE(app, argc, argv);
 
@@ -389,7 +427,24 @@ int main(int argc, char** argv) {
   j["load_average_before"] = load_average();
   j["hardware_threads"] = std::thread::hardware_concurrency();
   j["runs"] = nlohmann::json::array();
-  for (std::uint32_t n : o.sizes) j["runs"].push_back(run_size(o, n));
+  for (std::uint32_t n : o.sizes) {
+    j["runs"].push_back(run_size(o, n, false));
+    if (!o.in_memory) continue;
+    // The terrain in memory holds its samples as floats while it is made (4 bytes a sample,
+    // beside the 2-byte generated ones) and about 6 bytes a sample after: a size that would not
+    // fit in the machine's memory is reported, not tried.
+    const double need = 12.0 * double(n) * double(n);
+    const double have = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
+    if (need > 0.8 * have) {
+      j["runs"].push_back({{"size", n},
+                           {"path", "memory"},
+                           {"skipped", "needs about " + std::to_string(int(need / 1e9)) +
+                                           " GB in memory; the machine has " +
+                                           std::to_string(int(have / 1e9)) + " GB"}});
+      continue;
+    }
+    j["runs"].push_back(run_size(o, n, true));
+  }
   j["load_average_after"] = load_average();
   const std::string text = j.dump(2) + "\n";
   if (json_path.empty()) {
