@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Replays the planted faults of docs/reliability.md ("Planted faults"): for each line of
+# Replays the planted faults of docs/reliability/planted_faults.md: for each line of
 # tests/planted_faults.txt it applies the one-line fault tests/planted_faults/NAME.patch to the
 # source tree, rebuilds the targets the line names in BUILD_DIR, runs the tests its ctest regex
 # selects and reports "caught" when one of them fails, "NOT caught" when they all pass. The fault

@@ -93,7 +93,7 @@ asan() {
     run_ctest asan build/asan with_display
 }
 
-# libFuzzer targets (tests/fuzz, docs/reliability.md) from the asan stage's build (built here if
+# libFuzzer targets (tests/fuzz, docs/reliability/fuzzing.md) from the asan stage's build (built here if
 # that stage did not run), each run for FUZZ_SECONDS on a copy of its committed corpus. A crash
 # fails the stage; the input is kept in build/asan/crashes/ (commit it under tests/fuzz/corpus/
 # with the fix).
@@ -114,7 +114,7 @@ fuzz() {
       -print_final_stats=1 -artifact_prefix="$dir/crashes/$t-" "${extra[@]}" \
       "$work" "tests/fuzz/corpus/$t" > "$dir/$t.log" 2>&1
     local r=$?
-    # One line per target: executions, coverage, corpus size (docs/reliability.md quotes these).
+    # One line per target: executions, coverage, corpus size (docs/reliability/fuzzing.md quotes these).
     echo "$t: exit $r, $(grep -o 'stat::number_of_executed_units: *[0-9]*' "$dir/$t.log" |
       grep -o '[0-9]*$') execs, $(grep -o 'cov: [0-9]* ft: [0-9]*' "$dir/$t.log" | tail -1),"\
       "corpus $(find "$work" -type f | wc -l) files"

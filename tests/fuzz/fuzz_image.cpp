@@ -3,7 +3,7 @@
 // the file extension (bits 0-2), whether a channel is chosen (bit 3) and which (bits 4-5), and
 // whether the CRCs of a PNG's chunks are fixed up (bit 7); the rest is written to a file.
 //
-// Speed (docs/reliability.md, "Fuzzing"): images are capped at 4,096 samples before any pixel is
+// Speed (docs/reliability/fuzzing.md): images are capped at 4,096 samples before any pixel is
 // decoded, and OpenImageIO runs on one thread. Mutated PNG bytes would almost always fail their
 // chunk's CRC (the loader walks the chunks first), so half the PNG inputs get their CRCs
 // recomputed to reach the decoder.

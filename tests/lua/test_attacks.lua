@@ -269,7 +269,7 @@ T.case("file names: traversal, absolute, NUL, odd names", function()
 end)
 
 -- Debian 12's Lua is 5.4.4: the bugs lua.org/bugs.html lists for it, run through the sandbox
--- (docs/reliability.md, "Lua 5.4.4's known bugs"). Bug 9 (nested coroutine.close crashing the
+-- (docs/reliability/sandbox.md, "Lua 5.4.4's known bugs"). Bug 9 (nested coroutine.close crashing the
 -- process) is in test_lua_host.cpp: it needs more memory than this host allows.
 T.case("Lua 5.4.4 bug 2: _ENV <const> (CVE-2022-28805, patched by Debian)", function()
   local ok, err = pcall(function() local _ENV <const> = 11; X = "hi" end)  -- luacheck: ignore

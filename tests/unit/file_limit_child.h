@@ -1,5 +1,5 @@
 // Runs a piece of a test in a forked child whose files may not grow past a limit: a full disk
-// without root and without filling any file system (issue 9, docs/reliability.md "Faults").
+// without root and without filling any file system (issue 9, docs/reliability/soak_and_faults.md, "Faults").
 #pragma once
 #include <signal.h>
 #include <sys/resource.h>

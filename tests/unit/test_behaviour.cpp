@@ -1,7 +1,7 @@
 // Behaviour of the tessellator and the change log through the public API only (Terrain,
 // Landscape::create, RoamView, Terrain::changes_since): what an engine sees. Each test names the
 // fault it guards against in its failure message; none reads a private class, so they hold
-// whatever the storage and the view look like inside (docs/reliability.md, "Behaviour tests").
+// whatever the storage and the view look like inside (docs/reliability/planted_faults.md, "Behaviour tests").
 #include <gtest/gtest.h>
 
 #include <cmath>

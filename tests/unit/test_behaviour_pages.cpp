@@ -1,6 +1,6 @@
 // Behaviour across the borders of the terrain's pages (256 x 256 cells, each with a six-sample
 // apron of its neighbours' samples) and at the far edges, through the public API only
-// (docs/reliability.md, "Planted faults"): batched queries, edits near a page border, the bounds
+// (docs/reliability/planted_faults.md): batched queries, edits near a page border, the bounds
 // an edit remakes on the far edge, the box an edit reports, and undoing edits by loading an
 // earlier save. Each failure message names what went wrong.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Fault injection (issue 9, docs/reliability.md): the detail memory budget exhausted, a worker
+// Fault injection (issue 9, docs/reliability/soak_and_faults.md): the detail memory budget exhausted, a worker
 // task that fails, a heightmap file changing while loaded, the process killed in the middle of
 // saving the edit layer, the disk filling up during a save.
 #include <gtest/gtest.h>

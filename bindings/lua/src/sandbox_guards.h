@@ -29,7 +29,7 @@ void install_string_guards(lua_State* L, int string_t);
 /// The same for table.move and table.sort of the table library at `table_t`.
 void install_table_guards(lua_State* L, int table_t);
 /// Bounds the nesting of coroutine.close of the coroutine library at `coroutine_t` (Lua 5.4.4
-/// crashes on deep nesting: docs/reliability.md, "Lua 5.4.4's known bugs").
+/// crashes on deep nesting: docs/reliability/sandbox.md, "Lua 5.4.4's known bugs").
 void install_coroutine_guards(lua_State* L, int coroutine_t);
 /// Makes utf8.codes of the utf8 library at `utf8_t` raise on stray continuation bytes, as Lua
 /// 5.4.6 does (5.4.4 skips them).
