@@ -1,5 +1,5 @@
 // Measured error and popping of drawn meshes over a fixed sample of lattice vertices
-// (mesh_error.h; definitions in docs/report.md). Any drawn mesh: nothing here knows the
+// (mesh_error.h; definitions in docs/report_method.md). Any drawn mesh: nothing here knows the
 // tessellator (a view's leaves become a DrawnMesh in leaves_mesh.cpp).
 #include "ridgeline/mesh_error.h"
 

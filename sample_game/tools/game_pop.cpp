@@ -1,4 +1,4 @@
-// game_pop: the pop metric of `ridge report` (docs/report.md, "Pop") for a camera path the game
+// game_pop: the pop metric of `ridge report` (docs/report_method.md, "Pop") for a camera path the game
 // recorded (`ridgeline_game --record-path PATH.json`), on the game's own world: the default
 // terrain with the default world's procedural detail, the game's ROAM patches, a coherent
 // RoamView at a fixed threshold, geomorphs as the game's renderer draws them. A front end of

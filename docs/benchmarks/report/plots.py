@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Turns `ridge report`'s report.csv (no header; columns in docs/report.md) into gnuplot data and
+"""Turns `ridge report`'s report.csv (no header; columns in docs/cli.md) into gnuplot data and
 PNG plots (one per scene and path: error against triangles, error against update ms, update ms
 against triangles, one line per mode over the threshold settings) and a markdown summary.
 Usage: plots.py REPORT_DIR   (reads REPORT_DIR/report.csv and report.json, writes

@@ -1,4 +1,4 @@
-// The scenes of `ridge report` (docs/report.md, "Scenes"): the noise field and the real DEM as a
+// The scenes of `ridge report` (docs/report_method.md, "Scenes"): the noise field and the real DEM as a
 // user would load them (loader messages captured), the procedural-detail world, the synthetic
 // fields of the smoke run and the hard cases, and the loader hard cases written to files and
 // read back. Part of the `ridge` tool (it uses Ridgeline::io).

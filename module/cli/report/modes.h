@@ -1,4 +1,4 @@
-// The modes `ridge report` runs along a camera path (docs/report.md, "Modes"): ROAM coherent and
+// The modes `ridge report` runs along a camera path (docs/report_method.md, "Modes"): ROAM coherent and
 // rebuild, the uniform grid, the CDLOD-like quadtree and the SOAR refinement, each a technique of
 // Ridgeline::bench run by its frame loop over a scene's lattice.
 #pragma once

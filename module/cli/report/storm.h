@@ -1,6 +1,6 @@
 // The deformation storm of `ridge report`: a crater every frame (Terrain::apply_edit) where the
 // view ray meets the ground while the camera flies, every mode on its own fresh copy of the
-// terrain seeing the same craters (docs/report.md, "Scenes").
+// terrain seeing the same craters (docs/report_method.md, "Scenes").
 #pragma once
 
 #include <string>

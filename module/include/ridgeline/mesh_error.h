@@ -1,6 +1,6 @@
 // Measured error of a drawn triangle mesh against the true surface, and popping between two drawn
 // meshes: the one measurement that tests, `ridge bench lod` and `ridge report` share
-// (docs/report.md, "Measured error").
+// (docs/report_method.md, "Measured error").
 #pragma once
 
 #include <cstdint>
@@ -28,7 +28,7 @@ struct DrawnMesh {
   }
 };
 
-/// Measured error over the sampled lattice vertices (docs/report.md).
+/// Measured error over the sampled lattice vertices (docs/report_method.md).
 struct MeshError {
   double max_m = 0;             ///< largest |drawn height - surface height|, metres
   double rms_m = 0;             ///< root mean square of the same over the covered vertices, metres
@@ -105,7 +105,7 @@ class MeshErrorMeter {
   /// skipped. With `before_camera`, only vertices also inside that frustum count (a vertex that
   /// was out of view cannot visibly jump as it comes into view). Used for the per-vertex jump
   /// (two frames, each drawn for its own camera) and for the pop (two meshes drawn for the same
-  /// camera: docs/report.md, "Popping").
+  /// camera: docs/report_method.md, "Popping").
   double jump_px(const DrawnHeights& before, const DrawnHeights& now, const Camera& camera,
                  const Camera* before_camera = nullptr) const;
 

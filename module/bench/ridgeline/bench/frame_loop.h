@@ -55,7 +55,7 @@ struct Run {
   std::vector<double> wall_ms, cpu_ms, faults, output_ms, output_cpu_ms;
   std::vector<double> triangles, changes, memory_bytes, data_bytes, upload_bytes, output_bytes;
   // Per measured frame: the mesh drawn without geomorphs, and with them where it morphs; the
-  // per-vertex jump and the pop with pops (docs/report.md, "Definitions").
+  // per-vertex jump and the pop with pops (docs/report_method.md, "Definitions").
   std::vector<double> in_view, max_m, rms_m, max_px, p99_px, vertices, morph_max_px;
   std::vector<double> jump, jump_morph, pop, pop_morph;
   std::uint64_t uncovered = 0;  ///< measured vertices in view no triangle covered (holes)

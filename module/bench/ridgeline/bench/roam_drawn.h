@@ -1,6 +1,6 @@
 // ROAM's mesh as a renderer draws it, for the measurement: the patch meshes with their geomorph
 // data, captured after an update and drawn later for any camera (the pop metric draws the previous
-// frame's mesh with the current camera; docs/report.md, "Popping").
+// frame's mesh with the current camera; docs/report_method.md, "Popping").
 //
 // The geomorphed height of a vertex is computed in ONE place, roam_drawn_y(): when the core's
 // MeshVertex or its shader formula changes, that function is the only one to follow.

@@ -11,7 +11,7 @@
 // Cafu's TerrainT): kappa = projection_scale(camera) / threshold_px, so a threshold in pixels means
 // what it means for ROAM (a world error e at distance d projects to e * projection_scale / d px).
 //
-// A yardstick, not a feature: it lives in Ridgeline::bench (docs/report.md, "SOAR").
+// A yardstick, not a feature: it lives in Ridgeline::bench (docs/report_method.md, "SOAR").
 #pragma once
 
 #include <cstdint>

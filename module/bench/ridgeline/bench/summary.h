@@ -1,5 +1,5 @@
 // The figures of a run (frame_loop.h) as the front ends print them, every median and percentile
-// by stats.h's quantile: `ridge report`'s per-mode figures (docs/report.md, "Definitions"; also
+// by stats.h's quantile: `ridge report`'s per-mode figures (docs/report_method.md, "Definitions"; also
 // game_pop's) and `ridge bench lod`'s summary (docs/cli.md). The field names are what scripts/
 // and docs/ read: add fields, do not rename them.
 #pragma once
