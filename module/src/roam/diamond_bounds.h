@@ -464,9 +464,10 @@ struct SmallStencil {
   }
 
   // bound_of() of the diamond whose centre is entry `c0` of `p` (its triangles and children
-  // inside the data and the block), children's bounds read from `out` at the same entries.
-  DiamondBound bound(const RecordConfig& c, const float* p, const DiamondBound* out,
-                     std::ptrdiff_t c0) const noexcept {
+  // inside the data and the block), packed; children's packed bounds read from `out` at the same
+  // entries.
+  std::uint32_t bound(const RecordConfig& c, const float* p, const std::uint32_t* out,
+                      std::ptrdiff_t c0) const noexcept {
     double err = 0;
     for (const Tri& q : tri) {
       const double ha = p[c0 + q.a], hl = p[c0 + q.l], hr = p[c0 + q.r];
@@ -482,7 +483,7 @@ struct SmallStencil {
     bool straddles = false;
     const double hv = p[c0];
     for (int k = 0; k < children; ++k) {
-      const DiamondBound& cb = out[c0 + child[k]];
+      const DiamondBound cb = packed::unpack(out[c0 + child[k]]);
       const double dx = cdx[k] * c.spacing_x, dz = cdz[k] * c.spacing_z;
       const double dy = double(p[c0 + child[k]]) - hv;
       const double dist = std::sqrt(dx * dx + dz * dz + dy * dy);
@@ -492,25 +493,25 @@ struct SmallStencil {
       straddles |= cb.radius >= FLT_MAX;
     }
     if (straddles) radius = FLT_MAX;
-    return quantized(
+    return packed::pack(
         {round_up(err), round_up(morph), radius >= FLT_MAX ? FLT_MAX : round_up(radius)});
   }
 };
 
 // The bounds of every t <= 1 diamond whose descendants lie in the block of samples
 // [i0, i0 + n) x [j0, j0 + n) (or past the padded extent, where they do not exist), finest
-// first, into out[(i - i0) + (j - j0) n]; other entries are left as they are. `h`: the block's
-// heights. The level-0 blocks and the bake's t = 1 squares both come from here, so both hold
-// the same values.
+// first, packed (packed::pack: what the records hold, a quarter of a DiamondBound's bytes) into
+// out[(i - i0) + (j - j0) n]; other entries are left as they are. `h`: the block's heights. The
+// level-0 blocks and the bake's t = 1 squares both come from here, so both hold the same values.
 // `stencils` false computes every diamond with bound_of() (what the tests compare against).
-inline void small_bounds(const RecordConfig& c, const DenseBlock& h, std::vector<DiamondBound>& out,
+inline void small_bounds(const RecordConfig& c, const DenseBlock& h, std::vector<std::uint32_t>& out,
                          bool stencils = true) {
   const std::int64_t i0 = h.i0, j0 = h.j0, n = h.n;
   out.resize(std::size_t(n * n));
   auto at = [&](std::int64_t i, std::int64_t j) -> DiamondBound {
     const std::int64_t a = i - i0, b = j - j0;
     if (a < 0 || b < 0 || a >= n || b >= n) return DiamondBound{};
-    return out[std::size_t(a + b * n)];
+    return packed::unpack(out[std::size_t(a + b * n)]);
   };
   // Kinds in order: t = 0 edge, t = 0 square, t = 1 edge, t = 1 square; the residues of their
   // centres (i mod m, j mod m).
@@ -563,7 +564,7 @@ inline void small_bounds(const RecordConfig& c, const DenseBlock& h, std::vector
               const std::ptrdiff_t o = (i & 1) != 0 ? 1 : std::ptrdiff_t(n);
               const float err = round_up(
                   std::abs(double(h.p[e]) - 0.5 * (double(h.p[e - o]) + double(h.p[e + o]))));
-              out[e] = quantized({err, err, 0.0f});
+              out[e] = packed::pack({err, err, 0.0f});
             } else {
               // Which stencil: the diagonal rule of squares (diamond.h), the hypotenuse's
               // direction of edges.
@@ -574,7 +575,7 @@ inline void small_bounds(const RecordConfig& c, const DenseBlock& h, std::vector
             }
             continue;
           }
-          out[e] = bound_of(c, h, i, j, at);
+          out[e] = packed::pack(bound_of(c, h, i, j, at));
         }
       }
     }

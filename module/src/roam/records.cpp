@@ -105,11 +105,11 @@ std::shared_ptr<RecordBlock> level0_block(const RecordConfig& config, const worl
   // apron (kPageApron = 6) is the reach of a t = 1 square diamond, so every diamond of the
   // page's own cells is among them.
   thread_local std::vector<float> heights;
-  thread_local std::vector<DiamondBound> local;
+  thread_local std::vector<std::uint32_t> local;  // packed bounds
   heights.resize(kPageEntries);
   for (std::size_t e = 0; e < kPageEntries; ++e) heights[e] = page.local(e);
   const DenseBlock h{heights.data(), i0 - kPageApron, j0 - kPageApron, kPageStride};
-  local.assign(kPageEntries, DiamondBound{});
+  local.assign(kPageEntries, 0);
   small_bounds(c, h, local);
   for (std::int32_t b = 0; b <= kPageCells; ++b)
     for (std::int32_t a = 0; a <= kPageCells; ++a) {
@@ -118,7 +118,7 @@ std::shared_ptr<RecordBlock> level0_block(const RecordConfig& config, const worl
       const Diamond d = diamond_at(i, j, c.patch_log2);
       if (d.corner || d.t >= 2) continue;
       if (d.t == 0 && !d.square && !block->edges) continue;
-      block->set(a, b, local[world::entry_index(a, b)]);
+      block->set_packed(a, b, local[world::entry_index(a, b)]);
     }
   return block;
 }
@@ -185,18 +185,18 @@ void t1_squares(const RecordConfig& c, const world::PageGrid& g, const H& h,
     const std::int64_t i0 = (px << 8) - kPageApron, j0 = (pz << 8) - kPageApron;
     constexpr std::int64_t n = kPageStride;
     thread_local std::vector<float> heights;
-    thread_local std::vector<DiamondBound> local;
+    thread_local std::vector<std::uint32_t> local;  // packed bounds
     heights.resize(std::size_t(n * n));
     for (std::int64_t b = 0; b < n; ++b)
       read_row(h, j0 + b, i0, i0 + n - 1, heights.data() + b * n);
-    local.assign(std::size_t(n * n), DiamondBound{});
+    local.assign(std::size_t(n * n), 0);
     small_bounds(c, DenseBlock{heights.data(), i0, j0, n}, local);
     // The t = 1 squares of this page's cells.
     for (std::int64_t j = (pz << 8) + 2; j < ((pz + 1) << 8) && j <= c.pad_j; j += 4)
       for (std::int64_t i = (px << 8) + 2; i < ((px + 1) << 8) && i <= c.pad_i; i += 4) {
         const Diamond d = diamond_at(i, j, c.patch_log2);
         if (d.corner || d.t != 1 || !d.square) continue;
-        out(i, j, local[std::size_t((i - i0) + (j - j0) * n)]);
+        out(i, j, packed::unpack(local[std::size_t((i - i0) + (j - j0) * n)]));
       }
   });
 }

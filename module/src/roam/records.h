@@ -182,6 +182,11 @@ struct RecordBlock {
     if (values.empty() && encoded) own();
     values[slot(a, b)] = packed::pack(d);
   }
+  /// set() of a bound already packed (packed::pack).
+  void set_packed(std::int32_t a, std::int32_t b, std::uint32_t v) {
+    if (values.empty() && encoded) own();
+    values[slot(a, b)] = v;
+  }
   /// Bytes this block holds itself (a block read in place holds none of its payload).
   std::size_t bytes() const noexcept { return sizeof(*this) + values.capacity() * 4; }
   /// The block as bytes (the bake's payload) and back (checked: size and level; null when they
