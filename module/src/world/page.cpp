@@ -101,12 +101,40 @@ std::shared_ptr<PageSamples> samples_from(const Heightfield& hf, const PageKey& 
     s->f32.resize(kPageEntries);
   if (hf.has_materials()) s->materials.resize(kPageEntries);
   const double scale = hf.height_scale();
+  // Row by row: the entries past the data repeat its edge (clamped indices), so a row whose
+  // clamped source row is the previous row's is a copy of it, and each row's entries left and
+  // right of the data repeat its first and last sample (a small world's page is mostly these).
+  constexpr std::size_t kRow = std::size_t(kPageStride);
+  std::int64_t last_j = -1;
   for (std::int32_t b = -kPageApron; b <= kPageCells + kPageApron; ++b) {
     const auto j = std::uint32_t(std::clamp<std::int64_t>(j0 + (std::int64_t(b) << shift), 0, hj));
+    const std::size_t row = entry_index(-kPageApron, b);
+    if (std::int64_t(j) == last_j) {
+      const std::size_t prev = row - kRow;
+      if (as_u16)
+        std::copy_n(s->u16.begin() + std::ptrdiff_t(prev), kRow, s->u16.begin() + std::ptrdiff_t(row));
+      else
+        std::copy_n(s->f32.begin() + std::ptrdiff_t(prev), kRow, s->f32.begin() + std::ptrdiff_t(row));
+      if (!s->materials.empty())
+        std::copy_n(s->materials.begin() + std::ptrdiff_t(prev), kRow,
+                    s->materials.begin() + std::ptrdiff_t(row));
+      continue;
+    }
+    last_j = j;
+    std::int64_t last_i = -1;
     for (std::int32_t a = -kPageApron; a <= kPageCells + kPageApron; ++a) {
       const auto i =
           std::uint32_t(std::clamp<std::int64_t>(i0 + (std::int64_t(a) << shift), 0, wi));
       const std::size_t e = entry_index(a, b);
+      if (std::int64_t(i) == last_i) {  // clamped: the entry before it holds the same sample
+        if (as_u16)
+          s->u16[e] = s->u16[e - 1];
+        else
+          s->f32[e] = s->f32[e - 1];
+        if (!s->materials.empty()) s->materials[e] = s->materials[e - 1];
+        continue;
+      }
+      last_i = i;
       const float h = hf.local(i, j);
       if (as_u16)
         s->u16[e] = static_cast<std::uint16_t>(std::nearbyint(double(h) / scale));

@@ -208,12 +208,17 @@ template <class Height>
 PageSummary summarize(const PageGrid& g, std::int32_t px, std::int32_t pz, Height&& h) {
   PageSummary s{INFINITY, -INFINITY, INFINITY, -INFINITY};
   const std::int64_t i0 = std::int64_t(px) << 8, j0 = std::int64_t(pz) << 8;
-  for (std::int64_t j = j0 - 8; j <= j0 + kPageCells + 8; ++j)
-    for (std::int64_t i = i0 - 8; i <= i0 + kPageCells + 8; ++i) {
-      const float v = h(std::clamp<std::int64_t>(i, 0, g.last_i), std::clamp<std::int64_t>(j, 0, g.last_j));
+  // Indices past the data are clamped into it, which only repeats samples: the ranges are those
+  // of the samples in the clamped boxes, each read once (a small world's page is mostly repeats).
+  const auto clamp_i = [&](std::int64_t i) { return std::clamp<std::int64_t>(i, 0, g.last_i); };
+  const auto clamp_j = [&](std::int64_t j) { return std::clamp<std::int64_t>(j, 0, g.last_j); };
+  const std::int64_t ia = clamp_i(i0), ib = clamp_i(i0 + kPageCells);
+  const std::int64_t ja = clamp_j(j0), jb = clamp_j(j0 + kPageCells);
+  for (std::int64_t j = clamp_j(j0 - 8); j <= clamp_j(j0 + kPageCells + 8); ++j)
+    for (std::int64_t i = clamp_i(i0 - 8); i <= clamp_i(i0 + kPageCells + 8); ++i) {
+      const float v = h(i, j);
       s.lo8 = std::min(s.lo8, v), s.hi8 = std::max(s.hi8, v);
-      if (i >= i0 && i <= i0 + kPageCells && j >= j0 && j <= j0 + kPageCells)
-        s.lo = std::min(s.lo, v), s.hi = std::max(s.hi, v);
+      if (i >= ia && i <= ib && j >= ja && j <= jb) s.lo = std::min(s.lo, v), s.hi = std::max(s.hi, v);
     }
   return s;
 }
