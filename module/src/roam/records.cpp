@@ -149,8 +149,11 @@ struct StrideGrid {
     return packed::unpack(v[k]);
   }
   void set(std::int64_t i, std::int64_t j, const DiamondBound& b) noexcept {
+    set_packed(i, j, packed::pack(b));
+  }
+  void set_packed(std::int64_t i, std::int64_t j, std::uint32_t packed_bound) noexcept {
     const std::size_t k = std::size_t((i - off) >> shift) + std::size_t((j - off) >> shift) * std::size_t(nx);
-    v[k] = packed::pack(b);
+    v[k] = packed_bound;
   }
 };
 
@@ -172,7 +175,7 @@ void parallel_rows(std::int64_t n, unsigned threads, const Fn& fn) {
 
 // True nested bounds of the t = 1 square diamonds (positions 2 mod 4): what the size-4 edge
 // diamonds nest over (the level-0 blocks hold the same values).
-// Computed page by page over the page and 8 samples around it.
+// Computed page by page over the page and 8 samples around it; out(i, j, bound) gets each packed.
 template <class H, class Out>
 void t1_squares(const RecordConfig& c, const world::PageGrid& g, const H& h,
                 std::int64_t pi0, std::int64_t pj0, std::int64_t pi1, std::int64_t pj1,
@@ -196,7 +199,7 @@ void t1_squares(const RecordConfig& c, const world::PageGrid& g, const H& h,
       for (std::int64_t i = (px << 8) + 2; i < ((px + 1) << 8) && i <= c.pad_i; i += 4) {
         const Diamond d = diamond_at(i, j, c.patch_log2);
         if (d.corner || d.t != 1 || !d.square) continue;
-        out(i, j, packed::unpack(local[std::size_t((i - i0) + (j - j0) * n)]));
+        out(i, j, local[std::size_t((i - i0) + (j - j0) * n)]);
       }
   });
 }
@@ -273,7 +276,7 @@ void build_all(const RecordConfig& config, const world::PageGrid& grid, const He
   StrideGrid squares1;  // t = 1 squares
   squares1.init(2, c.pad_i, c.pad_j, 2);
   t1_squares(c, grid, dh, 0, 0, grid.px[0] - 1, grid.pz[0] - 1,
-             [&](std::int64_t i, std::int64_t j, const DiamondBound& v) { squares1.set(i, j, v); },
+             [&](std::int64_t i, std::int64_t j, std::uint32_t v) { squares1.set_packed(i, j, v); },
              threads);
   for (int k = 1; k <= top_level; ++k) {
     grids[std::size_t(k)].init(2 * k, c.pad_i, c.pad_j, 0);
@@ -364,8 +367,8 @@ std::vector<std::pair<PageKey, std::shared_ptr<const RecordBlock>>> remake(
     const std::int64_t w = 16;
     t1_squares(c, grid, dh, std::max<std::int64_t>(0, (i0 - w) >> 8),
                std::max<std::int64_t>(0, (j0 - w) >> 8), (i1 + w) >> 8, (j1 + w) >> 8,
-               [&](std::int64_t i, std::int64_t j, const DiamondBound& v) {
-                 t1.v[Window::key(i, j)] = v;
+               [&](std::int64_t i, std::int64_t j, std::uint32_t v) {
+                 t1.v[Window::key(i, j)] = packed::unpack(v);
                },
                1);
   }
