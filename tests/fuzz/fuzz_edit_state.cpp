@@ -10,7 +10,6 @@
 #include <memory>
 #include <string>
 #include <string_view>
-#include <vector>
 
 #include "ridgeline/edit.h"
 #include "ridgeline/heightfield.h"
@@ -20,24 +19,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // Every input loads onto a clone of one pristine terrain: the clone shares its pages until an
   // edit writes one (Terrain::clone), so an input that is refused allocates no page (a fresh
   // terrain's pages are fresh memory for each input under ASan's allocator: 30x slower). The
-  // terrain is the one the seeds were saved from, made as `ridge deform --default-terrain
-  // --default-size 33 --spacing 8` makes it: the default landscape at its 2 m spacing, its heights
-  // and materials then placed 8 m apart (an edit file names its terrain by a hash of its data).
+  // terrain is the one the seeds were saved from by `ridge deform --default-terrain
+  // --default-size 33` (an edit file names its terrain by a hash of its data).
   static const std::shared_ptr<const Terrain> pristine = [] {
     DefaultTerrainParams p;
     p.size = 33;
-    const Heightfield base = make_default_heightfield(p).value();
-    HeightfieldDesc d;
-    d.width = d.height = p.size;
-    d.spacing_x = d.spacing_z = 8;
-    d.name = "default terrain";
-    std::vector<std::uint8_t> materials;
-    for (std::uint32_t j = 0; j + 1 < base.height(); ++j)
-      for (std::uint32_t i = 0; i + 1 < base.width(); ++i) materials.push_back(base.material(i, j));
-    const auto h = base.local_heights();
     return std::shared_ptr<const Terrain>(
-        Terrain::create(Heightfield::create(d, std::vector<float>(h.begin(), h.end()), materials).value())
-            .value());
+        Terrain::create(std::move(make_default_heightfield(p)).value()).value());
   }();
   auto terrain = pristine->clone();
   std::string bytes(reinterpret_cast<const char*>(data), size);

@@ -199,3 +199,22 @@ TEST(DurableFile, PutInPlaceRenamesAFinishedTemporaryFileOrSaysWhyNot) {
   EXPECT_NE(s.message().find("rename failed"), std::string::npos) << s.message();
   EXPECT_TRUE(fs::exists(tmp)) << "left for the caller";
 }
+
+// The fuzz_edit_state harness loads its inputs onto the default terrain of 33 x 33 samples
+// (tests/fuzz/fuzz_edit_state.cpp): its seeds in the current format must be saves of that very
+// terrain, or every mutation stops at the terrain-hash check and the loader goes unfuzzed.
+TEST(EditFile, TheEditStateFuzzSeedsAreSavesOfTheHarnessTerrain) {
+  DefaultTerrainParams p;
+  p.size = 33;
+  auto terrain = Terrain::create(std::move(make_default_heightfield(p)).value()).value();
+  for (const char* name : {"v3_two_edits.bin", "v3_crater_and_holes.bin"}) {
+    const std::string path = std::string(RIDGELINE_TEST_DATA) + "/../fuzz/corpus/fuzz_edit_state/" + name;
+    std::ifstream in(path, std::ios::binary);
+    ASSERT_TRUE(in) << "cannot read " << path;
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    auto copy = terrain->clone();
+    auto r = load_edits_from_memory(*copy, bytes);
+    ASSERT_TRUE(r) << name << ": " << r.error().message;
+    EXPECT_GT(copy->edit_version(), 0u) << name << " loaded no edit";
+  }
+}
