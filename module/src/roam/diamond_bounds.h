@@ -73,6 +73,11 @@ struct DenseBlock {
     return p[std::size_t(i - i0) + std::size_t(j - j0) * std::size_t(n)];
   }
 };
+[[gnu::always_inline]] inline void read_row(const DenseBlock& h, std::int64_t z, std::int64_t lo, std::int64_t hi, float* out) {
+  RIDGELINE_ASSERT(lo >= h.i0 && hi < h.i0 + h.n && z >= h.j0 && z < h.j0 + h.n);
+  std::memcpy(out, h.p + std::size_t(lo - h.i0) + std::size_t(z - h.j0) * std::size_t(h.n),
+              std::size_t(hi - lo + 1) * sizeof(float));
+}
 
 // The samples inside the small bintree triangles (legs of at most 4 cells: the diamonds of
 // t <= 1, most of every world's diamonds), with their edge functions, by the apex's legs: a table

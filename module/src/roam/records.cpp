@@ -206,6 +206,11 @@ void t1_squares(const RecordConfig& c, const world::PageGrid& g, const H& h,
 
 // Level k >= 1 (t = 2k, 2k + 1) bounds of the positions of `grid` inside [i0, i1] x [j0, j1]
 // whose reach meets it (all of them for a whole world), from the heights and the grids below.
+// The finer levels (t <= 5: triangles of legs up to 32 cells, most of whose samples the small-
+// triangle table reads one by one) go tile by tile, each tile's heights copied once into a dense
+// block (the accessor's values bit for bit, so the bounds are the same): the reads are then plain
+// array reads without clamping, and a tile's rows stay in cache. The coarser levels read whole
+// rows through the accessor.
 template <class H>
 void level_bounds(const RecordConfig& c, const H& h, int k, StrideGrid& grid,
                   const StrideGrid& below_squares, std::int64_t i0, std::int64_t j0,
@@ -220,19 +225,41 @@ void level_bounds(const RecordConfig& c, const H& h, int k, StrideGrid& grid,
     const std::int64_t a1 = std::min<std::int64_t>(c.pad_i / stride, floor_div(i1 + reach, stride) + 1);
     const std::int64_t b0 = std::max<std::int64_t>(0, floor_div(j0 - reach, stride));
     const std::int64_t b1 = std::min<std::int64_t>(c.pad_j / stride, floor_div(j1 + reach, stride) + 1);
-    parallel_rows(b1 - b0 + 1, threads, [&](std::int64_t r) {
-      const std::int64_t b = b0 + r;
-      for (std::int64_t a = a0; a <= a1; ++a) {
-        const std::int64_t i = a * stride, j = b * stride;
-        const Diamond d = diamond_at(i, j, c.patch_log2);
-        if (d.corner || d.t != t || d.square != square) continue;
-        if (i + reach < i0 || i - reach > i1 || j + reach < j0 || j - reach > j1) continue;
-        auto child = [&](std::int64_t ci, std::int64_t cj) -> DiamondBound {
-          if (grid.has(ci, cj)) return grid.get(ci, cj);
-          return below_squares.get(ci, cj);
-        };
-        grid.set(i, j, bound_of(c, h, i, j, child));
-      }
+    if (a1 < a0 || b1 < b0) continue;
+    auto child = [&](std::int64_t ci, std::int64_t cj) -> DiamondBound {
+      if (grid.has(ci, cj)) return grid.get(ci, cj);
+      return below_squares.get(ci, cj);
+    };
+    // The diamond at position (a, b) from heights `hh`, when it is of this kind and meets the box.
+    auto one = [&](const auto& hh, std::int64_t a, std::int64_t b) {
+      const std::int64_t i = a * stride, j = b * stride;
+      const Diamond d = diamond_at(i, j, c.patch_log2);
+      if (d.corner || d.t != t || d.square != square) return;
+      if (i + reach < i0 || i - reach > i1 || j + reach < j0 || j - reach > j1) return;
+      grid.set_packed(i, j, packed::pack(bound_of(c, hh, i, j, child)));
+    };
+    if (t > 5) {
+      parallel_rows(b1 - b0 + 1, threads, [&](std::int64_t r) {
+        for (std::int64_t a = a0; a <= a1; ++a) one(h, a, b0 + r);
+      });
+      continue;
+    }
+    // Tiles of 128 samples a side (32 or 8 positions); a diamond's triangles and children lie
+    // within s samples of its centre.
+    const std::int64_t per = std::max<std::int64_t>(1, 128 / stride);
+    const std::int64_t ta = (a1 - a0) / per + 1, tb = (b1 - b0) / per + 1;
+    parallel_rows(ta * tb, threads, [&](std::int64_t r) {
+      const std::int64_t pa0 = a0 + (r % ta) * per, pb0 = b0 + (r / ta) * per;
+      const std::int64_t pa1 = std::min(a1, pa0 + per - 1), pb1 = std::min(b1, pb0 + per - 1);
+      const std::int64_t x0 = pa0 * stride - s, z0 = pb0 * stride - s;
+      const std::int64_t n = std::max(pa1 - pa0, pb1 - pb0) * stride + 2 * s + 1;
+      thread_local std::vector<float> heights;
+      heights.resize(std::size_t(n * n));
+      for (std::int64_t z = 0; z < n; ++z)
+        read_row(h, z0 + z, x0, x0 + n - 1, heights.data() + z * n);
+      const DenseBlock dense{heights.data(), x0, z0, n};
+      for (std::int64_t b = pb0; b <= pb1; ++b)
+        for (std::int64_t a = pa0; a <= pa1; ++a) one(dense, a, b);
     });
   }
 }
