@@ -5,7 +5,8 @@
 # Usage: check_docs.sh REPO_ROOT [--ridge RIDGE] [--game GAME] [--tmp DIR]
 #   always:  the README lists every page of docs/; lua_api.md says where ridgeline.so is installed
 #            (the install rule's destination) and does not call it uninstalled; deformation.md's
-#            edit file version is the one edit_file.cpp writes;
+#            edit file version is the one edit_file.cpp writes; no page names a commit, an issue
+#            or the work's diary ("this round");
 #   --ridge: data_model.md's default terrain content hash is what `ridge info --default-terrain`
 #            prints; deformation.md's JSON edit list is accepted by `ridge deform`;
 #   --game:  game.md's defaults of --detail-levels and --detail-amplitude are the game's --help's.
@@ -42,6 +43,17 @@ else
 fi
 if grep -n -i -E "not installed|install rules for" docs/lua_api.md; then
   fail "docs/lua_api.md calls something of the Lua binding uninstalled (lines above); CMakeLists.txt installs Ridgeline::lua and ridgeline.so"
+else
+  pass
+fi
+
+# Every page is reference: no commit hashes, issue numbers or work-diary words (history lives in
+# git; the data files under docs/benchmarks/ may record the commit of their run).
+diary=$(grep -nE "\bcommit [0-9a-f]{7,40}\b|\bat [0-9a-f]{7,12}\b|\bissues? #?[0-9]+\b|(^|[ (])#[0-9]{2,3}\b|\bthis (stop|round|session)\b" \
+  README.md docs/*.md docs/*/*.md 2>/dev/null)
+if [ -n "$diary" ]; then
+  echo "$diary"
+  fail "the lines above name a commit, an issue or the work's diary; docs are reference (say what is, with the command that shows it)"
 else
   pass
 fi
