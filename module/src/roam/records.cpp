@@ -92,25 +92,17 @@ void RecordBlock::own() {
 
 // ---- level 0, from the page alone ---------------------------------------------------------------
 
-std::shared_ptr<RecordBlock> level0_block(const RecordConfig& config, const world::Page& page) {
-  RecordConfig holed;
-  std::shared_ptr<const HoleMask> keep;
-  const RecordConfig& c = with_holes(config, holed, keep);
-  const std::int64_t i0 = std::int64_t(page.key.px) << 8, j0 = std::int64_t(page.key.pz) << 8;
+namespace {
+
+// The level-0 block of page (px, pz) from the packed bounds small_bounds() gave over the page and
+// its apron (entry_index() order): the t <= 1 diamonds of the page's cells.
+std::shared_ptr<RecordBlock> level0_from(const RecordConfig& c, std::int32_t px, std::int32_t pz,
+                                         const std::vector<std::uint32_t>& local) {
+  const std::int64_t i0 = std::int64_t(px) << 8, j0 = std::int64_t(pz) << 8;
   auto block = std::make_shared<RecordBlock>();
   block->level = 0;
   block->edges = c.L > 0;
   block->values.assign(RecordBlock::slots(0, block->edges), 0);
-  // Every t <= 1 diamond of the page and its apron whose descendants lie on the entries. The
-  // apron (kPageApron = 6) is the reach of a t = 1 square diamond, so every diamond of the
-  // page's own cells is among them.
-  thread_local std::vector<float> heights;
-  thread_local std::vector<std::uint32_t> local;  // packed bounds
-  heights.resize(kPageEntries);
-  for (std::size_t e = 0; e < kPageEntries; ++e) heights[e] = page.local(e);
-  const DenseBlock h{heights.data(), i0 - kPageApron, j0 - kPageApron, kPageStride};
-  local.assign(kPageEntries, 0);
-  small_bounds(c, h, local);
   for (std::int32_t b = 0; b <= kPageCells; ++b)
     for (std::int32_t a = 0; a <= kPageCells; ++a) {
       const std::int64_t i = i0 + a, j = j0 + b;
@@ -121,6 +113,26 @@ std::shared_ptr<RecordBlock> level0_block(const RecordConfig& config, const worl
       block->set_packed(a, b, local[world::entry_index(a, b)]);
     }
   return block;
+}
+
+}  // namespace
+
+std::shared_ptr<RecordBlock> level0_block(const RecordConfig& config, const world::Page& page) {
+  RecordConfig holed;
+  std::shared_ptr<const HoleMask> keep;
+  const RecordConfig& c = with_holes(config, holed, keep);
+  const std::int64_t i0 = std::int64_t(page.key.px) << 8, j0 = std::int64_t(page.key.pz) << 8;
+  // Every t <= 1 diamond of the page and its apron whose descendants lie on the entries. The
+  // apron (kPageApron = 6) is the reach of a t = 1 square diamond, so every diamond of the
+  // page's own cells is among them.
+  thread_local std::vector<float> heights;
+  thread_local std::vector<std::uint32_t> local;  // packed bounds
+  heights.resize(kPageEntries);
+  for (std::size_t e = 0; e < kPageEntries; ++e) heights[e] = page.local(e);
+  const DenseBlock h{heights.data(), i0 - kPageApron, j0 - kPageApron, kPageStride};
+  local.assign(kPageEntries, 0);
+  small_bounds(c, h, local);
+  return level0_from(c, page.key.px, page.key.pz, local);
 }
 
 // ---- every block of a whole world ------------------------------------------------------------
@@ -176,10 +188,14 @@ void parallel_rows(std::int64_t n, unsigned threads, const Fn& fn) {
 // True nested bounds of the t = 1 square diamonds (positions 2 mod 4): what the size-4 edge
 // diamonds nest over (the level-0 blocks hold the same values).
 // Computed page by page over the page and 8 samples around it; out(i, j, bound) gets each packed.
+// `page_bounds(px, pz, local)`, when given, gets every page's packed bounds too: what
+// level0_block() computes from the page's own samples, which these are.
 template <class H, class Out>
 void t1_squares(const RecordConfig& c, const world::PageGrid& g, const H& h,
                 std::int64_t pi0, std::int64_t pj0, std::int64_t pi1, std::int64_t pj1,
-                const Out& out, unsigned threads) {
+                const Out& out, unsigned threads,
+                const std::function<void(std::int32_t, std::int32_t, const std::vector<std::uint32_t>&)>&
+                    page_bounds = nullptr) {
   const std::int64_t npx = pi1 - pi0 + 1;
   parallel_rows((pj1 - pj0 + 1) * npx, threads, [&](std::int64_t r) {
     const std::int64_t px = pi0 + r % npx, pz = pj0 + r / npx;
@@ -201,6 +217,7 @@ void t1_squares(const RecordConfig& c, const world::PageGrid& g, const H& h,
         if (d.corner || d.t != 1 || !d.square) continue;
         out(i, j, local[std::size_t((i - i0) + (j - j0) * n)]);
       }
+    if (page_bounds) page_bounds(std::int32_t(px), std::int32_t(pz), local);
   });
 }
 
@@ -302,9 +319,18 @@ void build_all(const RecordConfig& config, const world::PageGrid& grid, const He
   std::vector<StrideGrid> grids(std::size_t(std::max(top_level, 0)) + 1);
   StrideGrid squares1;  // t = 1 squares
   squares1.init(2, c.pad_i, c.pad_j, 2);
+  // The level-0 blocks come from the same pass: its bounds over each page and its apron are the
+  // ones level0_block() would compute again from the page.
+  std::vector<std::shared_ptr<RecordBlock>> level0_blocks(level0 ? grid.count(0) : 0);
   t1_squares(c, grid, dh, 0, 0, grid.px[0] - 1, grid.pz[0] - 1,
              [&](std::int64_t i, std::int64_t j, std::uint32_t v) { squares1.set_packed(i, j, v); },
-             threads);
+             threads,
+             level0 ? [&](std::int32_t px, std::int32_t pz, const std::vector<std::uint32_t>& local) {
+                        if (page(PageKey{0, px, pz}) == nullptr) return;
+                        level0_blocks[std::size_t(px) + std::size_t(pz) * std::size_t(grid.px[0])] =
+                            level0_from(c, px, pz, local);
+                      }
+                    : std::function<void(std::int32_t, std::int32_t, const std::vector<std::uint32_t>&)>{});
   for (int k = 1; k <= top_level; ++k) {
     grids[std::size_t(k)].init(2 * k, c.pad_i, c.pad_j, 0);
     level_bounds(c, dh, k, grids[std::size_t(k)], k == 1 ? squares1 : grids[std::size_t(k - 1)],
@@ -319,13 +345,10 @@ void build_all(const RecordConfig& config, const world::PageGrid& grid, const He
     const PageKey& key = coarse[std::size_t(r)];
     out(key, slice(c, grids, grid.levels, key));
   });
-  if (!level0) return;
-  const std::int64_t n0 = std::int64_t(grid.count(0));
-  parallel_rows(n0, threads, [&](std::int64_t r) {
-    const std::int32_t px = std::int32_t(r % grid.px[0]), pz = std::int32_t(r / grid.px[0]);
-    const PageKey key{0, px, pz};
-    if (const world::Page* p = page(key)) out(key, level0_block(c, *p));
-  });
+  for (std::size_t r = 0; r < level0_blocks.size(); ++r)
+    if (level0_blocks[r])
+      out(PageKey{0, std::int32_t(r % std::size_t(grid.px[0])), std::int32_t(r / std::size_t(grid.px[0]))},
+          std::move(level0_blocks[r]));
 }
 
 std::vector<std::pair<PageKey, std::shared_ptr<const RecordBlock>>> remake(

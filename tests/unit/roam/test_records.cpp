@@ -6,12 +6,17 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <memory>
+#include <mutex>
 #include <random>
 #include <sstream>
 #include <vector>
 
+#include "ridgeline/heightfield.h"
 #include "roam/diamond_bounds.h"
 #include "roam/records.h"
+#include "surface/hole_mask.h"
+#include "world/page_store.h"
 
 using namespace ridgeline;
 using namespace ridgeline::roam;
@@ -136,5 +141,81 @@ TEST(Records, PackedMorphRatioIsTheSmallestStepThatCovers) {
     if (c > 0) {
       ASSERT_LT(pe * packed::kRatio[c - 1], m) << "a smaller ratio step would cover it";
     }
+  }
+}
+
+// A terrain in memory gets its level-0 blocks from the same pass as the t = 1 squares of the
+// coarse bounds (build_all): each must be the block level0_block() makes from the page alone,
+// which is what a paged world's arriving page gets. Float and 16-bit pages, several pages a side
+// (their aprons joining), holes, and a size that pads the last patches.
+TEST(Records, TheWholeWorldPassGivesEachPageItsOwnLevel0Block) {
+  for (const bool as_u16 : {false, true}) {
+    const std::uint32_t w = 601, hgt = 530;
+    std::vector<float> values(std::size_t(w) * hgt);
+    std::mt19937 rng(as_u16 ? 3 : 4);
+    std::uniform_real_distribution<float> bump(-0.6f, 0.6f);
+    for (std::uint32_t j = 0; j < hgt; ++j)
+      for (std::uint32_t i = 0; i < w; ++i) {
+        const float v = 30.0f * std::sin(0.031f * float(i)) * std::cos(0.017f * float(j)) + bump(rng);
+        values[std::size_t(i) + std::size_t(j) * w] = as_u16 ? std::round(4.0f * (v + 40.0f)) : v;
+      }
+    HeightfieldDesc desc;
+    desc.width = w, desc.height = hgt, desc.spacing_x = 1.5, desc.spacing_z = 0.75;
+    desc.height_scale = as_u16 ? 0.25 : 1.0;
+    auto hf = Heightfield::create(desc, values);
+    ASSERT_TRUE(hf) << hf.error().message;
+    ASSERT_EQ(world::fits_u16(*hf), as_u16);
+    WorldInfo info;
+    info.width = w, info.height = hgt, info.spacing_x = 1.5, info.spacing_z = 0.75;
+    info.height_scale = hf->height_scale();
+    info.format = as_u16 ? SampleFormat::kU16 : SampleFormat::kF32;
+    info.min_local = hf->min_local(), info.max_local = hf->max_local();
+    const auto store = world::PageStore::from_heightfield(*hf, info);
+    const world::PageGrid& g = store->grid();
+    ASSERT_GE(g.px[0], 3);
+    ASSERT_GE(g.pz[0], 2);
+    const auto table = store->snapshot();
+    // The heights as Landscape::create copies them: from the level-0 pages.
+    std::vector<float> dense(values.size());
+    for (std::int64_t j = 0; j <= g.last_j; ++j)
+      for (std::int64_t i = 0; i <= g.last_i; ++i)
+        dense[std::size_t(i) + std::size_t(j) * w] =
+            table->find(0, std::int32_t(i >> 8), std::int32_t(j >> 8))
+                ->local(std::int32_t(i & 255), std::int32_t(j & 255));
+    Heights h;
+    h.f32 = dense.data(), h.stride = w, h.last_i = g.last_i, h.last_j = g.last_j;
+    auto holes = std::make_shared<HoleMask>();
+    for (std::int64_t k = 0; k < 40; ++k) holes->set(250 + k, 200 + k / 3, true);  // over a page edge
+    holes->set(0, 0, true);
+    holes->set(w - 2, hgt - 2, true);
+    RecordConfig c;
+    c.patch_log2 = 6;
+    c.growth = std::sqrt(1.3);
+    c.last_i = w - 1, c.last_j = hgt - 1;
+    c.pad_i = ((c.last_i + 63) / 64) * 64, c.pad_j = ((c.last_j + 63) / 64) * 64;
+    c.spacing_x = 1.5, c.spacing_z = 0.75;
+    c.hole_source = [holes] { return std::shared_ptr<const HoleMask>(holes); };
+    std::vector<std::pair<PageKey, std::shared_ptr<RecordBlock>>> made;
+    std::mutex mu;
+    build_all(
+        c, g, h, [&](const PageKey& k) { return table->find(k); },
+        [&](const PageKey& k, std::shared_ptr<RecordBlock> b) {
+          std::lock_guard lock(mu);
+          made.emplace_back(k, std::move(b));
+        },
+        2);
+    std::size_t level0 = 0;
+    for (const auto& [key, block] : made) {
+      if (key.level != 0) continue;
+      ++level0;
+      const auto own = level0_block(c, *table->find(key));
+      ASSERT_EQ(block->values.size(), own->values.size());
+      std::size_t differing = 0;
+      for (std::size_t k = 0; k < own->values.size(); ++k) differing += block->values[k] != own->values[k];
+      EXPECT_EQ(differing, 0u) << (as_u16 ? "16-bit" : "float") << " page (" << key.px << ", "
+                               << key.pz << "): " << differing << " of " << own->values.size()
+                               << " packed bounds differ from the page's own block";
+    }
+    EXPECT_EQ(level0, std::size_t(g.px[0]) * std::size_t(g.pz[0]));
   }
 }
