@@ -324,13 +324,11 @@ void build_all(const RecordConfig& config, const world::PageGrid& grid, const He
   std::vector<std::shared_ptr<RecordBlock>> level0_blocks(level0 ? grid.count(0) : 0);
   t1_squares(c, grid, dh, 0, 0, grid.px[0] - 1, grid.pz[0] - 1,
              [&](std::int64_t i, std::int64_t j, std::uint32_t v) { squares1.set_packed(i, j, v); },
-             threads,
-             level0 ? [&](std::int32_t px, std::int32_t pz, const std::vector<std::uint32_t>& local) {
-                        if (page(PageKey{0, px, pz}) == nullptr) return;
-                        level0_blocks[std::size_t(px) + std::size_t(pz) * std::size_t(grid.px[0])] =
-                            level0_from(c, px, pz, local);
-                      }
-                    : std::function<void(std::int32_t, std::int32_t, const std::vector<std::uint32_t>&)>{});
+             threads, [&](std::int32_t px, std::int32_t pz, const std::vector<std::uint32_t>& local) {
+               if (!level0 || page(PageKey{0, px, pz}) == nullptr) return;
+               level0_blocks[std::size_t(px) + std::size_t(pz) * std::size_t(grid.px[0])] =
+                   level0_from(c, px, pz, local);
+             });
   for (int k = 1; k <= top_level; ++k) {
     grids[std::size_t(k)].init(2 * k, c.pad_i, c.pad_j, 0);
     level_bounds(c, dh, k, grids[std::size_t(k)], k == 1 ? squares1 : grids[std::size_t(k - 1)],
