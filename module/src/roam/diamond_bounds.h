@@ -20,6 +20,7 @@
 #endif
 
 #include "ridgeline/detail.h"
+#include "platform/cpu_features.h"
 #include "ridgeline/log.h"
 #include "roam/diamond.h"
 #include "roam/records.h"
@@ -224,9 +225,42 @@ inline const RowShapes& row_shapes() {
   return table;
 }
 
-// max |row[x] aw - (S x + T)| over x in [0, n): two lanes of SSE2 where there is SSE2 (every
-// x86-64; not with RIDGELINE_PORTABLE), one elsewhere; the same values either way (each lane rounds as the scalar code does).
+#if RIDGELINE_HAS_AVX2_DISPATCH
+// row_worst() for rows of 8 samples or more, eight at a time in two four-lane halves (AVX2).
+RIDGELINE_TARGET_AVX2 inline double row_worst_avx2(const float* row, std::int64_t n, double aw,
+                                                   double S, double T) noexcept {
+  const __m256d sign = _mm256_set1_pd(-0.0), vaw = _mm256_set1_pd(aw), vS = _mm256_set1_pd(S),
+                vT = _mm256_set1_pd(T), step = _mm256_set1_pd(8.0);
+  __m256d x0 = _mm256_setr_pd(0.0, 1.0, 2.0, 3.0), x1 = _mm256_setr_pd(4.0, 5.0, 6.0, 7.0);
+  __m256d m0 = _mm256_setzero_pd(), m1 = _mm256_setzero_pd();
+  std::int64_t x = 0;
+  for (; x + 7 < n; x += 8) {
+    const __m256d h0 = _mm256_cvtps_pd(_mm_loadu_ps(row + x)), h1 = _mm256_cvtps_pd(_mm_loadu_ps(row + x + 4));
+    const __m256d d0 = _mm256_sub_pd(_mm256_mul_pd(h0, vaw), _mm256_add_pd(_mm256_mul_pd(vS, x0), vT));
+    const __m256d d1 = _mm256_sub_pd(_mm256_mul_pd(h1, vaw), _mm256_add_pd(_mm256_mul_pd(vS, x1), vT));
+    m0 = _mm256_max_pd(m0, _mm256_andnot_pd(sign, d0));
+    m1 = _mm256_max_pd(m1, _mm256_andnot_pd(sign, d1));
+    x0 = _mm256_add_pd(x0, step), x1 = _mm256_add_pd(x1, step);
+  }
+  alignas(32) double lanes[4];
+  _mm256_store_pd(lanes, _mm256_max_pd(m0, m1));
+  double worst = std::max({lanes[0], lanes[1], lanes[2], lanes[3]});
+  for (; x < n; ++x) {
+    const double d = std::abs(double(row[x]) * aw - (S * double(x) + T));
+    worst = d > worst ? d : worst;
+  }
+  return worst;
+}
+#endif
+
+// max |row[x] aw - (S x + T)| over x in [0, n): four lanes of AVX2 for long rows where the CPU
+// has it, else two lanes of SSE2 where there is SSE2 (every x86-64; not with RIDGELINE_PORTABLE),
+// one elsewhere; the same values every way (each lane rounds as the scalar code does, and the
+// largest of them does not depend on the order).
 [[gnu::always_inline]] inline double row_worst(const float* row, std::int64_t n, double aw, double S, double T) noexcept {
+#if RIDGELINE_HAS_AVX2_DISPATCH
+  if (n >= 8 && detail::cpu_has_avx2()) return row_worst_avx2(row, n, aw, S, T);
+#endif
   std::int64_t x = 0;
   double worst = 0.0;
 #if !defined(RIDGELINE_PORTABLE) && (defined(__SSE2__) || defined(_M_X64))
@@ -436,6 +470,7 @@ struct SmallStencil {
   Tri tri[2];
   std::ptrdiff_t child[4] = {};
   double cdx[4] = {}, cdz[4] = {};
+  std::int64_t cdi[4] = {}, cdj[4] = {};  // the children's positions from the centre
   int children = 0;
 
   // From the representative diamond (ri, rj) of the kind (a patch exponent of 10: never a top).
@@ -465,6 +500,7 @@ struct SmallStencil {
         std::int64_t ci, cj;
         d.child(k, ci, cj);
         child[k] = off(ci, cj), cdx[k] = double(ci - ri), cdz[k] = double(cj - rj);
+        cdi[k] = ci - ri, cdj[k] = cj - rj;
       }
   }
 
@@ -473,6 +509,13 @@ struct SmallStencil {
   // entries.
   std::uint32_t bound(const RecordConfig& c, const float* p, const std::uint32_t* out,
                       std::ptrdiff_t c0) const noexcept {
+    std::uint32_t cv[4] = {};
+    for (int k = 0; k < children; ++k) cv[k] = out[c0 + child[k]];
+    return bound(c, p, c0, cv);
+  }
+  // The same with the children's packed bounds given (cv[k]: child k's).
+  std::uint32_t bound(const RecordConfig& c, const float* p, std::ptrdiff_t c0,
+                      const std::uint32_t* cv) const noexcept {
     double err = 0;
     for (const Tri& q : tri) {
       const double ha = p[c0 + q.a], hl = p[c0 + q.l], hr = p[c0 + q.r];
@@ -488,7 +531,7 @@ struct SmallStencil {
     bool straddles = false;
     const double hv = p[c0];
     for (int k = 0; k < children; ++k) {
-      const DiamondBound cb = packed::unpack(out[c0 + child[k]]);
+      const DiamondBound cb = packed::unpack(cv[k]);
       const double dx = cdx[k] * c.spacing_x, dz = cdz[k] * c.spacing_z;
       const double dy = double(p[c0 + child[k]]) - hv;
       const double dist = std::sqrt(dx * dx + dz * dz + dy * dy);
@@ -502,6 +545,227 @@ struct SmallStencil {
         {round_up(err), round_up(morph), radius >= FLT_MAX ? FLT_MAX : round_up(radius)});
   }
 };
+
+#if RIDGELINE_HAS_AVX2_DISPATCH
+// The t <= 1 diamonds four at a time (AVX2, chosen at run time): the scalar arithmetic of
+// SmallStencil::bound() and the edge rule in four lanes, the same operations in the same order
+// (doubles, no fused multiply-adds), so every lane's packed bound is the scalar one bit for bit
+// (Records.SmallDiamondStencilsGiveTheGeneralBoundsBitForBit). `lanes`: the four centres' entries.
+namespace x4 {
+
+// packed::up12() of four floats.
+RIDGELINE_TARGET_AVX2 inline __m128i up12(__m128 v) noexcept {
+  const __m128i bits = _mm_castps_si128(v);
+  const __m128i e = _mm_sub_epi32(_mm_srli_epi32(bits, 23), _mm_set1_epi32(127 - packed::kBias));
+  __m128i m = _mm_srli_epi32(_mm_and_si128(bits, _mm_set1_epi32(0x7fffff)), 17);
+  // + 1 when any of the 17 bits below is set (round up); a carry into the exponent is the add's.
+  const __m128i exact = _mm_cmpeq_epi32(_mm_and_si128(bits, _mm_set1_epi32(0x1ffff)), _mm_setzero_si128());
+  m = _mm_add_epi32(m, _mm_andnot_si128(exact, _mm_set1_epi32(1)));
+  __m128i c = _mm_add_epi32(_mm_slli_epi32(e, 6), m);
+  c = _mm_min_epi32(_mm_max_epi32(c, _mm_set1_epi32(1 << 6)), _mm_set1_epi32(int(packed::kInfinity)));
+  const __m128 big = _mm_cmpnlt_ps(v, _mm_set1_ps(1.0e30f));  // !(v < 1e30), NaN included
+  c = _mm_blendv_epi8(c, _mm_set1_epi32(int(packed::kInfinity)), _mm_castps_si128(big));
+  return _mm_and_si128(c, _mm_castps_si128(_mm_cmpgt_ps(v, _mm_setzero_ps())));  // !(v > 0): 0
+}
+
+// packed::down12() of four codes (0 .. kInfinity).
+RIDGELINE_TARGET_AVX2 inline __m128 down12(__m128i c) noexcept {
+  const __m128i ex = _mm_add_epi32(_mm_and_si128(_mm_srli_epi32(c, 6), _mm_set1_epi32(63)),
+                                   _mm_set1_epi32(127 - packed::kBias));
+  const __m128i bits = _mm_or_si128(_mm_slli_epi32(ex, 23),
+                                    _mm_slli_epi32(_mm_and_si128(c, _mm_set1_epi32(63)), 17));
+  __m128 f = _mm_castsi128_ps(bits);
+  f = _mm_blendv_ps(f, _mm_setzero_ps(), _mm_castsi128_ps(_mm_cmpeq_epi32(c, _mm_setzero_si128())));
+  const __m128i inf = _mm_cmpgt_epi32(c, _mm_set1_epi32(int(packed::kInfinity) - 1));
+  return _mm_blendv_ps(f, _mm_set1_ps(std::numeric_limits<float>::infinity()), _mm_castsi128_ps(inf));
+}
+
+// round_up() of four doubles >= 0, as floats.
+RIDGELINE_TARGET_AVX2 inline __m128 round_up(__m256d v) noexcept {
+  const __m128 f = _mm256_cvtpd_ps(v);
+  const __m256i lt = _mm256_castpd_si256(_mm256_cmp_pd(_mm256_cvtps_pd(f), v, _CMP_LT_OQ));
+  const __m128i below = _mm256_castsi256_si128(
+      _mm256_permutevar8x32_epi32(lt, _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7)));
+  return _mm_castsi128_ps(_mm_sub_epi32(_mm_castps_si128(f), below));  // the next float up
+}
+
+// A 64-bit lane mask as four 32-bit lanes.
+RIDGELINE_TARGET_AVX2 inline __m128 narrow(__m256d mask) noexcept {
+  return _mm_castsi128_ps(_mm256_castsi256_si128(_mm256_permutevar8x32_epi32(
+      _mm256_castpd_si256(mask), _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7))));
+}
+
+// Four lanes' values at `off` from their entries (plain loads: gathers are slower on some CPUs).
+struct Lanes {
+  std::ptrdiff_t e[4];
+  explicit Lanes(const std::int32_t* lanes) noexcept {
+    for (int l = 0; l < 4; ++l) e[l] = lanes[l];
+  }
+};
+RIDGELINE_TARGET_AVX2 inline __m256d heights(const float* p, std::ptrdiff_t off, const Lanes& x) noexcept {
+  return _mm256_cvtps_pd(_mm_setr_ps(p[x.e[0] + off], p[x.e[1] + off], p[x.e[2] + off], p[x.e[3] + off]));
+}
+
+// Size-1 edge diamonds inside the data: the centre's offset from the midpoint of its neighbours
+// `o` entries away, packed as pack({err, err, 0}) packs it (up12 of the error).
+RIDGELINE_TARGET_AVX2 inline void edges(const float* p, std::uint32_t* out, const std::int32_t* lanes,
+                                        std::ptrdiff_t o) noexcept {
+  const Lanes idx(lanes);
+  const __m256d mid = _mm256_mul_pd(_mm256_set1_pd(0.5), _mm256_add_pd(heights(p, -o, idx), heights(p, o, idx)));
+  const __m256d d = _mm256_andnot_pd(_mm256_set1_pd(-0.0), _mm256_sub_pd(heights(p, 0, idx), mid));
+  alignas(16) std::uint32_t v[4];
+  _mm_store_si128(reinterpret_cast<__m128i*>(v), up12(round_up(d)));
+  for (int l = 0; l < 4; ++l) out[lanes[l]] = v[l];
+}
+
+// SmallStencil::bound() of four diamonds of one stencil.
+// `cv[k][l]`: lane l's child k's packed bound; the four packed bounds into `result`.
+RIDGELINE_TARGET_AVX2 inline void stencil(const SmallStencil& st, const RecordConfig& c, const float* p,
+                                          const std::int32_t* lanes, const std::uint32_t (*cv)[4],
+                                          std::uint32_t* result) noexcept {
+  const Lanes idx(lanes);
+  const __m256d sign = _mm256_set1_pd(-0.0);
+  __m256d err = _mm256_setzero_pd();
+  for (const SmallStencil::Tri& q : st.tri) {
+    const __m256d ha = heights(p, q.a, idx), hl = heights(p, q.l, idx), hr = heights(p, q.r, idx);
+    const __m256d aw = _mm256_set1_pd(q.aw);
+    __m256d worst = _mm256_setzero_pd();
+    for (std::size_t k = 0; k < q.at.size(); ++k) {
+      const __m256d plane = _mm256_add_pd(
+          _mm256_add_pd(_mm256_mul_pd(_mm256_set1_pd(q.w[k][0]), ha), _mm256_mul_pd(_mm256_set1_pd(q.w[k][1]), hl)),
+          _mm256_mul_pd(_mm256_set1_pd(q.w[k][2]), hr));
+      const __m256d d = _mm256_andnot_pd(sign, _mm256_sub_pd(_mm256_mul_pd(heights(p, q.at[k], idx), aw), plane));
+      worst = _mm256_max_pd(d, worst);
+    }
+    err = _mm256_max_pd(_mm256_cvtps_pd(round_up(_mm256_div_pd(worst, aw))), err);
+  }
+  __m256d morph = err, radius = _mm256_setzero_pd();
+  __m128 straddles = _mm_setzero_ps();
+  const __m256d hv = heights(p, 0, idx), growth = _mm256_set1_pd(c.growth);
+  for (int k = 0; k < st.children; ++k) {
+    const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(cv[k]));
+    alignas(16) std::uint32_t mc[4];
+    _mm_store_si128(reinterpret_cast<__m128i*>(mc), _mm_srli_epi32(v, 24));
+    const __m128 ce = down12(_mm_and_si128(v, _mm_set1_epi32(0xfff)));
+    const __m128 cr = down12(_mm_and_si128(_mm_srli_epi32(v, 12), _mm_set1_epi32(0xfff)));
+    const __m128 cm = _mm_mul_ps(ce, _mm_setr_ps(packed::kRatio[mc[0]], packed::kRatio[mc[1]],
+                                                     packed::kRatio[mc[2]], packed::kRatio[mc[3]]));
+    const double dx = st.cdx[k] * c.spacing_x, dz = st.cdz[k] * c.spacing_z;
+    const __m256d dy = _mm256_sub_pd(heights(p, st.child[k], idx), hv);
+    const __m256d dist = _mm256_sqrt_pd(_mm256_add_pd(_mm256_set1_pd(dx * dx + dz * dz), _mm256_mul_pd(dy, dy)));
+    err = _mm256_max_pd(_mm256_cvtps_pd(ce), err);
+    morph = _mm256_max_pd(_mm256_mul_pd(growth, _mm256_cvtps_pd(cm)), morph);
+    radius = _mm256_max_pd(_mm256_add_pd(_mm256_cvtps_pd(cr), dist), radius);
+    straddles = _mm_or_ps(straddles, _mm_cmpge_ps(cr, _mm_set1_ps(FLT_MAX)));
+  }
+  const __m128 e = round_up(err), m = round_up(morph);
+  const __m128 far = _mm_or_ps(straddles, narrow(_mm256_cmp_pd(radius, _mm256_set1_pd(FLT_MAX), _CMP_GE_OQ)));
+  const __m128 r = _mm_blendv_ps(round_up(radius), _mm_set1_ps(FLT_MAX), far);
+  // packed::pack(): the error and radius codes here, the morph code lane by lane.
+  alignas(16) std::uint32_t ce[4], cr[4];
+  alignas(16) float mm[4];
+  _mm_store_si128(reinterpret_cast<__m128i*>(ce), up12(e));
+  _mm_store_si128(reinterpret_cast<__m128i*>(cr), up12(r));
+  _mm_store_ps(mm, _mm_max_ps(e, m));  // std::max(morph, error)
+  for (int l = 0; l < 4; ++l) result[l] = packed::with_morph(ce[l], mm[l]) | (cr[l] << 12);
+}
+
+// stencil() of four diamonds of a dense block whose children's bounds are in the block's `out`.
+RIDGELINE_TARGET_AVX2 inline void stencil(const SmallStencil& st, const RecordConfig& c, const float* p,
+                                          std::uint32_t* out, const std::int32_t* lanes) noexcept {
+  std::uint32_t cv[4][4] = {}, result[4];
+  for (int k = 0; k < st.children; ++k)
+    for (int l = 0; l < 4; ++l) cv[k][l] = out[lanes[l] + st.child[k]];
+  stencil(st, c, p, lanes, cv, result);
+  for (int l = 0; l < 4; ++l) out[lanes[l]] = result[l];
+}
+
+}  // namespace x4
+#endif
+
+// The two stencils (orientations) of the diamonds of size 2^t and one kind whose triangles the
+// small-triangle table holds (t <= 1, and the t = 2 edges: legs of at most 4 cells along each
+// axis), in a dense block of stride n.
+struct SmallStencils {
+  int t = -1;
+  bool square = false;
+  std::int64_t n = -1;
+  std::vector<SmallStencil> v;
+  // Which of the two a diamond of this kind centred at (i, j) takes: the diagonal rule of
+  // squares (diamond.h), the hypotenuse's direction of edges.
+  int which(std::int64_t i, std::int64_t j) const noexcept {
+    const std::int64_t s = std::int64_t{1} << t;
+    return square ? int((((i - s) >> (t + 1)) + ((j - s) >> (t + 1))) & 1) : int(((i >> t) & 1) == 0);
+  }
+};
+// This thread's stencils of a kind for blocks of stride n (made again when n changes).
+inline const SmallStencils& small_stencils(int t, bool square, std::int64_t n) {
+  thread_local SmallStencils cache[8];
+  SmallStencils& k = cache[t * 2 + (square ? 1 : 0)];
+  if (k.n != n) {
+    const std::int64_t s = std::int64_t{1} << t;
+    k.t = t, k.square = square, k.n = n;
+    k.v.clear();
+    k.v.emplace_back(s, square ? s : 2 * s, n);
+    k.v.emplace_back(square ? 3 * s : 2 * s, s, n);
+  }
+  return k;
+}
+
+// Diamonds of one kind waiting for their stencil four at a time (AVX2 where the CPU has it, else
+// one by one; the same bounds bit for bit), each with its children's packed bounds; `sink(i, j,
+// packed)` gets every result.
+struct StencilBatches {
+  const SmallStencils& st;
+  const RecordConfig& c;
+  const float* p;
+  struct Batch {
+    std::int32_t lanes[4];
+    std::uint32_t cv[4][4];  // [child][lane]
+    std::int64_t i[4], j[4];
+    int size = 0;
+  };
+  Batch b[2];
+  StencilBatches(const SmallStencils& s, const RecordConfig& config, const float* heights)
+      : st(s), c(config), p(heights) {}
+  template <class Sink>
+  void add(int which, std::int32_t e, const std::uint32_t* cv, std::int64_t i, std::int64_t j,
+           const Sink& sink) {
+    Batch& q = b[which];
+    q.lanes[q.size] = e, q.i[q.size] = i, q.j[q.size] = j;
+    for (int k = 0; k < 4; ++k) q.cv[k][q.size] = cv[k];
+    if (++q.size == 4) run(which, sink);
+  }
+  template <class Sink>
+  void flush(const Sink& sink) {
+    for (int w = 0; w < 2; ++w)
+      if (b[w].size > 0) run(w, sink);
+  }
+
+ private:
+  template <class Sink>
+  void run(int which, const Sink& sink);
+};
+
+template <class Sink>
+void StencilBatches::run(int which, const Sink& sink) {
+  Batch& q = b[which];
+  const SmallStencil& sv = st.v[std::size_t(which)];
+  std::uint32_t result[4];
+#if RIDGELINE_HAS_AVX2_DISPATCH
+  if (q.size == 4 && detail::cpu_has_avx2()) {
+    x4::stencil(sv, c, p, q.lanes, q.cv, result);
+  } else
+#endif
+  {
+    for (int l = 0; l < q.size; ++l) {
+      const std::uint32_t cv[4] = {q.cv[0][l], q.cv[1][l], q.cv[2][l], q.cv[3][l]};
+      result[l] = sv.bound(c, p, q.lanes[l], cv);
+    }
+  }
+  for (int l = 0; l < q.size; ++l) sink(q.i[l], q.j[l], result[l]);
+  q.size = 0;
+}
 
 // The bounds of every t <= 1 diamond whose descendants lie in the block of samples
 // [i0, i0 + n) x [j0, j0 + n) (or past the padded extent, where they do not exist), finest
@@ -548,6 +812,21 @@ inline void small_bounds(const RecordConfig& c, const DenseBlock& h, std::vector
   // The fast path: no detail, no holes, and the diamond's triangles inside the data (so none
   // straddles its border) and its top never reached (t <= 1 < patch_log2 - 1).
   const bool fast = stencils && c.L == 0 && c.holes == nullptr && c.patch_log2 > 2;
+  auto edge_entry = [&](std::size_t e, std::ptrdiff_t o) {
+    const float err = round_up(std::abs(double(h.p[e]) - 0.5 * (double(h.p[e - o]) + double(h.p[e + o]))));
+    return packed::pack({err, err, 0.0f});
+  };
+#if RIDGELINE_HAS_AVX2_DISPATCH
+  // Diamonds of the fast path wait in batches of four of one stencil (or, for the size-1 edges,
+  // one direction); a kind's diamonds depend only on finer kinds, so a kind's leftovers are
+  // computed one by one before the next kind starts.
+  const bool wide = fast && detail::cpu_has_avx2() && n * n < (std::int64_t{1} << 31);
+  struct Batch {
+    std::int32_t lanes[4];
+    int size = 0;
+  };
+  Batch batches[8];
+#endif
   for (const Kind& k : kinds) {
     const std::int64_t r = (k.square ? 3 : 2) << k.t;
     for (int v = 0; v < k.count; ++v) {
@@ -566,16 +845,32 @@ inline void small_bounds(const RecordConfig& c, const DenseBlock& h, std::vector
             if (k.t == 0 && !k.square) {
               // edge_bound_of() inside the data: the centre's offset from the hypotenuse's
               // midpoint as error and morph bound, no sphere.
-              const std::ptrdiff_t o = (i & 1) != 0 ? 1 : std::ptrdiff_t(n);
-              const float err = round_up(
-                  std::abs(double(h.p[e]) - 0.5 * (double(h.p[e - o]) + double(h.p[e + o]))));
-              out[e] = packed::pack({err, err, 0.0f});
+              const bool horizontal = (i & 1) != 0;
+#if RIDGELINE_HAS_AVX2_DISPATCH
+              if (wide) {
+                Batch& b = batches[6 + (horizontal ? 0 : 1)];
+                b.lanes[b.size++] = std::int32_t(e);
+                if (b.size == 4)
+                  x4::edges(h.p, out.data(), b.lanes, horizontal ? 1 : std::ptrdiff_t(n)), b.size = 0;
+                continue;
+              }
+#endif
+              out[e] = edge_entry(e, horizontal ? 1 : std::ptrdiff_t(n));
             } else {
               // Which stencil: the diagonal rule of squares (diamond.h), the hypotenuse's
               // direction of edges.
               const bool other = k.square ? ((((i - s) >> (k.t + 1)) + ((j - s) >> (k.t + 1))) & 1) != 0
                                           : ((i >> k.t) & 1) == 0;
               const int which = (k.t == 0 ? 0 : (k.square ? 4 : 2)) + (other ? 1 : 0);
+#if RIDGELINE_HAS_AVX2_DISPATCH
+              if (wide) {
+                Batch& b = batches[which];
+                b.lanes[b.size++] = std::int32_t(e);
+                if (b.size == 4)
+                  x4::stencil(st.v[std::size_t(which)], c, h.p, out.data(), b.lanes), b.size = 0;
+                continue;
+              }
+#endif
               out[e] = st.v[std::size_t(which)].bound(c, h.p, out.data(), std::ptrdiff_t(e));
             }
             continue;
@@ -584,6 +879,18 @@ inline void small_bounds(const RecordConfig& c, const DenseBlock& h, std::vector
         }
       }
     }
+#if RIDGELINE_HAS_AVX2_DISPATCH
+    // This kind's leftovers, one by one.
+    for (int w = 0; w < 8; ++w) {
+      Batch& b = batches[w];
+      for (int l = 0; l < b.size; ++l) {
+        const std::size_t e = std::size_t(b.lanes[l]);
+        out[e] = w >= 6 ? edge_entry(e, w == 6 ? 1 : std::ptrdiff_t(n))
+                        : st.v[std::size_t(w)].bound(c, h.p, out.data(), std::ptrdiff_t(e));
+      }
+      b.size = 0;
+    }
+#endif
   }
 }
 

@@ -156,9 +156,12 @@ struct StrideGrid {
            ((j - off) & ((std::int64_t{1} << shift) - 1)) == 0 && m < nx && n < nz;
   }
   DiamondBound get(std::int64_t i, std::int64_t j) const noexcept {
-    if (!has(i, j)) return {};
+    return packed::unpack(get_packed(i, j));
+  }
+  std::uint32_t get_packed(std::int64_t i, std::int64_t j) const noexcept {
+    if (!has(i, j)) return 0;  // unpacks to DiamondBound{}
     const std::size_t k = std::size_t((i - off) >> shift) + std::size_t((j - off) >> shift) * std::size_t(nx);
-    return packed::unpack(v[k]);
+    return v[k];
   }
   void set(std::int64_t i, std::int64_t j, const DiamondBound& b) noexcept {
     set_packed(i, j, packed::pack(b));
@@ -247,6 +250,14 @@ void level_bounds(const RecordConfig& c, const H& h, int k, StrideGrid& grid,
       if (grid.has(ci, cj)) return grid.get(ci, cj);
       return below_squares.get(ci, cj);
     };
+    auto child_packed = [&](std::int64_t ci, std::int64_t cj) -> std::uint32_t {
+      if (grid.has(ci, cj)) return grid.get_packed(ci, cj);
+      return below_squares.get_packed(ci, cj);
+    };
+    // The small triangles' stencils serve the size-4 edges too (legs of 4 cells across, the
+    // table's largest) without detail or holes, below the patches' top; larger triangles'
+    // rows come from their shapes' table (exact_triangle()).
+    const bool stencils = c.L == 0 && c.holes == nullptr && t < c.patch_log2 - 1 && t == 2 && !square;
     // The diamond at position (a, b) from heights `hh`, when it is of this kind and meets the box.
     auto one = [&](const auto& hh, std::int64_t a, std::int64_t b) {
       const std::int64_t i = a * stride, j = b * stride;
@@ -275,8 +286,33 @@ void level_bounds(const RecordConfig& c, const H& h, int k, StrideGrid& grid,
       for (std::int64_t z = 0; z < n; ++z)
         read_row(h, z0 + z, x0, x0 + n - 1, heights.data() + z * n);
       const DenseBlock dense{heights.data(), x0, z0, n};
+      if (!stencils) {
+        for (std::int64_t b = pb0; b <= pb1; ++b)
+          for (std::int64_t a = pa0; a <= pa1; ++a) one(dense, a, b);
+        return;
+      }
+      // Diamonds inside the data through the stencil of their orientation (four at a time where
+      // the CPU allows), the others through bound_of().
+      const SmallStencils& st = small_stencils(t, square, n);
+      StencilBatches batches(st, c, heights.data());
+      auto store = [&grid](std::int64_t i, std::int64_t j, std::uint32_t v) { grid.set_packed(i, j, v); };
       for (std::int64_t b = pb0; b <= pb1; ++b)
-        for (std::int64_t a = pa0; a <= pa1; ++a) one(dense, a, b);
+        for (std::int64_t a = pa0; a <= pa1; ++a) {
+          const std::int64_t i = a * stride, j = b * stride;
+          if (i - s < 0 || j - s < 0 || i + s > c.last_i || j + s > c.last_j) {
+            one(dense, a, b);
+            continue;
+          }
+          const Diamond d = diamond_at(i, j, c.patch_log2);
+          if (d.corner || d.t != t || d.square != square) continue;
+          if (i + reach < i0 || i - reach > i1 || j + reach < j0 || j - reach > j1) continue;
+          const int which = st.which(i, j);
+          std::uint32_t cv[4];
+          for (int q = 0; q < 4; ++q)
+            cv[q] = child_packed(i + st.v[std::size_t(which)].cdi[q], j + st.v[std::size_t(which)].cdj[q]);
+          batches.add(which, std::int32_t((i - x0) + (j - z0) * n), cv, i, j, store);
+        }
+      batches.flush(store);
     });
   }
 }

@@ -86,9 +86,9 @@ inline DiamondBound unpack(std::uint32_t v) noexcept {
   const float e = down12(v & 0xfffu);
   return {e, e * kRatio[v >> 24], down12((v >> 12) & 0xfffu)};
 }
-inline std::uint32_t pack(const DiamondBound& b) noexcept {
-  const float morph = std::max(b.morph, b.error);
-  std::uint32_t ce = up12(b.error);
+/// The error code `ce` (up12 of the error) with the morph code of a morph bound `morph` (at
+/// least the error) in bits 24-31: the error code raised when the ratio would pass kRatio[255].
+inline std::uint32_t with_morph(std::uint32_t ce, float morph) noexcept {
   float e = down12(ce);
   std::uint32_t cm = 0;
   if (morph > e) {
@@ -110,7 +110,10 @@ inline std::uint32_t pack(const DiamondBound& b) noexcept {
       cm = std::uint32_t(c);
     }
   }
-  return ce | (up12(b.radius) << 12) | (cm << 24);
+  return ce | (cm << 24);
+}
+inline std::uint32_t pack(const DiamondBound& b) noexcept {
+  return with_morph(up12(b.error), std::max(b.morph, b.error)) | (up12(b.radius) << 12);
 }
 }  // namespace packed
 

@@ -6,10 +6,12 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <random>
 #include <sstream>
+#include <tuple>
 #include <vector>
 
 #include "ridgeline/heightfield.h"
@@ -217,5 +219,88 @@ TEST(Records, TheWholeWorldPassGivesEachPageItsOwnLevel0Block) {
                                << " packed bounds differ from the page's own block";
     }
     EXPECT_EQ(level0, std::size_t(g.px[0]) * std::size_t(g.pz[0]));
+  }
+}
+
+// The coarse levels of a whole world (build_all: sizes 4 and 8 through the small triangles'
+// stencils, four at a time where the CPU allows, tile by tile; larger ones through bound_of())
+// hold, for every diamond, exactly diamond_bound() of its heights and its children's stored
+// bounds: a stencil of the wrong orientation, a child read from the wrong place or a lane mixed
+// up changes some of them.
+TEST(Records, CoarseLevelsAreTheGeneralBoundsOfTheirStoredChildren) {
+  for (const int round : {0, 1}) {
+    const std::int64_t w = 700 - 37 * round, hgt = 530 + 21 * round;
+    std::vector<float> values(std::size_t(w * hgt));
+    std::mt19937 rng(11 + round);
+    std::uniform_real_distribution<float> bump(-0.8f, 0.8f);
+    for (std::int64_t j = 0; j < hgt; ++j)
+      for (std::int64_t i = 0; i < w; ++i) {
+        const float v = 25.0f * std::sin(0.023f * float(i)) * std::cos(0.041f * float(j)) + bump(rng);
+        values[std::size_t(i + j * w)] = round == 1 ? std::round(8.0f * v) / 8.0f : v;
+      }
+    HeightfieldDesc desc;
+    desc.width = std::uint32_t(w), desc.height = std::uint32_t(hgt);
+    desc.spacing_x = 1.25, desc.spacing_z = 0.8;
+    auto hf = Heightfield::create(desc, values);
+    ASSERT_TRUE(hf) << hf.error().message;
+    WorldInfo info;
+    info.width = std::uint32_t(w), info.height = std::uint32_t(hgt);
+    info.spacing_x = 1.25, info.spacing_z = 0.8;
+    info.height_scale = hf->height_scale();
+    info.format = world::fits_u16(*hf) ? SampleFormat::kU16 : SampleFormat::kF32;
+    info.min_local = hf->min_local(), info.max_local = hf->max_local();
+    const auto store = world::PageStore::from_heightfield(*hf, info);
+    const world::PageGrid& g = store->grid();
+    const auto table = store->snapshot();
+    // The heights as the pages hold them (what the level-0 blocks are made from).
+    std::vector<float> dense(values.size());
+    for (std::int64_t j = 0; j < hgt; ++j)
+      for (std::int64_t i = 0; i < w; ++i)
+        dense[std::size_t(i + j * w)] = table->find(0, std::int32_t(i >> 8), std::int32_t(j >> 8))
+                                            ->local(std::int32_t(i & 255), std::int32_t(j & 255));
+    Heights h;
+    h.f32 = dense.data(), h.stride = w, h.last_i = w - 1, h.last_j = hgt - 1;
+    RecordConfig c;
+    c.patch_log2 = 7 - round;
+    c.growth = round == 0 ? std::sqrt(1.3) : 1.0;
+    c.last_i = w - 1, c.last_j = hgt - 1;
+    const std::int64_t P = std::int64_t{1} << c.patch_log2;
+    c.pad_i = ((c.last_i + P - 1) / P) * P, c.pad_j = ((c.last_j + P - 1) / P) * P;
+    c.spacing_x = 1.25, c.spacing_z = 0.8;
+    std::map<std::tuple<std::uint32_t, std::int32_t, std::int32_t>, std::shared_ptr<RecordBlock>> blocks;
+    std::mutex mu;
+    build_all(
+        c, g, h, [&](const PageKey& k) { return table->find(k); },
+        [&](const PageKey& k, std::shared_ptr<RecordBlock> b) {
+          std::lock_guard lock(mu);
+          blocks[{k.level, k.px, k.pz}] = std::move(b);
+        },
+        2);
+    auto stored = [&](std::int64_t i, std::int64_t j) -> std::uint32_t {
+      const Diamond d = diamond_at(i, j, c.patch_log2);
+      const std::uint32_t k = record_level(d.t, g.levels);
+      const PageKey key = g.page_of(k, i, j);
+      const RecordBlock& b = *blocks.at({k, key.px, key.pz});
+      const std::int32_t a = std::int32_t((i >> (2 * k)) - (std::int64_t(key.px) << 8));
+      const std::int32_t bb = std::int32_t((j >> (2 * k)) - (std::int64_t(key.pz) << 8));
+      return b.values[b.slot(a, bb)];
+    };
+    std::size_t compared[8] = {}, differing = 0;
+    for (std::int64_t j = 0; j <= c.pad_j; j += 4)
+      for (std::int64_t i = 0; i <= c.pad_i; i += 4) {
+        const Diamond d = diamond_at(i, j, c.patch_log2);
+        if (d.corner || d.t < 2) continue;
+        const std::uint32_t want = packed::pack(diamond_bound(
+            c, h, i, j, [&](std::int64_t ci, std::int64_t cj) { return packed::unpack(stored(ci, cj)); }));
+        const std::uint32_t got = stored(i, j);
+        ++compared[std::min(d.t, 7)];
+        if (got != want && ++differing <= 5)
+          ADD_FAILURE() << "round " << round << ", the size-" << (1 << d.t) << (d.square ? " square" : " edge")
+                        << " diamond at (" << i << ", " << j << "): stored " << std::hex << got
+                        << ", diamond_bound() " << want << std::dec;
+      }
+    EXPECT_EQ(differing, 0u);
+    EXPECT_GT(compared[2], 3000u);
+    EXPECT_GT(compared[3], 1000u);
   }
 }
