@@ -833,10 +833,12 @@ inline void small_bounds(const RecordConfig& c, const DenseBlock& h, std::vector
       auto first = [&](std::int64_t lo, std::int64_t res) {
         return lo + (((res - lo) % k.m) + k.m) % k.m;
       };
-      for (std::int64_t j = first(j0, k.rj[v]); j < j0 + n; j += k.m) {
-        if (j < 0 || j > c.pad_j || !within(j, r, j0, j0 + n - 1, c.pad_j)) continue;
-        for (std::int64_t i = first(i0, k.ri[v]); i < i0 + n; i += k.m) {
-          if (i < 0 || i > c.pad_i || !within(i, r, i0, i0 + n - 1, c.pad_i)) continue;
+      // Only the block's part of the padded extent (a small world's page is mostly past it).
+      const std::int64_t jend = std::min(j0 + n - 1, c.pad_j), iend = std::min(i0 + n - 1, c.pad_i);
+      for (std::int64_t j = first(std::max<std::int64_t>(j0, 0), k.rj[v]); j <= jend; j += k.m) {
+        if (!within(j, r, j0, j0 + n - 1, c.pad_j)) continue;
+        for (std::int64_t i = first(std::max<std::int64_t>(i0, 0), k.ri[v]); i <= iend; i += k.m) {
+          if (!within(i, r, i0, i0 + n - 1, c.pad_i)) continue;
           // The residues make (i, j) a diamond of this kind (t <= 1 < patch_log2: never a corner).
           const std::size_t e = std::size_t((i - i0) + (j - j0) * n);
           const std::int64_t s = std::int64_t{1} << k.t;

@@ -103,10 +103,12 @@ std::shared_ptr<RecordBlock> level0_from(const RecordConfig& c, std::int32_t px,
   block->level = 0;
   block->edges = c.L > 0;
   block->values.assign(RecordBlock::slots(0, block->edges), 0);
-  for (std::int32_t b = 0; b <= kPageCells; ++b)
-    for (std::int32_t a = 0; a <= kPageCells; ++a) {
+  // Entries past the padded extent hold no diamond (most of a small world's page).
+  const std::int32_t bend = std::int32_t(std::min<std::int64_t>(kPageCells, c.pad_j - j0));
+  const std::int32_t aend = std::int32_t(std::min<std::int64_t>(kPageCells, c.pad_i - i0));
+  for (std::int32_t b = 0; b <= bend; ++b)
+    for (std::int32_t a = 0; a <= aend; ++a) {
       const std::int64_t i = i0 + a, j = j0 + b;
-      if (i > c.pad_i || j > c.pad_j) continue;
       const Diamond d = diamond_at(i, j, c.patch_log2);
       if (d.corner || d.t >= 2) continue;
       if (d.t == 0 && !d.square && !block->edges) continue;
