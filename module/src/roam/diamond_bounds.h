@@ -48,10 +48,23 @@ void read_row(const H& h, std::int64_t z, std::int64_t lo, std::int64_t hi, floa
   for (std::int64_t x = lo; x <= hi; ++x) out[x - lo] = h(x, z);
 }
 [[gnu::always_inline]] inline void read_row(const Heights& h, std::int64_t z, std::int64_t lo, std::int64_t hi, float* out) {
-  if ((h.f32 == nullptr && h.u16 == nullptr) || z < 0 || z > h.last_j || lo < 0 ||
-      hi > h.last_i) {
+  if (h.f32 == nullptr && h.u16 == nullptr) {
     for (std::int64_t x = lo; x <= hi; ++x) out[x - lo] = h(x, z);
     return;
+  }
+  // Past the data the accessor repeats the edge: the row's clamped row, its ends repeated.
+  z = z < 0 ? 0 : (z > h.last_j ? h.last_j : z);
+  if (lo < 0 || hi > h.last_i) {
+    const std::int64_t a = std::max<std::int64_t>(lo, 0), b = std::min(hi, h.last_i);
+    if (a > b) {  // wholly past one side
+      const float v = h(lo < 0 ? 0 : h.last_i, z);
+      for (std::int64_t x = lo; x <= hi; ++x) out[x - lo] = v;
+      return;
+    }
+    const float first = h(0, z), last = h(h.last_i, z);
+    for (std::int64_t x = lo; x < a; ++x) out[x - lo] = first;
+    for (std::int64_t x = b + 1; x <= hi; ++x) out[x - lo] = last;
+    out += a - lo, lo = a, hi = b;
   }
   const std::size_t e = std::size_t(lo) + std::size_t(z) * std::size_t(h.stride);
   const std::size_t n = std::size_t(hi - lo + 1);

@@ -304,3 +304,29 @@ TEST(Records, CoarseLevelsAreTheGeneralBoundsOfTheirStoredChildren) {
     EXPECT_GT(compared[3], 1000u);
   }
 }
+
+// A row read in one go (the bounds' dense copies) holds the accessor's values bit for bit: past
+// the data on either side, wholly past it, on rows past the first and the last, 16-bit and float.
+TEST(Records, ReadRowRepeatsTheEdgesAsTheAccessorDoes) {
+  const std::int64_t w = 13, hgt = 7;
+  std::vector<float> f(std::size_t(w * hgt));
+  std::vector<std::uint16_t> u(f.size());
+  for (std::size_t k = 0; k < f.size(); ++k) f[k] = 0.37f * float(k) - 5.0f, u[k] = std::uint16_t(977 * k % 65536);
+  for (const bool as_u16 : {false, true}) {
+    Heights h;
+    h.f32 = as_u16 ? nullptr : f.data();
+    h.u16 = as_u16 ? u.data() : nullptr;
+    h.scale = 0.013;
+    h.stride = w, h.last_i = w - 1, h.last_j = hgt - 1;
+    std::vector<float> row(64);
+    for (std::int64_t z = -3; z <= hgt + 2; ++z)
+      for (std::int64_t lo = -20; lo <= w + 5; lo += 3)
+        for (std::int64_t hi = lo; hi <= lo + 40; hi += 7) {
+          bounds::read_row(h, z, lo, hi, row.data());
+          for (std::int64_t x = lo; x <= hi; ++x)
+            ASSERT_EQ(std::bit_cast<std::uint32_t>(row[std::size_t(x - lo)]), std::bit_cast<std::uint32_t>(h(x, z)))
+                << (as_u16 ? "16-bit" : "float") << " row " << z << ", samples " << lo << " .. " << hi
+                << ": sample " << x;
+        }
+  }
+}
