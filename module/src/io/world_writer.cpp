@@ -302,7 +302,18 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
       else
         s->f32.resize(kPageEntries);
       if (mats) s->materials.resize(kPageEntries);
-      for (std::int32_t b = -kPageApron; b <= kPageCells + kPageApron; ++b)
+      // A row of a finest page inside the data: one copy.
+      const std::int64_t x0 = i0 - kPageApron, x1 = i0 + kPageCells + kPageApron;
+      const bool rows = k == 0 && !mats && x0 >= 0 && x1 <= grid.last_i;
+      for (std::int32_t b = -kPageApron; b <= kPageCells + kPageApron; ++b) {
+        if (rows) {
+          const std::size_t from = sample(-kPageApron, b), e = world::entry_index(-kPageApron, b);
+          if (store_u16)
+            std::memcpy(s->u16.data() + e, u16 + from, std::size_t(kPageStride) * 2);
+          else
+            std::memcpy(s->f32.data() + e, f32 + from, std::size_t(kPageStride) * 4);
+          continue;
+        }
         for (std::int32_t a = -kPageApron; a <= kPageCells + kPageApron; ++a) {
           const std::size_t at = sample(a, b), e = world::entry_index(a, b);
           if (store_u16)
@@ -316,6 +327,7 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
             s->materials[e] = in.materials[std::size_t(i) + std::size_t(j) * info.width];
           }
         }
+      }
       world::Page page;
       page.key = key;
       page.set_samples(s, info.height_scale);
@@ -326,14 +338,18 @@ Result<BakeReport> bake_world(const BakeSamples& in, const std::string& path,
         tile.resize(kTileSamples);
         ring.clear();
         ring.reserve(kApronSamples);
-        for (std::int32_t b = -kPageApron; b <= kPageCells + kPageApron; ++b)
-          for (std::int32_t a = -kPageApron; a <= kPageCells + kPageApron; ++a) {
-            const std::uint16_t v = s->u16[world::entry_index(a, b)];
-            if (a >= 0 && b >= 0 && a < std::int32_t(kTile) && b < std::int32_t(kTile))
-              tile[std::size_t(a) + std::size_t(b) * kTile] = v;
-            else
-              ring.push_back(v);
+        // Row by row: the tile's part of the row, the rest to the ring in entry order.
+        const std::uint16_t* ev = s->u16.data();
+        for (std::int32_t b = -kPageApron; b <= kPageCells + kPageApron; ++b) {
+          const std::uint16_t* row = ev + world::entry_index(-kPageApron, b);
+          if (b < 0 || b >= std::int32_t(kTile)) {
+            ring.insert(ring.end(), row, row + kPageStride);
+            continue;
           }
+          ring.insert(ring.end(), row, row + kPageApron);
+          std::memcpy(tile.data() + std::size_t(b) * kTile, row + kPageApron, kTile * 2);
+          ring.insert(ring.end(), row + kPageApron + kTile, row + kPageStride);
+        }
         encode_u16(tile);
         cp.tile = deflate({reinterpret_cast<const std::uint8_t*>(tile.data()), tile.size() * 2},
                           o.compression_level);
