@@ -248,14 +248,11 @@ void level_bounds(const RecordConfig& c, const H& h, int k, StrideGrid& grid,
     const std::int64_t b0 = std::max<std::int64_t>(0, floor_div(j0 - reach, stride));
     const std::int64_t b1 = std::min<std::int64_t>(c.pad_j / stride, floor_div(j1 + reach, stride) + 1);
     if (a1 < a0 || b1 < b0) continue;
-    auto child = [&](std::int64_t ci, std::int64_t cj) -> DiamondBound {
-      if (grid.has(ci, cj)) return grid.get(ci, cj);
-      return below_squares.get(ci, cj);
-    };
     auto child_packed = [&](std::int64_t ci, std::int64_t cj) -> std::uint32_t {
       if (grid.has(ci, cj)) return grid.get_packed(ci, cj);
       return below_squares.get_packed(ci, cj);
     };
+    auto child = [&](std::int64_t ci, std::int64_t cj) { return packed::unpack(child_packed(ci, cj)); };
     // The small triangles' stencils serve the size-4 edges too (legs of 4 cells across, the
     // table's largest) without detail or holes, below the patches' top; larger triangles'
     // rows come from their shapes' table (exact_triangle()).
