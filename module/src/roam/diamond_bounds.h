@@ -560,10 +560,11 @@ struct SmallStencil {
 };
 
 #if RIDGELINE_HAS_AVX2_DISPATCH
-// The t <= 1 diamonds four at a time (AVX2, chosen at run time): the scalar arithmetic of
-// SmallStencil::bound() and the edge rule in four lanes, the same operations in the same order
-// (doubles, no fused multiply-adds), so every lane's packed bound is the scalar one bit for bit
-// (Records.SmallDiamondStencilsGiveTheGeneralBoundsBitForBit). `lanes`: the four centres' entries.
+// The stencil diamonds (t <= 1 and the t = 2 edges) four at a time (AVX2, chosen at run time):
+// the scalar arithmetic of SmallStencil::bound() and the edge rule in four lanes, the same
+// operations in the same order (doubles, no fused multiply-adds), so every lane's packed bound is
+// the scalar one bit for bit (Records.SmallDiamondStencilsGiveTheGeneralBoundsBitForBit,
+// Records.CoarseLevelsAreTheGeneralBoundsOfTheirStoredChildren). `lanes`: the centres' entries.
 namespace x4 {
 
 // packed::up12() of four floats.
