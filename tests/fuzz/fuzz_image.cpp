@@ -3,8 +3,10 @@
 // the file extension (bits 0-2), whether a channel is chosen (bit 3) and which (bits 4-5), and
 // whether the CRCs of a PNG's chunks are fixed up (bit 7); the rest is written to a file.
 //
-// Speed (docs/reliability/fuzzing.md): images are capped at 4,096 samples before any pixel is
-// decoded, and OpenImageIO runs on one thread. Mutated PNG bytes would almost always fail their
+// The loader offers a file to the reader its extension names, then to the one its first bytes
+// name (module/src/io/image_loader.cpp): the extension-less inputs reach every accepted reader
+// through the signatures. Speed (docs/reliability/fuzzing.md): images are capped at 4,096
+// samples before any pixel is decoded, and OpenImageIO runs on one thread. Mutated PNG bytes would almost always fail their
 // chunk's CRC (the loader walks the chunks first), so half the PNG inputs get their CRCs
 // recomputed to reach the decoder.
 #include <OpenImageIO/imageio.h>
@@ -55,10 +57,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (size < 1) return 0;
   static const char* const kExt[] = {".png", ".tif", ".exr", ".pgm", ".hdr", ".bmp", ".tga", ""};
   const char* ext = kExt[data[0] % 8];
-  // A file that its extension's reader refuses is offered to every other reader only when it has
-  // no extension: that path is the one a misnamed file takes, and probing every reader (LibRaw's
-  // is a large object made afresh for each probe) would otherwise cost most of every input.
-  OIIO::attribute("try_all_readers", *ext == '\0' ? 1 : 0);
   std::vector<unsigned char> bytes(data + 1, data + size);
   if (std::strcmp(ext, ".png") == 0 && (data[0] & 0x80) != 0) fix_png_crcs(bytes);
   const std::string path = "/tmp/ridgeline_fuzz_image_" + std::to_string(getpid()) + ext;

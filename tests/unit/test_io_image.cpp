@@ -219,6 +219,72 @@ TEST(IoBadInput, NotAnImage) {
   EXPECT_TRUE(contains(e.error().message, "heightmap '" + empty + "'")) << e.error().message;
 }
 
+// A file is read by the reader its extension names, or by the one its first bytes name when the
+// extension names none of the accepted formats or that reader refuses it.
+TEST(IoFormats, AFileIsReadByItsSignatureWhenItsNameSaysNothingOrLies) {
+  const std::vector<std::uint16_t> px = {0, 1, 500, 65535, 7, 8};
+  const auto png = tmp_path("as_png.png");
+  write_image(png, 3, 2, 1, OIIO::TypeDesc::UINT16, px);
+  const auto tif = tmp_path("as_tif.tif");
+  write_image(tif, 3, 2, 1, OIIO::TypeDesc::UINT16, px);
+  const auto pgm = tmp_path("as_pgm.pgm");
+  write_image(pgm, 3, 2, 1, OIIO::TypeDesc::UINT16, px);
+  const struct {
+    std::string from, to;
+  } cases[] = {{png, tmp_path("png_named_tif.tif")},
+               {tif, tmp_path("tif_named_png.png")},
+               {tif, tmp_path("tif_without_extension")},
+               {pgm, tmp_path("pgm_named.dat")},
+               {png, tmp_path("png_named.RLA")}};
+  // The PNG and TIFF give the 16-bit values written (the PGM as OpenImageIO wrote it: 8-bit).
+  for (const auto& path : {png, tif}) {
+    auto hf = io::load_image(path, options());
+    ASSERT_TRUE(hf) << hf.error().message;
+    for (std::size_t k = 0; k < px.size(); ++k) EXPECT_EQ(locals(*hf)[k], float(px[k])) << path;
+  }
+  for (const auto& c : cases) {
+    fs::copy_file(c.from, c.to, fs::copy_options::overwrite_existing);
+    auto by_name = io::load_image(c.from, options());
+    ASSERT_TRUE(by_name) << c.from << ": " << by_name.error().message;
+    auto hf = io::load_image(c.to, options());
+    ASSERT_TRUE(hf) << c.to << ": " << hf.error().message;
+    EXPECT_EQ(locals(*hf), locals(*by_name)) << c.to;
+    ASSERT_EQ(locals(*hf).size(), px.size()) << c.to;
+  }
+}
+
+// OpenImageIO reads some 28 formats; a heightmap is read only by the readers of the listed ones, so
+// an image another reader would take (here an RLA file OpenImageIO writes and reads) is refused with
+// the list, whatever its name. Debian's OpenImageIO aborts the process in that reader on a crafted
+// file (tests/fuzz/corpus/fuzz_image/crash-rla-channel-type-assert).
+TEST(IoFormats, OnlyTheListedFormatsReachAReader) {
+  const std::vector<std::uint8_t> px = {1, 2, 3, 4, 5, 6};
+  const auto rla = tmp_path("h.rla");
+  write_image(rla, 3, 2, 1, OIIO::TypeDesc::UINT8, px);
+  {
+    auto direct = OIIO::ImageInput::open(rla);
+    ASSERT_TRUE(direct) << "OpenImageIO cannot read back its own RLA file";
+  }
+  const auto bare = tmp_path("rla_without_extension");
+  fs::copy_file(rla, bare, fs::copy_options::overwrite_existing);
+  for (const auto& path : {rla, bare}) {
+    auto hf = io::load_image(path, options());
+    ASSERT_FALSE(hf) << path;
+    EXPECT_EQ(hf.error().message,
+              "heightmap '" + path +
+                  "': not a readable image: neither its name nor its first bytes are those of a "
+                  "PNG, TIFF, OpenEXR, PNM, Radiance HDR, BMP, TGA or JPEG image (a headerless "
+                  "raw file needs --raw-size W,H)");
+  }
+  // JPEG is one of them (8-bit: the raw integers, as PNG).
+  const auto jpg = tmp_path("h.jpg");
+  const std::vector<std::uint8_t> flat(16 * 16, 200);
+  write_image(jpg, 16, 16, 1, OIIO::TypeDesc::UINT8, flat);
+  auto hf = io::load_image(jpg, options());
+  ASSERT_TRUE(hf) << hf.error().message;
+  for (float v : locals(*hf)) EXPECT_NEAR(v, 200.0f, 1.0f);
+}
+
 TEST(IoBadInput, TruncatedFilesAreRefused) {
   // Noise does not compress, so cutting the file in half removes pixel data, not just padding.
   const int w = 64, h = 64;

@@ -9,8 +9,11 @@
 #include <limits>
 #include <cctype>
 #include <filesystem>
+#include <fstream>
+#include <initializer_list>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "format.h"
@@ -89,6 +92,69 @@ std::string channel_list(const ImageSpec& spec) {
   return out;
 }
 
+// The image formats heightmaps and material layers are read from, by OpenImageIO's reader of that
+// name. A file goes to the reader its extension names, or, when it has no such extension or that
+// reader refuses it, to the one its first bytes name; no other reader ever sees it. OpenImageIO
+// would otherwise offer a file to each of its ~28 readers in turn (video through ffmpeg, camera raw,
+// DICOM, ...), and Debian's OpenImageIO 2.4 aborts the process in one of them (RLA, an assertion on
+// a crafted channel type) on a file of 76 bytes. These are the readers the fuzz campaign runs
+// (tests/fuzz/fuzz_image.cpp, docs/reliability/fuzzing.md).
+struct ImageFormat {
+  const char* reader;  // OpenImageIO's format name
+  const char* label;
+  std::initializer_list<const char*> extensions;
+};
+const ImageFormat kFormats[] = {
+    {"png", "PNG", {"png"}},
+    {"tiff", "TIFF", {"tif", "tiff"}},
+    {"openexr", "OpenEXR", {"exr"}},
+    {"pnm", "PNM", {"pgm", "ppm", "pbm", "pnm", "pfm"}},
+    {"hdr", "Radiance HDR", {"hdr", "rgbe"}},
+    {"bmp", "BMP", {"bmp", "dib"}},
+    {"targa", "TGA", {"tga"}},
+    {"jpeg", "JPEG", {"jpg", "jpeg", "jpe"}},
+};
+constexpr const char* kFormatList = "PNG, TIFF, OpenEXR, PNM, Radiance HDR, BMP, TGA or JPEG";
+
+const ImageFormat* format_named(std::string_view reader) {
+  for (const ImageFormat& f : kFormats)
+    if (reader == f.reader) return &f;
+  return nullptr;
+}
+
+const ImageFormat* format_by_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  if (ext.empty()) return nullptr;
+  ext.erase(0, 1);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  for (const ImageFormat& f : kFormats)
+    for (const char* e : f.extensions)
+      if (ext == e) return &f;
+  return nullptr;
+}
+
+// The format whose signature the file starts with (TGA has none: by extension only).
+const ImageFormat* format_by_signature(const std::string& path) {
+  unsigned char h[8] = {};
+  std::ifstream in(path, std::ios::binary);
+  in.read(reinterpret_cast<char*>(h), sizeof h);
+  const std::size_t n = static_cast<std::size_t>(in.gcount());
+  auto starts = [&](std::initializer_list<unsigned char> sig) {
+    return sig.size() <= n && std::equal(sig.begin(), sig.end(), h);
+  };
+  if (starts({0x89, 'P', 'N', 'G', 0x0d, 0x0a, 0x1a, 0x0a})) return format_named("png");
+  if (starts({'I', 'I', '*', 0}) || starts({'M', 'M', 0, '*'}) || starts({'I', 'I', '+', 0}) ||
+      starts({'M', 'M', 0, '+'}))
+    return format_named("tiff");
+  if (starts({0x76, 0x2f, 0x31, 0x01})) return format_named("openexr");
+  if (n >= 2 && h[0] == 'P' && ((h[1] >= '1' && h[1] <= '6') || h[1] == 'f' || h[1] == 'F'))
+    return format_named("pnm");
+  if (starts({'#', '?'})) return format_named("hdr");
+  if (starts({'B', 'M'})) return format_named("bmp");
+  if (starts({0xff, 0xd8, 0xff})) return format_named("jpeg");
+  return nullptr;
+}
+
 /// An open image whose header passed the checks common to heightmaps and material layers.
 struct OpenImage {
   std::unique_ptr<ImageInput> input;
@@ -99,11 +165,35 @@ struct OpenImage {
 Result<OpenImage> open_image(const std::string& path, const std::string& name) {
   if (auto s = detail::check_regular_file(path, name); !s) return Error{s.message()};
   if (auto s = detail::check_png_chunks(path, name); !s) return Error{s.message()};
+  const ImageFormat* by_extension = format_by_extension(path);
+  const ImageFormat* by_signature = format_by_signature(path);
+  if (by_extension == nullptr && by_signature == nullptr)
+    return Error{fmt("%s: not a readable image: neither its name nor its first bytes are those of "
+                     "a %s image (a headerless raw file needs --raw-size W,H)",
+                     name.c_str(), kFormatList)};
   // Keep colour values as stored: OIIO would otherwise premultiply grey by alpha.
   ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);
-  auto in = ImageInput::open(path, &config);
-  if (!in) return Error{name + ": not a readable image: " + one_line(OIIO::geterror())};
+  std::unique_ptr<ImageInput> in;
+  std::string refusals;
+  const ImageFormat* tries[] = {by_extension, by_signature != by_extension ? by_signature : nullptr};
+  for (const ImageFormat* f : tries) {
+    if (f == nullptr) continue;
+    auto candidate = ImageInput::create(f->reader);
+    if (!candidate) {
+      refusals += fmt("%sno %s reader: %s", refusals.empty() ? "" : "; ", f->label,
+                      one_line(OIIO::geterror()).c_str());
+      continue;
+    }
+    ImageSpec opened;
+    if (candidate->open(path, opened, config)) {
+      in = std::move(candidate);
+      break;
+    }
+    refusals += fmt("%sas %s: %s", refusals.empty() ? "" : "; ", f->label,
+                    one_line(candidate->geterror()).c_str());
+  }
+  if (!in) return Error{name + ": not a readable image: " + refusals};
   const ImageSpec& spec = in->spec();
   if (spec.deep) return Error{name + ": deep images are not supported"};
   if (spec.depth > 1)
