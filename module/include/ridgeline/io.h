@@ -92,7 +92,9 @@ struct LoadReport {
 };
 
 /// Loads a heightmap through OpenImageIO: 8- and 16-bit greyscale PNG, 16-bit and float TIFF,
-/// float EXR (anything else OpenImageIO reads with one channel works too). Integer formats give
+/// float EXR; also PNM, Radiance HDR, BMP, TGA and JPEG. The reader is the one the extension names,
+/// else the one the file's first bytes name; OpenImageIO's other formats are refused (docs/
+/// data_model.md, "File formats"). Integer formats give
 /// the raw integer as value (0..255 or 0..65535; signed and 32-bit integers likewise, the latter
 /// rounded to float above 2^24), half/float formats the float, double pixels are rounded to float.
 /// Headers are checked (size against `placement.max_samples`, channels, pixel type) before any

@@ -97,7 +97,7 @@ std::string channel_list(const ImageSpec& spec) {
 // reader refuses it, to the one its first bytes name; no other reader ever sees it. OpenImageIO
 // would otherwise offer a file to each of its ~28 readers in turn (video through ffmpeg, camera raw,
 // DICOM, ...), and Debian's OpenImageIO 2.4 aborts the process in one of them (RLA, an assertion on
-// a crafted channel type) on a file of 76 bytes. These are the readers the fuzz campaign runs
+// a crafted channel type) on such a file. These are the readers the fuzz campaign runs
 // (tests/fuzz/fuzz_image.cpp, docs/reliability/fuzzing.md).
 struct ImageFormat {
   const char* reader;  // OpenImageIO's format name
