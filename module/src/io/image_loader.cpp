@@ -6,6 +6,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
+#include <array>
 #include <limits>
 #include <cctype>
 #include <filesystem>
@@ -102,7 +103,7 @@ std::string channel_list(const ImageSpec& spec) {
 struct ImageFormat {
   const char* reader;  // OpenImageIO's format name
   const char* label;
-  std::initializer_list<const char*> extensions;
+  std::array<const char*, 5> extensions;  // lower case, unused ones null
 };
 const ImageFormat kFormats[] = {
     {"png", "PNG", {"png"}},
@@ -129,7 +130,7 @@ const ImageFormat* format_by_extension(const std::string& path) {
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   for (const ImageFormat& f : kFormats)
     for (const char* e : f.extensions)
-      if (ext == e) return &f;
+      if (e != nullptr && ext == e) return &f;
   return nullptr;
 }
 
